@@ -1,0 +1,228 @@
+#include "laser_laws.h"
+
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+namespace laser {
+
+RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf, double lo,
+                       double hi, double xtol, int maxit) {
+  RootResult r;
+  double flo, fhi, d;
+  fdf(lo, flo, d);
+  fdf(hi, fhi, d);
+  if (flo == 0.0) { r.x = lo; r.converged = true; return r; }
+  if (fhi == 0.0) { r.x = hi; r.converged = true; return r; }
+  if ((flo > 0.0) == (fhi > 0.0) || !std::isfinite(flo) || !std::isfinite(fhi)) {
+    r.x = std::numeric_limits<double>::quiet_NaN();
+    return r;
+  }
+  if (flo > 0.0) std::swap(lo, hi);  // orient so that f(lo) < 0 < f(hi)
+  double x = 0.5 * (lo + hi), dxold = std::fabs(hi - lo), dx = dxold;
+  double f, df;
+  fdf(x, f, df);
+  for (int it = 1; it <= maxit; ++it) {
+    r.iterations = it;
+    const bool newton_leaves = ((x - hi) * df - f) * ((x - lo) * df - f) > 0.0;
+    const bool too_slow = std::fabs(2.0 * f) > std::fabs(dxold * df);
+    dxold = dx;
+    if (newton_leaves || too_slow || !std::isfinite(df) || df == 0.0) {
+      dx = 0.5 * (hi - lo);
+      x = lo + dx;
+    } else {
+      dx = f / df;
+      x -= dx;
+    }
+    if (std::fabs(dx) <= xtol) { r.converged = true; break; }
+    fdf(x, f, df);
+    if (f == 0.0) { r.converged = true; break; }
+    if (f < 0.0) lo = x; else hi = x;
+    if (std::fabs(hi - lo) <= xtol) { r.converged = true; break; }
+  }
+  r.x = x;
+  return r;
+}
+
+Groups make_groups(const Material& m, double I0, double R) {
+  Groups G;
+  G.dT = m.Tsat0 - m.Tm;
+  G.alpha_l = m.kl / (m.rho * m.cpl);
+  G.alpha_s = m.ks / (m.rho * m.cps);
+  G.t_scale = R * R / G.alpha_l;
+  G.p_scale = m.rho * G.alpha_l * G.alpha_l / (R * R);
+  G.v_scale = G.alpha_l / R;
+  G.Na = G.alpha_s / G.alpha_l;
+  G.Nc = m.cps / m.cpl;
+  G.k = m.kl / m.ks;
+  G.Ste = m.cpl * G.dT / m.hls;
+  G.theta_i = (m.Ti - m.Tm) / G.dT;
+  G.theta_m = m.Tm / m.Tsat0;
+  G.kprime = m.kl * G.dT / (R * I0);
+  G.Iprime = I0 / (m.p0 * m.hlv) * std::sqrt(2.0 * kPi * kGasConstant * m.Tsat0 / m.M);
+  G.Lambda = kGamma * kGasConstant * m.Tsat0 / (2.0 * m.M * m.hlv);
+  G.Hlv = m.hlv * m.M / (kGasConstant * m.Tsat0);
+  G.Ni = I0 * R / (m.rho * G.alpha_l * m.hlv);
+  G.Psi = std::sqrt(kGamma * G.Lambda) / (2.0 * std::sqrt(kPi)) * G.alpha_l /
+          (R * std::sqrt(m.hlv));
+  G.hls_hlv = m.hls / m.hlv;
+  G.p0 = m.p0;
+  return G;
+}
+
+namespace {
+// Vapour side of (4-29) divided by I' sqrt(phi).
+inline double vapour_term(const Groups& G, double phi, double* dterm) {
+  const double v = std::exp(G.Hlv * (1.0 - 1.0 / phi)) * (1.0 + G.Lambda * phi) /
+                   (G.Iprime * std::sqrt(phi));
+  if (dterm)
+    *dterm = v * (G.Hlv / (phi * phi) + G.Lambda / (1.0 + G.Lambda * phi) - 0.5 / phi);
+  return v;
+}
+}  // namespace
+
+double interface_residual(const Groups& G, double phi, double xi, double g, double b2,
+                          double* dres) {
+  double dv = 0;
+  const double v = vapour_term(G, phi, dres ? &dv : nullptr);
+  const double c = G.kprime / (g * (1.0 - G.theta_m));
+  if (dres) *dres = dv + c;
+  return v + c * (phi - G.theta_m) + G.kprime * b2 * g - gaussian_beam(xi);
+}
+
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2) {
+  InterfaceState s;
+  const double E = gaussian_beam(xi);
+  s.phi = G.theta_m;
+  s.theta_sat = 0.0;
+  if (!(g > 0.0)) {
+    // Vanishing layer: all that is not evaporated at T_m is conducted through.
+    const double q = std::max(E - vapour_term(G, G.theta_m, nullptr), 0.0) / G.kprime;
+    s.grad_top = s.grad_bottom = q;
+  } else {
+    const double avail = E - G.kprime * b2 * g;
+    const double r0 = vapour_term(G, G.theta_m, nullptr) - avail;
+    if (r0 < 0.0) {
+      // Upper bracket: the conduction-only root, where the vapour term is > 0.
+      const double hi = G.theta_m + avail * g * (1.0 - G.theta_m) / G.kprime;
+      auto fdf = [&](double phi, double& f, double& df) {
+        f = interface_residual(G, phi, xi, g, b2, &df);
+      };
+      const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+      s.phi = rr.x;
+      s.iterations = rr.iterations;
+      s.converged = rr.converged;
+      s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
+      s.residual = interface_residual(G, s.phi, xi, g, b2) / E;
+    }
+    s.grad_top = s.theta_sat / g + b2 * g;
+    s.grad_bottom = s.theta_sat / g - b2 * g;
+  }
+  s.p_pa = G.p0 * std::exp(G.Hlv * (1.0 - 1.0 / s.phi));
+  s.p_star = s.p_pa / G.p_scale;
+  return s;
+}
+
+double recession_rate(const Groups& G, double xi, const InterfaceState& s) {
+  return G.Ni * gaussian_beam(xi) - G.Psi * s.p_star * std::sqrt(s.phi) -
+         G.hls_hlv * G.Ste * s.grad_top;
+}
+
+double recession_rate_from_flux(const Material& m, double R, const InterfaceState& s,
+                                double Tsat0) {
+  const double T = s.phi * Tsat0;
+  const double jv = evaporation_molar_flux(s.p_pa, T, m.M);
+  const double alpha_l = m.kl / (m.rho * m.cpl);
+  return jv * m.M / m.rho / (alpha_l / R);
+}
+
+double premelt_temperature(const Groups& G, double xi, double n, double tau) {
+  if (tau <= 0.0) return G.theta_i;
+  const double sq = std::sqrt(G.Na * tau);
+  const double eta = n / (2.0 * sq);
+  const double ierfc = std::exp(-eta * eta) / std::sqrt(kPi) - eta * std::erfc(eta);
+  return G.theta_i + 2.0 * G.k / G.kprime * gaussian_beam(xi) * sq * ierfc;
+}
+
+double melt_onset_tau(const Groups& G, double xi) {
+  const double x = G.theta_i * G.kprime / (G.k * gaussian_beam(xi));
+  return kPi / (4.0 * G.Na) * x * x;
+}
+
+double established_profile(double theta_i, double eta_m) {
+  return theta_i -
+         theta_i * (std::exp(-eta_m * eta_m) - std::sqrt(kPi) * eta_m * std::erfc(eta_m));
+}
+
+double stefan_gradient(double theta_i, double Na, double tau_m, double tau, double c) {
+  return theta_i / std::sqrt(kPi * Na * (tau - tau_m + c * tau_m));
+}
+
+double stefan_gradient_mean(double theta_i, double Na, double tau_m, double ta, double tb,
+                            double c) {
+  const double xa = ta - tau_m + c * tau_m, xb = tb - tau_m + c * tau_m;
+  return 2.0 * theta_i / (std::sqrt(kPi * Na) * (std::sqrt(xa) + std::sqrt(xb)));
+}
+
+double curvature_factor(double a, double d) {
+  double y = 0.5 * a * d;
+  if (std::fabs(y) < 1e-8) return 1.0 - (a > 0 ? 1.0 : -1.0) * y * y / 6.0;
+  const bool convex = y > 0;  // a > 0
+  y = std::min(std::fabs(y), 1.0);
+  return convex ? y / std::asin(y) : std::asin(y) / y;
+}
+
+CubicRoot select_flow_root(double Q1, double Q2, double Q3, double Q4) {
+  CubicRoot out;
+  if (!(Q1 > 0.0) || !std::isfinite(Q1) || !std::isfinite(Q2) || !std::isfinite(Q3) ||
+      !std::isfinite(Q4)) {
+    out.note = "degenerate cubic (no melt or non-finite coefficients)";
+    return out;
+  }
+  if (Q4 == 0.0) { out.ok = true; out.A = 0.0; out.real_roots = 1; return out; }
+  auto W = [&](double A) { return ((Q1 * A - Q2) * A + Q3) * A - Q4; };
+  auto fdf = [&](double A, double& f, double& df) {
+    f = W(A);
+    df = (3.0 * Q1 * A - 2.0 * Q2) * A + Q3;
+  };
+  const double B = 1.0 + std::max({std::fabs(Q2), std::fabs(Q3), std::fabs(Q4)}) / Q1;
+  std::vector<std::pair<double, double>> brackets;
+  const double disc = Q2 * Q2 - 3.0 * Q1 * Q3;
+  if (disc <= 0.0) {
+    brackets.push_back({-B, B});
+  } else {
+    const double A1 = (Q2 - std::sqrt(disc)) / (3.0 * Q1);  // local maximum of W
+    const double A2 = (Q2 + std::sqrt(disc)) / (3.0 * Q1);  // local minimum of W
+    const double w1 = W(A1), w2 = W(A2);
+    if (w1 >= 0.0) brackets.push_back({-B, A1});
+    if (w1 >= 0.0 && w2 <= 0.0) brackets.push_back({A1, A2});
+    if (w2 <= 0.0) brackets.push_back({A2, B});
+  }
+  std::vector<double> roots;
+  for (auto [lo, hi] : brackets) {
+    const RootResult r = safe_newton(fdf, lo, hi, 1e-15 * B);
+    if (r.converged && std::isfinite(r.x)) roots.push_back(r.x);
+  }
+  out.real_roots = static_cast<int>(roots.size());
+  if (roots.empty()) { out.note = "no real root found"; return out; }
+  if (Q4 > 0.0) {
+    // W(0) < 0: the physical root is the smallest positive one, i.e. the root
+    // in (0, A1] when W(A1) >= 0 and the single root beyond A2 otherwise.
+    double best = std::numeric_limits<double>::infinity();
+    for (double r : roots)
+      if (r > 0.0 && r < best) best = r;
+    if (!std::isfinite(best)) { out.note = "no positive root"; return out; }
+    out.A = best;
+  } else {
+    // Pressure rising outwards (Q4 < 0): take the root nearest zero.
+    double best = roots[0];
+    for (double r : roots)
+      if (std::fabs(r) < std::fabs(best)) best = r;
+    out.A = best;
+    out.note = "Q4 < 0: inward flow root";
+  }
+  out.ok = true;
+  return out;
+}
+
+}  // namespace laser

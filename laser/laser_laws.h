@@ -1,0 +1,148 @@
+// Physics laws of the laser drilling model (dissertation Part I, ch. 3-4),
+// kept apart from the time stepping so that each can be tested on its own.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <functional>
+#include <string>
+
+namespace laser {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kGasConstant = 8.314462618;  // R_g [J/(mol K)]
+constexpr double kGamma = 5.0 / 3.0;           // monoatomic vapour, text after (3-13)
+
+// ---------------------------------------------------------------- root finding
+struct RootResult {
+  double x = 0.0;
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Safeguarded Newton ("rtsafe"): f(lo) and f(hi) must have opposite signs; a
+// Newton step that leaves the current bracket, or does not halve the bracket
+// fast enough, is replaced by bisection, so the iteration never diverges.
+RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf,
+                       double lo, double hi, double xtol, int maxit = 200);
+
+// --------------------------------------------------------- Clausius-Clapeyron
+// (3-15): vapour pressure [Pa] at the surface temperature T [K].
+inline double clausius_clapeyron_pressure(double T, double p0, double Tsat0, double hlv,
+                                          double M) {
+  return p0 * std::exp(hlv * M / kGasConstant * (1.0 / Tsat0 - 1.0 / T));
+}
+// Inverse of (3-15): saturation temperature [K] at pressure p [Pa].
+inline double clausius_clapeyron_temperature(double p, double p0, double Tsat0, double hlv,
+                                             double M) {
+  return 1.0 / (1.0 / Tsat0 - kGasConstant / (hlv * M) * std::log(p / p0));
+}
+// (3-13): vapour velocity [m/s].
+inline double vapour_velocity(double T, double M) {
+  return std::sqrt(kGamma * kGasConstant * T / M);
+}
+// (3-17): molar evaporation flux [mol/(m2 s)].
+inline double evaporation_molar_flux(double p, double T, double M) {
+  return p / std::sqrt(2.0 * kPi * M * kGasConstant * T);
+}
+// (3-19), read dimensionally consistent (the square root covers only
+// 2 pi R_g T / M): recoil pressure [Pa] that carries the net flux q [W/m2].
+inline double recoil_pressure_from_flux(double q, double T, double hlv, double M) {
+  return std::sqrt(2.0 * kPi * kGasConstant * T / M) * q /
+         (hlv + kGamma * kGasConstant * T / (2.0 * M));
+}
+
+// ------------------------------------------------------------------ beam
+// (3-21), nondimensional: I / I0.
+inline double gaussian_beam(double xi) { return std::exp(-xi * xi); }
+
+// ----------------------------------------------------- nondimensional groups
+struct Material {
+  std::string name = "superalloy";
+  double hls = 2.31e4;      // J/kg
+  double hlv = 6.444e6;     // J/kg
+  double rho = 8.4e3;       // kg/m3
+  double M = 0.076;         // kg/mol
+  double Ti = 293.15;       // K
+  double Tm = 1510.0 + 273.15;    // K
+  double Tsat0 = 3170.0 + 273.15; // K
+  double p0 = 1.01325e5;    // Pa
+  double kl = 21.70;        // W/(m K)
+  double ks = 52.72;        // W/(m K)
+  double cpl = 625.0;       // J/(kg K)
+  double cps = 380.0;       // J/(kg K)
+  double Pr = 0.142;        // -
+};
+
+struct Groups {
+  // scales
+  double dT = 0, alpha_l = 0, alpha_s = 0, t_scale = 0, p_scale = 0, v_scale = 0;
+  // groups of ch. 3
+  double Na = 0, Nc = 0, k = 0, Ste = 0, theta_i = 0, theta_m = 0;
+  double kprime = 0, Iprime = 0, Lambda = 0, Hlv = 0, Ni = 0, Psi = 0, hls_hlv = 0;
+  double p0 = 0;  // Pa, to restore dimensional pressure
+};
+
+// Builds the groups defined after (3-4a), (3-22), (3-24), (3-25), (3-26).
+Groups make_groups(const Material& m, double I0, double R);
+
+// ---------------------------------------------------- melt-vapour interface
+struct InterfaceState {
+  double phi = 0;        // T_sat / T_sat0
+  double theta_sat = 0;  // (T_sat - T_m) / (T_sat0 - T_m)
+  double p_star = 0;     // p R^2 / (rho alpha_l^2)
+  double p_pa = 0;       // Pa
+  double grad_top = 0;   // d theta_l / d zeta at zeta = g   (4-26)
+  double grad_bottom = 0;// d theta_l / d zeta at zeta = 0   (4-26)
+  double residual = 0;   // of (4-29), relative to exp(-xi^2)
+  int iterations = 0;
+  bool converged = true;
+};
+
+// Residual of (4-29) divided by I' sqrt(phi): vapour term + conduction term -
+// beam. Strictly increasing in phi for phi < 2 H_lv, so its root is unique.
+double interface_residual(const Groups& G, double phi, double xi, double g, double b2,
+                          double* dres = nullptr);
+// Solves (4-28)-(4-30) for the surface temperature of a melt layer of
+// nondimensional thickness g with the quadratic profile (4-25) of coefficient
+// b2; g = 0 is the limit of a vanishing layer (T_sat = T_m).
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2);
+// Nondimensional vaporization recession rate dS1/dtau by (3-25).
+double recession_rate(const Groups& G, double xi, const InterfaceState& s);
+// The same rate from the dimensional laws (3-16), (3-17): rho ds1/dt = j_v M.
+double recession_rate_from_flux(const Material& m, double R, const InterfaceState& s,
+                                double Tsat0);
+
+// ------------------------------------------------------------ solid conduction
+// Pre-melting surface temperature, (3-26) at n = 0, with the coefficient 2 of
+// the classical constant-flux solution (see docs/laser_model.md).
+double premelt_temperature(const Groups& G, double xi, double n, double tau);
+// Melt onset time (3-27) consistent with premelt_temperature.
+double melt_onset_tau(const Groups& G, double xi);
+// (3-28): profile at onset, eta_m = n / (2 sqrt(N_a tau_m)).
+double established_profile(double theta_i, double eta_m);
+// (3-31) as printed: tau_0 = tau_m / (4 pi).
+constexpr double kTau0OverTauM = 1.0 / (4.0 * kPi);
+// Stefan gradient d theta_s/dn at n = 0 of theta_i erf(n / (2 sqrt(Na (tau - tau_m + c tau_m)))),
+// i.e. (3-30) for c = tau_0/tau_m and (3-36) for c = 3 tau_0/tau_m.
+double stefan_gradient(double theta_i, double Na, double tau_m, double tau, double c);
+// Its mean over [tau_a, tau_b] (closed form), used by the time stepper.
+double stefan_gradient_mean(double theta_i, double Na, double tau_m, double ta, double tb,
+                            double c);
+
+// ------------------------------------------------- interface corrections
+// Curvature factor (3-37) for curvature a and arc d; clamps |a d| < 2.
+double curvature_factor(double a, double d);
+
+// ------------------------------------------------------------ melt flow
+struct CubicRoot {
+  double A = 0;
+  int real_roots = 0;
+  bool ok = false;
+  std::string note;
+};
+// Physical root of W(A) = Q1 A^3 - Q2 A^2 + Q3 A - Q4 (4-19) selected as in
+// the text after (4-21).
+CubicRoot select_flow_root(double Q1, double Q2, double Q3, double Q4);
+
+}  // namespace laser

@@ -1,0 +1,480 @@
+#include "laser_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <sstream>
+
+namespace laser {
+
+namespace {
+
+struct Node {
+  double xi = 0, tau_m = 0, area = 0;  // area in m2
+  bool molten = false;
+  double S1 = 0, S2 = 0, g = 0, b2 = 0, S1flow = 0;
+  InterfaceState itf;
+  double dS1 = 0, dS2 = 0, v = 0, f = 0;  // rates of the last step, f: u = f zeta
+};
+
+std::string fmt(double v) {
+  std::ostringstream o;
+  o.precision(4);
+  o << v;
+  return o.str();
+}
+
+class Drill {
+ public:
+  explicit Drill(const Config& c) : cfg_(c), G_(make_groups(c.mat, c.I0, c.R)) {}
+  Result run();
+
+ private:
+  void setup();
+  void melt_onset(double ta, double tb);
+  void solve_interfaces();
+  bool solve_melt_flow();
+  void solve_boundary_layer(int& last_bl);
+  double solid_gradient_mean(const Node& n, double ta, double tb) const;
+  void advance_interfaces(double ta, double tb);
+  void melt_temperature();
+  void record(double tau, bool frame);
+  double node_ta(const Node& n, double ta) const { return std::max(ta, n.tau_m); }
+
+  Config cfg_;
+  Groups G_;
+  std::unique_ptr<CorrectedConduction> exact_;
+  std::vector<Node> nodes_;
+  Result res_;
+  double A_ = 0, u_peak_ = 0;
+  double lambda_max_ = 0;
+  double dtau_ = 0;
+  std::string flow_failure_;
+  int idx_x1_ = 0;
+};
+
+void Drill::setup() {
+  res_.groups = G_;
+  dtau_ = cfg_.dt / G_.t_scale;
+  res_.dtau = dtau_;
+  res_.tau_p = cfg_.tp / G_.t_scale;
+  const double tau_m0 = melt_onset_tau(G_, 0.0);
+  double xi_edge = 0.0;
+  if (res_.tau_p > tau_m0) xi_edge = std::sqrt(0.5 * std::log(res_.tau_p / tau_m0));
+  res_.xi_melt_edge = xi_edge;
+  int N;
+  if (cfg_.xi_max > 0.0) N = static_cast<int>(std::lround(cfg_.xi_max / cfg_.dxi)) + 1;
+  else N = static_cast<int>(std::floor(xi_edge / cfg_.dxi)) + 3;
+  N = std::max(N, 3);
+  nodes_.resize(N);
+  const double R2 = cfg_.R * cfg_.R;
+  for (int i = 0; i < N; ++i) {
+    Node& n = nodes_[i];
+    n.xi = i * cfg_.dxi;
+    n.tau_m = melt_onset_tau(G_, n.xi);
+    n.area = (i == 0) ? kPi * 0.25 * cfg_.dxi * cfg_.dxi * R2 : 2.0 * kPi * n.xi * cfg_.dxi * R2;
+    n.itf.phi = G_.theta_m;
+    res_.xi.push_back(n.xi);
+    res_.tau_m_s.push_back(n.tau_m * G_.t_scale);
+  }
+  idx_x1_ = std::min(N - 1, static_cast<int>(std::lround(1.0 / cfg_.dxi)));
+  res_.nodes = N;
+  const double xi_out = (N - 0.5) * cfg_.dxi;
+  res_.energy.laser_exact = kPi * R2 * cfg_.I0 * cfg_.tp * (1.0 - std::exp(-xi_out * xi_out));
+  if (cfg_.solid == SolidModel::Exact) exact_ = std::make_unique<CorrectedConduction>(kTau0OverTauM);
+}
+
+void Drill::melt_onset(double ta, double tb) {
+  for (auto& n : nodes_) {
+    if (!n.molten && n.tau_m < tb) {
+      n.molten = true;
+      // Everything absorbed before onset went into the solid, (3-26).
+      const double t0 = std::max(ta, 0.0);
+      (void)t0;
+    }
+  }
+}
+
+void Drill::solve_interfaces() {
+  for (auto& n : nodes_) {
+    if (!n.molten) continue;
+    n.itf = solve_interface(G_, n.xi, n.g, n.b2);
+    res_.max_interface_residual = std::max(res_.max_interface_residual, std::fabs(n.itf.residual));
+  }
+}
+
+// Least squares coefficient A of (4-18)/(4-19) for the integral profiles and
+// the vertical surface velocity v(xi, g) that enters (4-13).
+bool Drill::solve_melt_flow() {
+  const int N = static_cast<int>(nodes_.size());
+  for (auto& n : nodes_) { n.v = 0.0; n.f = 0.0; }
+  A_ = 0.0;
+  u_peak_ = 0.0;
+  if (cfg_.model == FlowModel::Conduction) return true;
+  int first = 1;  // the centre is pure conduction (text, 5.5)
+  if (cfg_.model == FlowModel::Boundary) {
+    int last_bl = 0;
+    solve_boundary_layer(last_bl);
+    first = last_bl + 1;
+  }
+  const double Pr = cfg_.mat.Pr, m = cfg_.m, xp = cfg_.xi_p;
+  const bool rising = cfg_.model == FlowModel::Rising;
+  std::vector<double> dpdx(N, 0.0);
+  for (int i = 1; i < N; ++i) {
+    if (!nodes_[i].molten) continue;
+    const bool lm = nodes_[i - 1].molten, rm = (i + 1 < N) && nodes_[i + 1].molten;
+    const double pl = nodes_[i - 1].itf.p_star, pc = nodes_[i].itf.p_star;
+    if (rm) {
+      const double pr = nodes_[i + 1].itf.p_star;
+      dpdx[i] = lm ? (pr - pl) / (2 * cfg_.dxi) : (pr - pc) / cfg_.dxi;
+    } else if (lm) {
+      dpdx[i] = (pc - pl) / cfg_.dxi;
+    }
+  }
+  double Q1 = 0, Q2 = 0, Q3 = 0, Q4 = 0;
+  for (int i = first; i < N; ++i) {
+    const Node& n = nodes_[i];
+    if (!n.molten || !(n.g > 0.0)) continue;
+    const double x = n.xi, g = n.g;
+    double a, b, c;
+    if (rising) {  // (4-17)
+      a = g * g * std::pow(x, 2.0 / m + 1.0);
+      b = -3.0 * Pr * g * std::pow(x, 1.0 / m);
+      c = -6.0 * m / (m - 1.0) * x * x * dpdx[i];
+    } else {  // (4-23)
+      const double e = std::exp(x / xp);
+      a = g * g * x * x;
+      b = -3.0 * Pr * g * e;
+      c = -6.0 * xp * dpdx[i] * e * e;
+    }
+    const double w = (i == N - 1) ? 0.5 * cfg_.dxi : cfg_.dxi;
+    // W(A) = 2 int a^2 A^3 + 3 int ab A^2 + int (b^2 + 2ac) A + int bc, i.e. (4-20)/(4-24)
+    Q1 += 2.0 * a * a * w;
+    Q2 += -3.0 * a * b * w;
+    Q3 += (b * b + 2.0 * a * c) * w;
+    Q4 += -b * c * w;
+  }
+  if (Q1 == 0.0) return true;  // no melt off the axis yet
+  const CubicRoot root = select_flow_root(Q1, Q2, Q3, Q4);
+  if (!root.ok || !std::isfinite(root.A)) {
+    flow_failure_ = "no physical root of the cubic (4-19): " + root.note;
+    return false;
+  }
+  A_ = root.A;
+  for (int i = first; i < N; ++i) {
+    Node& n = nodes_[i];
+    if (!n.molten || !(n.g > 0.0) || n.xi == 0.0) continue;
+    const double x = n.xi, g = n.g;
+    if (rising) {
+      n.f = A_ * std::pow(x, 1.0 / m);
+      n.v = -(1.0 + m) / (2.0 * m) * A_ * std::pow(x, 1.0 / m - 1.0) * g * g;
+    } else {
+      n.f = A_ * x * std::exp(-x / xp);
+      n.v = -0.5 * A_ * g * g * (2.0 - x / xp) * std::exp(-x / xp);  // (4-22)
+    }
+    u_peak_ = std::max(u_peak_, std::fabs(n.f * g));
+  }
+  return true;
+}
+
+// Boundary-layer profile (4-7) near the centre: free stream (4-4), thickness
+// from (4-9) by RK4 started at the second node with delta = sqrt(70 Pr xi/(37 U));
+// used while the layer is thinner than the melt; V + v_delta by (4-11), (4-12).
+void Drill::solve_boundary_layer(int& last_bl) {
+  last_bl = 0;
+  const int N = static_cast<int>(nodes_.size());
+  if (N < 3 || !nodes_[0].molten || !nodes_[1].molten) return;
+  const double Pr = cfg_.mat.Pr, h = cfg_.dxi, pc = nodes_[0].itf.p_star;
+  std::vector<double> U(N, 0.0);
+  int end = 1;
+  while (end < N && nodes_[end].molten) ++end;
+  for (int i = 0; i < end; ++i) U[i] = std::sqrt(std::max(0.0, 2.0 * (pc - nodes_[i].itf.p_star)));
+  auto Ux = [&](double x, double& u, double& du) {
+    const double s = x / h;
+    int i = std::min(static_cast<int>(s), end - 2);
+    const double w = s - i;
+    u = (1 - w) * U[i] + w * U[i + 1];
+    du = (U[i + 1] - U[i]) / h;
+  };
+  auto rhs = [&](double x, double d) {
+    double u, du;
+    Ux(x, u, du);
+    if (!(u > 0.0) || !(d > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    const double den = 105.0 * Pr - 39.0 * x * u;
+    return (-35.0 * Pr * (12.0 * x / d - 5.0 * d / u * du + 5.0 * d / x) + 39.0 * d * u +
+            183.0 * x * d * du) / den;
+  };
+  if (!(U[1] > 0.0)) return;
+  double d = std::sqrt(70.0 * Pr * h / (37.0 * U[1]));
+  for (int i = 1; i < end - 1; ++i) {
+    Node& n = nodes_[i];
+    if (!(d > 0.0) || !std::isfinite(d) || d >= n.g) break;
+    const double dU = (U[i + 1] - U[i - 1]) / (2 * h);
+    const double div = dU + U[i] / n.xi;
+    n.v = -div * (n.g - d) - 0.625 * d * div;  // V + v_delta
+    n.f = 0.0;
+    u_peak_ = std::max(u_peak_, U[i]);
+    last_bl = i;
+    // RK4 to the next node
+    const double x = n.xi;
+    const double k1 = rhs(x, d), k2 = rhs(x + h / 2, d + h / 2 * k1),
+                 k3 = rhs(x + h / 2, d + h / 2 * k2), k4 = rhs(x + h, d + h * k3);
+    d += h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+}
+
+double Drill::solid_gradient_mean(const Node& n, double ta, double tb) const {
+  const double ti = G_.theta_i;
+  switch (cfg_.solid) {
+    case SolidModel::Exact: {
+      const double sa = (ta - n.tau_m) / n.tau_m, sb = (tb - n.tau_m) / n.tau_m;
+      return ti / std::sqrt(G_.Na * n.tau_m) * exact_->gradient_mean(std::max(sa, 0.0), sb);
+    }
+    case SolidModel::Shifted:
+      return stefan_gradient_mean(ti, G_.Na, n.tau_m, ta, tb, cfg_.shift);
+    case SolidModel::Stefan:
+      return stefan_gradient_mean(ti, G_.Na, n.tau_m, ta, tb, kTau0OverTauM);
+  }
+  return 0.0;
+}
+
+void Drill::advance_interfaces(double ta, double tb) {
+  const int N = static_cast<int>(nodes_.size());
+  const double h = cfg_.dxi;
+  std::vector<double> S2old(N);
+  for (int i = 0; i < N; ++i) S2old[i] = nodes_[i].S2;
+  const double qscale_l = cfg_.mat.kl * G_.dT / cfg_.R;  // W/m2 per unit nondim gradient
+  const double qscale_s = cfg_.mat.ks * G_.dT / cfg_.R;
+  const double vscale = G_.v_scale;
+  Energy& E = res_.energy;
+  for (int i = 0; i < N; ++i) {
+    Node& n = nodes_[i];
+    const double t0 = n.molten ? node_ta(n, ta) : tb;
+    const double dt_pre = std::max(0.0, std::min(tb, n.tau_m) - ta);
+    const double beam = cfg_.I0 * gaussian_beam(n.xi) * n.area;  // W
+    E.laser_nodal += beam * (tb - ta) * G_.t_scale;
+    E.solid_premelt += beam * dt_pre * G_.t_scale;
+    if (!n.molten) continue;
+    const double dtn = tb - t0;
+    if (!(dtn > 0.0)) continue;
+    // slope and curvature of the melting front (3-38)
+    double s2x = 0.0, s2xx = 0.0;
+    if (i == 0) {
+      s2xx = 2.0 * (S2old[1] - S2old[0]) / (h * h);
+    } else if (i < N - 1) {
+      s2x = (S2old[i + 1] - S2old[i - 1]) / (2 * h);
+      s2xx = (S2old[i + 1] - 2 * S2old[i] + S2old[i - 1]) / (h * h);
+    }
+    const double J = std::sqrt(1.0 + s2x * s2x);
+    double Cc = 1.0;
+    if (cfg_.curvature) {
+      const double a = -s2xx / (J * J * J);
+      const double d = h * J;
+      if (std::fabs(a * d) >= 2.0) ++res_.curvature_clamps;
+      Cc = curvature_factor(a, d);
+    }
+    const double grad_n = solid_gradient_mean(n, t0, tb);
+    const double theta_mo = cfg_.moving_origin ? G_.theta_i : 0.0;
+    const double L = (1.0 / (G_.Ste * G_.Nc) - Cc * theta_mo) / G_.Na;
+    const double drive = Cc * grad_n * J + G_.k * n.itf.grad_bottom;  // right side of (3-40)
+    double dS2 = drive / L;
+    if (dS2 < 0.0) {
+      ++res_.melt_rate_clamps;
+      E.clamp_defect += -drive * qscale_s * n.area * dtn * G_.t_scale;
+      dS2 = 0.0;
+    }
+    double dS1 = recession_rate(G_, n.xi, n.itf);
+    dS1 = std::max(dS1, 0.0);
+    n.dS2 = dS2;
+    n.dS1 = dS1;
+    // stability of the explicit update (4-14): d(dg/dtau)/dg
+    if (n.itf.theta_sat > 0.0 && n.g > 0.0) {
+      double dres;
+      interface_residual(G_, n.itf.phi, n.xi, n.g, n.b2, &dres);
+      const double dres_dg =
+          -G_.kprime * (n.itf.phi - G_.theta_m) / (n.g * n.g * (1.0 - G_.theta_m)) + G_.kprime * n.b2;
+      const double dtheta_dg = -dres_dg / dres / (1.0 - G_.theta_m);
+      const double dq = n.itf.theta_sat / (n.g * n.g) - dtheta_dg / n.g;  // -d(theta/g)/dg
+      const double lambda = (G_.k / L + G_.hls_hlv * G_.Ste) * dq;
+      lambda_max_ = std::max(lambda_max_, lambda);
+      if (lambda * dtn > 2.0 && !res_.unstable) {
+        res_.unstable = true;
+        res_.message = "melt thickness update (4-14) unstable at xi = " + fmt(n.xi) + ", t = " +
+                       fmt(tb * G_.t_scale) + " s: lambda*dtau = " + fmt(lambda * dtn) + " > 2";
+      }
+    }
+    // energy terms [J]
+    const double dts = dtn * G_.t_scale;
+    E.solid_conduction += -Cc * grad_n * J * qscale_s * n.area * dts;
+    E.solid_preheat += -Cc * theta_mo * G_.dT * cfg_.mat.rho * cfg_.mat.cps * dS2 * vscale * n.area * dts;
+    E.melt_latent += cfg_.mat.rho * cfg_.mat.hls * dS2 * vscale * n.area * dts;
+    const double T = n.itf.phi * cfg_.mat.Tsat0;
+    const double jv = evaporation_molar_flux(n.itf.p_pa, T, cfg_.mat.M);
+    E.vapour_latent += jv * cfg_.mat.M * cfg_.mat.hlv * n.area * dts;
+    const double Vv = vapour_velocity(T, cfg_.mat.M);
+    E.vapour_kinetic += 0.5 * jv * cfg_.mat.M * Vv * Vv * n.area * dts;
+    E.flow_advected += (n.itf.grad_top - n.itf.grad_bottom) * qscale_l * n.area * dts;
+    // (3-40), (3-25), (4-14)
+    n.S2 += dS2 * dtn;
+    n.S1 += dS1 * dtn;
+    n.S1flow += -n.v * dtn;
+    n.g += (dS2 - dS1 + n.v) * dtn;
+    if (n.g < 0.0) {
+      ++res_.melt_clamps;
+      n.g = 0.0;
+    }
+  }
+}
+
+// b2 of (4-25) from the integral energy balance (4-27), with the b2 of the last
+// step inside the xi-derivative (the text's lagged update).
+void Drill::melt_temperature() {
+  if (cfg_.model == FlowModel::Conduction) return;
+  const int N = static_cast<int>(nodes_.size());
+  std::vector<double> fJ(N, 0.0);
+  for (int i = 0; i < N; ++i) {
+    const Node& n = nodes_[i];
+    if (n.molten && n.g > 0.0)
+      fJ[i] = n.f * (n.itf.theta_sat * n.g * n.g / 3.0 - n.b2 * std::pow(n.g, 4) / 12.0);
+  }
+  for (int i = 0; i < N; ++i) {
+    Node& n = nodes_[i];
+    if (i == 0 || !n.molten || !(n.g > 0.0) || n.f == 0.0) { n.b2 = 0.0; continue; }
+    const double dfJ = (i + 1 < N) ? (fJ[i + 1] - fJ[i - 1]) / (2 * cfg_.dxi) : (fJ[i] - fJ[i - 1]) / cfg_.dxi;
+    const double g = n.g, th = n.itf.theta_sat;
+    const double num = dfJ + n.f / n.xi * th * g * g / 3.0 + n.v * th;
+    const double den = 2.0 * g + n.f / n.xi * std::pow(g, 4) / 12.0;
+    n.b2 = num / den;
+  }
+}
+
+void Drill::record(double tau, bool frame) {
+  const double R = cfg_.R, vs = G_.v_scale;
+  const Node& c = nodes_[0];
+  const Node& c1 = nodes_[1];
+  const Node& x1 = nodes_[idx_x1_];
+  auto T = [&](const Node& n) {
+    if (n.molten) return n.itf.phi * cfg_.mat.Tsat0;
+    return cfg_.mat.Tm + G_.dT * premelt_temperature(G_, n.xi, 0.0, tau);
+  };
+  CentreRecord r{tau * G_.t_scale, (c.S2 - c.g) * R, c.S2 * R, c.g * R, T(c),
+                 c.molten ? c.itf.p_pa : 0.0, c.dS2 * vs, c.dS1 * vs, A_, u_peak_ * vs,
+                 c1.dS2 * vs, c1.dS1 * vs, c1.v * vs, x1.dS2 * vs, x1.dS1 * vs, x1.v * vs};
+  res_.centre.push_back(r);
+  if (!frame) return;
+  Frame f;
+  f.t = tau * G_.t_scale;
+  f.A = A_;
+  f.u_peak = u_peak_ * vs;
+  for (const auto& n : nodes_) {
+    f.S1net.push_back((n.S2 - n.g) * R);
+    f.S2.push_back(n.S2 * R);
+    f.S1.push_back(n.S1 * R);
+    f.g.push_back(n.g * R);
+    f.theta_sat.push_back(n.molten ? n.itf.theta_sat : 0.0);
+    f.T.push_back(T(n));
+    f.p.push_back(n.molten ? n.itf.p_pa : 0.0);
+    f.melt_rate.push_back(n.dS2 * vs);
+    f.vap_rate.push_back(n.dS1 * vs);
+    f.flow_v.push_back(n.v * vs);
+    f.b2.push_back(n.b2);
+  }
+  res_.frames.push_back(std::move(f));
+}
+
+Result Drill::run() {
+  setup();
+  const double tau_p = res_.tau_p;
+  const long nsteps = static_cast<long>(std::ceil(tau_p / dtau_ - 1e-9));
+  const long centre_every = std::max(1L, nsteps / 20000);
+  const int nframes = std::max(2, cfg_.frames);
+  int next_frame = 1;
+  record(0.0, true);
+  long next_progress = nsteps / 10;
+  double tau = 0.0;
+  for (long step = 0; step < nsteps; ++step) {
+    const double ta = tau;
+    const double tb = (step == nsteps - 1) ? tau_p : std::min(tau_p, (step + 1) * dtau_);
+    melt_onset(ta, tb);
+    solve_interfaces();
+    if (!solve_melt_flow()) {
+      res_.status = "no_flow_solution";
+      res_.message = flow_failure_ + " at t = " + fmt(ta * G_.t_scale) + " s";
+      break;
+    }
+    advance_interfaces(ta, tb);
+    melt_temperature();
+    tau = tb;
+    res_.steps = static_cast<int>(step + 1);
+    res_.A_last = A_;
+    res_.u_peak_max = std::max(res_.u_peak_max, u_peak_ * G_.v_scale);
+    for (const auto& n : nodes_) {
+      if (!n.molten) continue;
+      res_.T_peak = std::max(res_.T_peak, n.itf.phi * cfg_.mat.Tsat0);
+      res_.p_peak = std::max(res_.p_peak, n.itf.p_pa);
+    }
+    // Non-finite state: stop with the location instead of writing NaN.
+    for (const auto& n : nodes_) {
+      if (!std::isfinite(n.S2) || !std::isfinite(n.g) || !std::isfinite(n.S1) ||
+          !std::isfinite(n.b2) || !std::isfinite(n.itf.phi)) {
+        res_.status = "diverged";
+        res_.message = "non-finite state at xi = " + fmt(n.xi) + ", t = " + fmt(tb * G_.t_scale) +
+                       " s (model " + to_string(cfg_.model) + ")";
+        break;
+      }
+    }
+    if (res_.status != "ok") break;
+    if (res_.unstable) {
+      res_.status = "unstable_time_step";
+      break;
+    }
+    const bool frame = tb >= tau_p * next_frame / (nframes - 1) - 1e-12 * tau_p;
+    if (frame) ++next_frame;
+    if (frame || step % centre_every == 0 || step == nsteps - 1) record(tb, frame);
+    if (!cfg_.quiet && nsteps >= 1000 && next_progress > 0 && step + 1 >= next_progress) {
+      std::fprintf(stderr, "laser_drill: t = %.1f us (%3.0f %%), centre depth %.2f um, T %.0f K\n",
+                   tb * G_.t_scale * 1e6, 100.0 * (step + 1) / nsteps,
+                   (nodes_[0].S2 - nodes_[0].g) * cfg_.R * 1e6, res_.centre.back().T);
+      next_progress += nsteps / 10;
+    }
+  }
+  if (res_.frames.empty() || res_.frames.back().t < tau * G_.t_scale) record(tau, true);
+  res_.t_end = tau * G_.t_scale;
+  res_.max_stable_dt = lambda_max_ > 0 ? 2.0 / lambda_max_ * G_.t_scale : 0.0;
+  if (res_.unstable)
+    res_.message += "; use --dt below about " + fmt(res_.max_stable_dt) + " s (--dtau " +
+                    fmt(res_.max_stable_dt / G_.t_scale) + ")";
+  // summary quantities
+  const double R = cfg_.R;
+  const Node& c = nodes_[0];
+  if (c.tau_m < tau_p) res_.t_melt_center = c.tau_m * G_.t_scale;
+  res_.depth_center = (c.S2 - c.g) * R;
+  res_.S2_center = c.S2 * R;
+  res_.g_center = c.g * R;
+  for (const auto& n : nodes_) {
+    res_.volume_removed += (n.S2 - n.g) * R * n.area;
+    res_.volume_vaporized += n.S1 * R * n.area;
+    res_.volume_flow += n.S1flow * R * n.area;
+    res_.volume_melted += n.S2 * R * n.area;
+  }
+  res_.removal_rate = res_.t_end > 0 ? res_.volume_removed / res_.t_end : 0.0;
+  if (res_.status == "ok" && c.tau_m >= tau_p) {
+    res_.status = "no_melt";
+    res_.message = "the surface does not reach T_m within the pulse: melt onset at the centre would be at t = " +
+                   fmt(c.tau_m * G_.t_scale) + " s > pulse " + fmt(cfg_.tp) + " s";
+    res_.T_peak = cfg_.mat.Tm + G_.dT * premelt_temperature(G_, 0.0, 0.0, tau_p);
+  }
+  if (res_.status == "ok" && res_.curvature_clamps > 0)
+    res_.message = "curvature |a d| >= 2 clamped " + std::to_string(res_.curvature_clamps) + " times";
+  return res_;
+}
+
+}  // namespace
+
+Result run_simulation(const Config& cfg) {
+  Drill d(cfg);
+  return d.run();
+}
+
+}  // namespace laser
