@@ -108,10 +108,15 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2) 
       auto fdf = [&](double phi, double& f, double& df) {
         f = interface_residual(G, phi, xi, g, b2, &df);
       };
-      const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
-      s.phi = rr.x;
-      s.iterations = rr.iterations;
-      s.converged = rr.converged;
+      if (interface_residual(G, hi, xi, g, b2) > 0.0) {
+        const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+        s.phi = rr.x;
+        s.iterations = rr.iterations;
+        s.converged = rr.converged;
+      } else {
+        // hi - theta_m below round-off (very thin layer): the conduction root.
+        s.phi = hi;
+      }
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
       s.residual = interface_residual(G, s.phi, xi, g, b2) / E;
     }

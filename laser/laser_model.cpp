@@ -162,9 +162,12 @@ bool Drill::solve_melt_flow() {
     return false;
   }
   A_ = root.A;
-  for (int i = first; i < N; ++i) {
+  // The rising-fall v has the finite limit -A g^2 on the axis; the rising v
+  // ~ xi^(1/m - 1) is singular there and the centre stays pure conduction.
+  const int first_v = (!rising && first == 1) ? 0 : first;
+  for (int i = first_v; i < N; ++i) {
     Node& n = nodes_[i];
-    if (!n.molten || !(n.g > 0.0) || n.xi == 0.0) continue;
+    if (!n.molten || !(n.g > 0.0) || (rising && n.xi == 0.0)) continue;
     const double x = n.xi, g = n.g;
     if (rising) {
       n.f = A_ * std::pow(x, 1.0 / m);
@@ -420,7 +423,8 @@ Result Drill::run() {
           !std::isfinite(n.b2) || !std::isfinite(n.itf.phi)) {
         res_.status = "diverged";
         res_.message = "non-finite state at xi = " + fmt(n.xi) + ", t = " + fmt(tb * G_.t_scale) +
-                       " s (model " + to_string(cfg_.model) + ")";
+                       " s (model " + to_string(cfg_.model) + "; S2 " + fmt(n.S2) + ", g " + fmt(n.g) +
+                       ", S1 " + fmt(n.S1) + ", phi " + fmt(n.itf.phi) + ", b2 " + fmt(n.b2) + ")";
         break;
       }
     }

@@ -31,7 +31,7 @@ struct Config {
   bool moving_origin = true;
   double dxi = 0.0125;
   double xi_max = 0.0;     // 0: just beyond the last node that melts within the pulse
-  double dt = 2e-7;        // s
+  double dt = 0.0;         // s; 0: 5e-7 s * min(1, (7.5e10 W/m2 / I0)^2)
   double dtau = 0.0;       // nondimensional; overrides dt when > 0
   int frames = 200;        // HDF5 frames
   std::string out = "laser_out";
