@@ -349,6 +349,13 @@ void Drill::melt_temperature() {
     const double num = dfJ + n.f / n.xi * th * g * g / 3.0 + n.v * th;
     const double den = 2.0 * g + n.f / n.xi * std::pow(g, 4) / 12.0;
     n.b2 = num / den;
+    // Limiter: keep the profile (4-25) monotone in [0, g], |b2 g^2| <= theta_sat;
+    // beyond it the lagged update of (4-27) feeds back on itself and diverges.
+    const double bmax = th / (g * g);
+    if (std::fabs(n.b2) > bmax || !std::isfinite(n.b2)) {
+      ++res_.b2_clamps;
+      n.b2 = std::isfinite(n.b2) ? std::copysign(bmax, n.b2) : 0.0;
+    }
   }
 }
 

@@ -58,7 +58,7 @@ struct Result {
   double T_peak = 0, p_peak = 0, u_peak_max = 0, A_last = 0;
   double xi_melt_edge = 0;
   int steps = 0, nodes = 0;
-  int melt_clamps = 0, melt_rate_clamps = 0, curvature_clamps = 0;
+  int melt_clamps = 0, melt_rate_clamps = 0, curvature_clamps = 0, b2_clamps = 0;
   double max_interface_residual = 0;
   double dtau = 0, tau_p = 0;
   Energy energy;

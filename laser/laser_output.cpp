@@ -108,6 +108,7 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   o << "  \"melt_thickness_clamps\": " << r.melt_clamps << ",\n";
   o << "  \"melt_rate_clamps\": " << r.melt_rate_clamps << ",\n";
   o << "  \"curvature_clamps\": " << r.curvature_clamps << ",\n";
+  o << "  \"b2_limiter_hits\": " << r.b2_clamps << ",\n";
   o << "  \"max_interface_residual\": " << num(r.max_interface_residual) << ",\n";
   o << "  \"case\": {\"intensity_W_per_m2\": " << num(cfg.I0) << ", \"pulse_s\": " << num(cfg.tp)
     << ", \"radius_m\": " << num(cfg.R) << ", \"model\": " << quote(to_string(cfg.model))
