@@ -94,7 +94,7 @@ CorrectedConduction::CorrectedConduction(double c0) : c0_(c0) {
   // G'(0) from (3-28) and (3-32): sqrt(pi)/2 - 1/sqrt(pi c0).
   const double dG0 = 0.5 * std::sqrt(kPi) - 1.0 / std::sqrt(kPi * c0_);
 
-  const double s_first = 1e-4, s_last = 1e4;
+  const double s_first = 1e-6, s_last = 1e4;
   const int per_decade = 40;
   s_.push_back(0.0);
   g2_.push_back(0.5 * dG0);
@@ -105,7 +105,7 @@ CorrectedConduction::CorrectedConduction(double c0) : c0_(c0) {
 
   // theta_s3: zero initial value, boundary -theta_s2b, far boundary 0.
   std::vector<double> x{0.0};
-  double h = 2e-4;
+  double h = 2e-5;
   while (x.back() < 12.0 * std::sqrt(s_last)) { x.push_back(x.back() + h); h *= 1.04; }
   HeatSolver1D heat(x, std::vector<double>(x.size(), 0.0));
   double s_now = 0.0;

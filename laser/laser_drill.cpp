@@ -19,6 +19,15 @@ int main(int argc, char** argv) {
       return 0;
     }
     validate(cfg);
+    const double dt_max = explicit_step_limit(cfg);
+    if (dt_max > 0.0 && cfg.dt > dt_max) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf,
+                    "--dt/--dtau: time step %.4g s is above the explicit stability limit %.4g s of the "
+                    "melt thickness update (4-14) at this intensity; valid range (0, %.4g] s",
+                    cfg.dt, dt_max, dt_max);
+      throw UsageError(buf);
+    }
   } catch (const UsageError& e) {
     std::cerr << "laser_drill: error: " << e.what() << "\n";
     return 2;

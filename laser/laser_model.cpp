@@ -483,6 +483,46 @@ Result Drill::run() {
 
 }  // namespace
 
+double explicit_step_limit(const Config& cfg) {
+  const Groups G = make_groups(cfg.mat, cfg.I0, cfg.R);
+  const double L0 = 1.0 / (G.Ste * G.Nc) - G.theta_i;
+  // surface state for a conduction gradient q into the melt: vapour term = 1 - k' q
+  auto phi_of_q = [&](double q) {
+    const double target = 1.0 - G.kprime * q;
+    auto fdf = [&](double phi, double& f, double& df) {
+      const double v = std::exp(G.Hlv * (1.0 - 1.0 / phi)) * (1.0 + G.Lambda * phi) / (G.Iprime * std::sqrt(phi));
+      f = v - target;
+      df = v * (G.Hlv / (phi * phi) + G.Lambda / (1.0 + G.Lambda * phi) - 0.5 / phi);
+    };
+    return safe_newton(fdf, G.theta_m, 2.0 * G.Hlv, 1e-14).x;
+  };
+  auto F = [&](double q, double& f, double& df) {
+    const double phi = phi_of_q(q);
+    InterfaceState s;
+    s.phi = phi;
+    s.p_pa = G.p0 * std::exp(G.Hlv * (1.0 - 1.0 / phi));
+    s.p_star = s.p_pa / G.p_scale;
+    s.grad_top = q;
+    f = recession_rate(G, 0.0, s) - G.Na * G.k * q / L0;  // dS1/dtau = dS2/dtau
+    df = 0.0;  // bisection only
+  };
+  const double v_m = std::exp(G.Hlv * (1.0 - 1.0 / G.theta_m)) * (1.0 + G.Lambda * G.theta_m) /
+                     (G.Iprime * std::sqrt(G.theta_m));
+  const double qmax = (1.0 - v_m * (1.0 + 1e-6)) / G.kprime;  // theta_sat -> 0
+  double flo, fhi, d;
+  F(1e-9 * qmax, flo, d);
+  F(qmax, fhi, d);
+  if (!(flo > 0.0 && fhi < 0.0)) return 0.0;
+  const RootResult r = safe_newton(F, 1e-9 * qmax, qmax, 1e-12 * qmax, 200);
+  if (!r.converged) return 0.0;
+  const double q = r.x, phi = phi_of_q(q);
+  const double theta = (phi - G.theta_m) / (1.0 - G.theta_m);
+  if (!(theta > 0.0)) return 0.0;
+  const double g = theta / q;
+  const double lambda = (G.Na * G.k / L0 + G.hls_hlv * G.Ste) * q / g;
+  return 2.0 / lambda * G.t_scale;
+}
+
 Result run_simulation(const Config& cfg) {
   Drill d(cfg);
   return d.run();

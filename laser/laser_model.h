@@ -71,4 +71,9 @@ struct Result {
 // Runs one case; never throws for physical reasons (status says why it ended).
 Result run_simulation(const Config& cfg);
 
+// A priori limit [s] of the explicit melt-thickness update (4-14): 2/lambda
+// with lambda = -d(dg/dtau)/dg at the quasi-steady ablation state of the beam
+// centre (no flow, solid gradient decayed). Returns 0 if there is no such state.
+double explicit_step_limit(const Config& cfg);
+
 }  // namespace laser

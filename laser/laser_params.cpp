@@ -305,7 +305,8 @@ Config parse_command_line(int argc, const char* const* argv, bool& help, bool& d
       continue;
     }
     if (!inline_value) {
-      if (i + 1 >= argc) throw UsageError("--" + name + ": missing value");
+      if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
+        throw UsageError("--" + name + ": missing value");
       value = argv[++i];
     }
     apply(c, *o, value, "");

@@ -1,0 +1,208 @@
+// Whole-model checks L1, L3, L4 of CASES.md and the extreme cases, run in
+// process on the Table 5.1 material with short settings where possible.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "laser_model.h"
+
+using namespace laser;
+
+namespace {
+Config base() {
+  Config c;
+  c.quiet = true;
+  c.write_files = false;
+  validate(c);
+  return c;
+}
+Config with(double I0, FlowModel m, double tp = 700e-6) {
+  Config c;
+  c.quiet = true;
+  c.I0 = I0;
+  c.tp = tp;
+  c.model = m;
+  validate(c);
+  return c;
+}
+bool all_finite(const Result& r) {
+  for (const auto& f : r.frames)
+    for (const auto* v : {&f.S1net, &f.S2, &f.g, &f.T, &f.p})
+      for (double x : *v)
+        if (!std::isfinite(x)) return false;
+  return std::isfinite(r.depth_center) && std::isfinite(r.volume_removed) && std::isfinite(r.T_peak);
+}
+}  // namespace
+
+// L1: before melting the surface follows (3-26) and the onset time is (3-27),
+// both checked against the classical dimensional constant-flux solution
+// T_s = T_i + 2 q sqrt(alpha_s t / pi) / k_s, computed here independently.
+TEST(LaserCases, L1PremeltingSurfaceTemperatureAndOnsetTime) {
+  Config c;
+  c.quiet = true;
+  c.I0 = 2.5e10;
+  c.tp = 2e-6;
+  c.dt = 1e-8;
+  c.model = FlowModel::Conduction;
+  validate(c);
+  const Result r = run_simulation(c);
+  const Material& m = c.mat;
+  const double alpha_s = m.ks / (m.rho * m.cps);
+  double worst_T = 0;
+  int checked = 0;
+  for (const auto& rec : r.centre) {
+    if (rec.t <= 0 || rec.t >= r.t_melt_center) continue;
+    const double T = m.Ti + 2 * c.I0 * std::sqrt(alpha_s * rec.t / kPi) / m.ks;
+    worst_T = std::max(worst_T, std::fabs(rec.T - T) / T);
+    ++checked;
+  }
+  EXPECT_GT(checked, 10);
+  EXPECT_LT(worst_T, 1e-13);
+  double worst_t = 0;
+  for (size_t i = 0; i < r.xi.size(); ++i) {
+    const double q = c.I0 * std::exp(-r.xi[i] * r.xi[i]);
+    const double tm = kPi / alpha_s * std::pow(m.ks * (m.Tm - m.Ti) / (2 * q), 2);
+    worst_t = std::max(worst_t, std::fabs(r.tau_m_s[i] - tm) / tm);
+  }
+  EXPECT_LT(worst_t, 1e-13);
+  EXPECT_NEAR(r.t_melt_center / (kPi / alpha_s * std::pow(m.ks * (m.Tm - m.Ti) / (2 * c.I0), 2)), 1.0, 1e-13);
+  std::printf("[ L1 ] surface temperature max rel. error %.1e over %d times, onset time %.1e over %zu nodes\n",
+              worst_T, checked, worst_t, r.xi.size());
+}
+
+// L3: absorbed laser energy = solid (before and after onset, incl. the
+// moving-origin preheat) + latent heat of melting + latent heat and kinetic
+// energy of the vapour (from (3-15), (3-17), not from (3-25)) + heat carried
+// sideways by the melt flow; the beam is integrated analytically over the disk.
+TEST(LaserCases, L3EnergyBalanceOverThePulse) {
+  for (FlowModel m : {FlowModel::Conduction, FlowModel::RisingFall, FlowModel::Rising}) {
+    Config c = with(7.5e10, m);
+    const Result r = run_simulation(c);
+    ASSERT_EQ(r.status, "ok");
+    const Energy& e = r.energy;
+    const double imbalance = (e.sum() - e.laser_exact) / e.laser_exact;
+    std::printf("[ L3 ] %-10s laser %.4f J: solid %.4f + preheat %.4f + melt %.4f + vapour %.4f + kinetic %.4f + flow %.2e"
+                " -> imbalance %.2e\n",
+                to_string(m), e.laser_exact, e.solid_premelt + e.solid_conduction, e.solid_preheat,
+                e.melt_latent, e.vapour_latent, e.vapour_kinetic, e.flow_advected, imbalance);
+    EXPECT_LT(std::fabs(imbalance), 0.01);
+    // the vapour latent heat from the flux law agrees with the vaporized volume
+    const double from_volume = c.mat.rho * c.mat.hlv * r.volume_vaporized;
+    EXPECT_NEAR(e.vapour_latent / from_volume, 1.0, 0.01);
+  }
+}
+
+// L4 (chapter 5) statements that are deterministic properties of the model.
+TEST(LaserCases, L4RemovalRateRisesWithIntensity) {
+  double prev = 0;
+  for (double I : {2.5e10, 5e10, 7.5e10, 10e10, 16e10}) {
+    const Result r = run_simulation(with(I, FlowModel::RisingFall));
+    ASSERT_EQ(r.status, "ok") << I;
+    std::printf("[ L4 ] I0 = %.2e W/m2: removal rate %.4e m3/s, depth %.4e m\n", I, r.removal_rate, r.depth_center);
+    EXPECT_GT(r.removal_rate, prev);
+    prev = r.removal_rate;
+  }
+}
+
+TEST(LaserCases, L4FlowModelsWithinTwoPercentOfConduction) {
+  const double ref = run_simulation(with(7.5e10, FlowModel::Conduction)).volume_removed;
+  for (double m : {1.5, 2.0, 3.0, 5.0}) {
+    Config c = with(7.5e10, FlowModel::Rising);
+    c.m = m;
+    const Result r = run_simulation(c);
+    ASSERT_EQ(r.status, "ok");
+    EXPECT_NEAR(r.volume_removed / ref, 1.0, 0.02) << "rising m = " << m;
+  }
+  for (double xp : {0.6, 0.8, 1.0, 1.5}) {
+    Config c = with(7.5e10, FlowModel::RisingFall);
+    c.xi_p = xp;
+    const Result r = run_simulation(c);
+    ASSERT_EQ(r.status, "ok");
+    EXPECT_NEAR(r.volume_removed / ref, 1.0, 0.02) << "rising-fall xi_p = " << xp;
+  }
+}
+
+TEST(LaserCases, L4NearlyConstantDrillingRateAndProfiles) {
+  const Result r = run_simulation(base());
+  ASSERT_EQ(r.status, "ok");
+  // vertical drilling rate: second half of the pulse vs 10 %..50 %
+  const auto& c = r.centre;
+  const size_t a = c.size() / 10, h = c.size() / 2, e = c.size() - 1;
+  const double v1 = (c[h].depth - c[a].depth) / (c[h].t - c[a].t);
+  const double v2 = (c[e].depth - c[h].depth) / (c[e].t - c[h].t);
+  std::printf("[ L4 ] drilling rate %.4f m/s (10-50 %%) and %.4f m/s (50-100 %%)\n", v1, v2);
+  EXPECT_NEAR(v2 / v1, 1.0, 0.02);
+  // pressure and temperature at tau_p (Figs 5.3, 5.4)
+  const Frame& f = r.frames.back();
+  auto at = [&](const std::vector<double>& y, double xi) {
+    return y[static_cast<size_t>(std::lround(xi / 0.0125))];
+  };
+  const double p05 = at(f.p, 0.5) / f.p[0], p1 = at(f.p, 1.0) / f.p[0];
+  const double th15 = at(f.theta_sat, 1.5) / f.theta_sat[0], T15 = at(f.T, 1.5) / f.T[0];
+  std::printf("[ L4 ] p(0.5)/p(0) = %.3f, p(1)/p(0) = %.3f, theta_sat(1.5)/theta_sat(0) = %.3f, T(1.5)/T(0) = %.3f (K)\n",
+              p05, p1, th15, T15);
+  EXPECT_NEAR(p05, 0.8, 0.05);       // "about 80 %"
+  EXPECT_NEAR(p1, 1.0 / 3.0, 0.03);  // "one third"
+  EXPECT_NEAR(th15, 0.7, 0.05);      // "about 70 %", true for theta_sat, not for T in K
+  // melt flow 3-4 orders of magnitude below the vaporization rate (Fig. 5.7)
+  const CentreRecord& last = c.back();
+  const double r1 = std::fabs(last.flow_v_1) / last.vap_rate_1;
+  const double rx = std::fabs(last.flow_v_x1) / last.vap_rate_x1;
+  std::printf("[ L4 ] |v_flow| / vaporization rate at xi = 0.0125: %.2e, at xi = 1: %.2e\n", r1, rx);
+  EXPECT_LT(r1, 1e-3);
+  EXPECT_GT(r1, 1e-5);
+  EXPECT_LT(rx, 1e-3);
+  EXPECT_GT(rx, 1e-5);
+}
+
+// Extreme cases: each ends with a status and finite numbers.
+TEST(LaserCases, ExtremeIntensityTooLowToMelt) {
+  Config c = with(1e8, FlowModel::RisingFall);
+  const Result r = run_simulation(c);
+  EXPECT_EQ(r.status, "no_melt");
+  EXPECT_NE(r.message.find("does not reach T_m"), std::string::npos);
+  EXPECT_EQ(r.volume_removed, 0.0);
+  EXPECT_LT(r.T_peak, c.mat.Tm);
+  EXPECT_GT(r.T_peak, c.mat.Ti);
+}
+
+TEST(LaserCases, ExtremeVeryHighIntensity) {
+  // 1e12 W/m2 over 50 us (the full 700 us pulse takes ~30 s; see docs)
+  Config c = with(1e12, FlowModel::RisingFall, 50e-6);
+  const Result r = run_simulation(c);
+  std::printf("[ EXT ] 1e12 W/m2: status %s, depth %.3e m, T_peak %.0f K, p_peak %.3e Pa %s\n", r.status.c_str(),
+              r.depth_center, r.T_peak, r.p_peak, r.message.c_str());
+  EXPECT_EQ(r.status, "ok");
+  EXPECT_TRUE(all_finite(r));
+  EXPECT_LT(std::fabs(r.energy.sum() / r.energy.laser_exact - 1.0), 0.01);
+}
+
+TEST(LaserCases, ExtremeSmallPeakPositionsEndWithStatus) {
+  for (double xp : {0.2, 0.4}) {
+    Config c = with(7.5e10, FlowModel::RisingFall);
+    c.xi_p = xp;
+    const Result r = run_simulation(c);
+    std::printf("[ EXT ] xi_p = %.1f: status %s, volume %.4e m3, u_peak %.3e m/s %s\n", xp, r.status.c_str(),
+                r.volume_removed, r.u_peak_max, r.message.c_str());
+    EXPECT_FALSE(r.status.empty());
+    if (r.status == "ok") EXPECT_TRUE(all_finite(r));
+    else EXPECT_FALSE(r.message.empty());
+  }
+}
+
+TEST(LaserCases, ExtremeLargePrandtlEndsWithStatus) {
+  for (double pr : {142.0, 142000.0}) {
+    for (FlowModel m : {FlowModel::Rising, FlowModel::RisingFall}) {
+      Config c = with(7.5e10, m);
+      c.mat.Pr = pr;
+      const Result r = run_simulation(c);
+      std::printf("[ EXT ] Pr = %g %s: status %s, flow share of removal %.3f %s\n", pr, to_string(m),
+                  r.status.c_str(), r.volume_removed > 0 ? r.volume_flow / r.volume_removed : 0.0,
+                  r.message.c_str());
+      EXPECT_FALSE(r.status.empty());
+      if (r.status == "ok") EXPECT_TRUE(all_finite(r));
+      else EXPECT_FALSE(r.message.empty());
+    }
+  }
+}
