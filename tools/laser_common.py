@@ -1,0 +1,27 @@
+"""Helpers shared by the laser_*.py tools: locate and run laser_drill."""
+import json
+import os
+import subprocess
+import sys
+
+TOP = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def find_exe(exe=None):
+    candidates = [exe] if exe else [os.path.join(TOP, d, "laser_drill") for d in ("build", "build-laser")]
+    for c in candidates:
+        if c and os.path.isfile(c) and os.access(c, os.X_OK):
+            return c
+    sys.exit("laser_drill not found (tried %s); build it or pass --exe" % ", ".join(c for c in candidates if c))
+
+
+def run_case(exe, out, args, quiet=True):
+    """Runs laser_drill into directory out; returns (exit code, summary dict or None, stderr)."""
+    cmd = [exe, "--out", out] + [str(a) for a in args] + (["--quiet"] if quiet else [])
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    summary = None
+    path = os.path.join(out, "summary.json")
+    if p.returncode == 0 and os.path.exists(path):
+        with open(path) as f:
+            summary = json.load(f)
+    return p.returncode, summary, p.stderr.strip()
