@@ -1,0 +1,1276 @@
+/* fix mpm/fluid: see fix_mpm_fluid.h, docs/fix_mpm_fluid.md and docs/design.md.
+   The time step follows chapter 8 of the dissertation, phase by phase:
+   particles_to_grid (8-10), (8-19), (8-24); update_grid (8-35), (8-36) with
+   boundary conditions; grid_to_particles (8-37) to (8-41); MUSL remap and
+   stress update (7-21) to (7-24). */
+
+#include "fix_mpm_fluid.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "atom.h"
+#include "atom_vec.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "force.h"
+#include "group.h"
+#include "memory.h"
+#include "modify.h"
+#include "neighbor.h"
+#include "region.h"
+#include "update.h"
+
+#include "mpm/hdf5_series.h"
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+
+namespace {
+
+const char *kFaceNames[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
+
+int axis_of(const char *s) {
+  if (strcmp(s, "x") == 0) return 0;
+  if (strcmp(s, "y") == 0) return 1;
+  if (strcmp(s, "z") == 0) return 2;
+  return -1;
+}
+
+bool parse_double(const char *s, double &v) {
+  char *end = nullptr;
+  v = strtod(s, &end);
+  return end != s && *end == '\0' && std::isfinite(v);
+}
+
+bool parse_int(const char *s, int &v) {
+  char *end = nullptr;
+  long l = strtol(s, &end, 10);
+  v = static_cast<int>(l);
+  return end != s && *end == '\0';
+}
+
+bool parse_yesno(const char *s, bool &v) {
+  if (strcmp(s, "yes") == 0) { v = true; return true; }
+  if (strcmp(s, "no") == 0) { v = false; return true; }
+  return false;
+}
+
+const char *kPointFields[] = {"v", "p", "rho", "vol", "tau", "theta", "id", "type", "affine", "mass"};
+const char *kGridFields[] = {"mass", "v"};
+
+}  // namespace
+
+/* ---------------------------------------------------------------------- */
+
+FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
+  if (domain->triclinic) error->all(FLERR, "Fix mpm/fluid requires an orthogonal simulation box");
+  if (!atom->rmass_flag || !atom->radius_flag)
+    error->all(FLERR, "Fix mpm/fluid requires atom_style sphere (per-atom mass and radius)");
+
+  parse_args(narg, arg);
+
+  restart_global = 1;
+  restart_peratom = 1;
+  // no create_attribute: LIGGGHTS would call set_arrays() for every atom at
+  // the first setup and wipe the points' state; new rows are zeroed in grow_arrays
+  time_integrate = 1;  // the fix moves its material points itself
+  vector_flag = 1;
+  size_vector = 10;
+  global_freq = 1;
+  extvector = 0;
+  peratom_flag = 1;
+  size_peratom_cols = NCOL;
+  peratom_freq = 1;
+  nevery = out_every > 0 ? out_every : 1;
+
+  grow_arrays(atom->nmax);
+  atom->add_callback(0);
+  atom->add_callback(1);
+  array_atom = pdata;
+}
+
+FixMpmFluid::~FixMpmFluid() {
+  atom->delete_callback(id, 0);
+  atom->delete_callback(id, 1);
+  memory->destroy(pdata);
+}
+
+int FixMpmFluid::setmask() {
+  int mask = PRE_FINAL_INTEGRATE;
+  if (out_every > 0) mask |= END_OF_STEP;
+  return mask;
+}
+
+// error->one aborts without flushing stdio, so a message would be lost when
+// the screen is a pipe or a file: print and flush first, then abort.
+void FixMpmFluid::fail_one(const std::string &msg) {
+  if (screen) {
+    fprintf(screen, "ERROR on proc %d: %s\n", comm->me, msg.c_str());
+    fflush(screen);
+  }
+  if (logfile) {
+    fprintf(logfile, "ERROR on proc %d: %s\n", comm->me, msg.c_str());
+    fflush(logfile);
+  }
+  MPI_Abort(world, 1);
+  std::abort();
+}
+
+void FixMpmFluid::bad_arg(const char *keyword, const char *expected, const char *given) {
+  std::string msg = std::string("Fix mpm/fluid: keyword '") + keyword + "' expects " + expected +
+                    ", got " + (given ? std::string("'") + given + "'" : std::string("nothing"));
+  error->all(FLERR, msg.c_str());
+  std::abort();
+}
+
+/* ----------------------------------------------------------------------
+   fix ID group mpm/fluid keyword value ...
+------------------------------------------------------------------------- */
+
+void FixMpmFluid::parse_args(int narg, char **arg) {
+  bool have_cell = false, have_density = false, have_bulk = false;
+  for (int f = 0; f < 6; ++f) face[f] = Face();
+
+  auto need = [&](int iarg, int n, const char *kw, const char *what) {
+    if (iarg + n >= narg) bad_arg(kw, what, nullptr);
+  };
+  auto positive = [&](const char *kw, const char *s, double &v) {
+    if (!parse_double(s, v) || v <= 0.0) bad_arg(kw, "a positive number", s);
+  };
+
+  int iarg = 3;
+  while (iarg < narg) {
+    const char *kw = arg[iarg];
+    if (strcmp(kw, "cell") == 0) {
+      need(iarg, 1, kw, "the cell size (length units)");
+      positive(kw, arg[iarg + 1], gspec.dx);
+      have_cell = true;
+      iarg += 2;
+    } else if (strcmp(kw, "grid") == 0) {
+      need(iarg, 6, kw, "six bounds xlo xhi ylo yhi zlo zhi");
+      for (int k = 0; k < 6; ++k)
+        if (!parse_double(arg[iarg + 1 + k], gbounds[k])) bad_arg(kw, "a number", arg[iarg + 1 + k]);
+      for (int d = 0; d < 3; ++d)
+        if (gbounds[2 * d + 1] <= gbounds[2 * d]) bad_arg(kw, "hi > lo in every dimension", arg[iarg + 2 + 2 * d]);
+      grid_bounds_given = true;
+      iarg += 7;
+    } else if (strcmp(kw, "density") == 0) {
+      need(iarg, 1, kw, "the reference density (mass/volume)");
+      positive(kw, arg[iarg + 1], eos.rho0);
+      have_density = true;
+      iarg += 2;
+    } else if (strcmp(kw, "bulk") == 0) {
+      need(iarg, 1, kw, "the bulk modulus (pressure units)");
+      positive(kw, arg[iarg + 1], eos.K);
+      have_bulk = true;
+      iarg += 2;
+    } else if (strcmp(kw, "viscosity") == 0) {
+      need(iarg, 1, kw, "the dynamic viscosity");
+      if (!parse_double(arg[iarg + 1], viscosity) || viscosity < 0.0)
+        bad_arg(kw, "a non-negative number", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(kw, "eos") == 0) {
+      need(iarg, 1, kw, "'linear' or 'tait gamma'");
+      if (strcmp(arg[iarg + 1], "linear") == 0) {
+        eos.kind = mpm::EosKind::Linear;
+        iarg += 2;
+      } else if (strcmp(arg[iarg + 1], "tait") == 0) {
+        need(iarg, 2, kw, "'tait' followed by the exponent gamma");
+        if (!parse_double(arg[iarg + 2], eos.gamma) || eos.gamma < 1.0)
+          bad_arg("eos tait", "an exponent gamma >= 1", arg[iarg + 2]);
+        eos.kind = mpm::EosKind::Tait;
+        iarg += 3;
+      } else
+        bad_arg(kw, "'linear' or 'tait'", arg[iarg + 1]);
+    } else if (strcmp(kw, "shape") == 0) {
+      need(iarg, 1, kw, "'linear' or 'bspline2'");
+      if (strcmp(arg[iarg + 1], "linear") == 0)
+        shape = mpm::ShapeKind::Linear;
+      else if (strcmp(arg[iarg + 1], "bspline2") == 0)
+        shape = mpm::ShapeKind::QuadraticBSpline;
+      else
+        bad_arg(kw, "'linear' or 'bspline2'", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(kw, "transfer") == 0) {
+      need(iarg, 1, kw, "'apic', 'pic' or 'flip alpha'");
+      if (strcmp(arg[iarg + 1], "apic") == 0) {
+        transfer = TR_APIC;
+        iarg += 2;
+      } else if (strcmp(arg[iarg + 1], "pic") == 0) {
+        transfer = TR_PIC;
+        iarg += 2;
+      } else if (strcmp(arg[iarg + 1], "flip") == 0) {
+        // optional FLIP fraction; a following word that is not a number is the next keyword
+        transfer = TR_FLIP;
+        flip_alpha = 1.0;
+        iarg += 2;
+        double a;
+        if (iarg < narg && parse_double(arg[iarg], a)) {
+          if (a < 0.0 || a > 1.0) bad_arg("transfer flip", "a FLIP fraction in [0,1]", arg[iarg]);
+          flip_alpha = a;
+          ++iarg;
+        }
+      } else
+        bad_arg(kw, "'apic', 'pic' or 'flip'", arg[iarg + 1]);
+    } else if (strcmp(kw, "update") == 0) {
+      need(iarg, 1, kw, "'musl' or 'usl'");
+      if (strcmp(arg[iarg + 1], "musl") == 0)
+        musl = true;
+      else if (strcmp(arg[iarg + 1], "usl") == 0)
+        musl = false;
+      else
+        bad_arg(kw, "'musl' or 'usl'", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(kw, "antilock") == 0) {
+      need(iarg, 1, kw, "'yes' or 'no'");
+      if (!parse_yesno(arg[iarg + 1], antilock)) bad_arg(kw, "'yes' or 'no'", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(kw, "boundary") == 0) {
+      need(iarg, 2, kw, "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip' or 'partial f'");
+      parse_face(arg[iarg + 1], arg[iarg + 2], narg, arg, iarg);
+    } else if (strcmp(kw, "gate") == 0) {
+      need(iarg, 4, kw, "'dim pos lower|upper release_time'");
+      gate.dim = axis_of(arg[iarg + 1]);
+      if (gate.dim < 0) bad_arg(kw, "an axis x, y or z", arg[iarg + 1]);
+      if (!parse_double(arg[iarg + 2], gate.pos)) bad_arg(kw, "a gate position", arg[iarg + 2]);
+      if (strcmp(arg[iarg + 3], "lower") == 0)
+        gate.fluid_below = true;
+      else if (strcmp(arg[iarg + 3], "upper") == 0)
+        gate.fluid_below = false;
+      else
+        bad_arg(kw, "'lower' or 'upper' (side of the gate that holds the fluid)", arg[iarg + 3]);
+      if (strcmp(arg[iarg + 4], "never") == 0)
+        gate.release_time = -1.0;
+      else if (!parse_double(arg[iarg + 4], gate.release_time) || gate.release_time < 0.0)
+        bad_arg(kw, "a release time >= 0 or 'never'", arg[iarg + 4]);
+      gate.active = true;
+      iarg += 5;
+    } else if (strcmp(kw, "damping") == 0) {
+      need(iarg, 1, kw, "a damping rate (1/time) >= 0");
+      if (!parse_double(arg[iarg + 1], damping) || damping < 0.0)
+        bad_arg(kw, "a damping rate (1/time) >= 0", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(kw, "cfl") == 0) {
+      need(iarg, 1, kw, "a CFL number in (0,1]");
+      if (!parse_double(arg[iarg + 1], cfl) || cfl <= 0.0 || cfl > 1.0)
+        bad_arg(kw, "a CFL number in (0,1]", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(kw, "subcycle") == 0) {
+      need(iarg, 1, kw, "'yes' or 'no'");
+      if (!parse_yesno(arg[iarg + 1], subcycle)) bad_arg(kw, "'yes' or 'no'", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(kw, "mass_threshold") == 0) {
+      need(iarg, 1, kw, "a fraction of the point mass in [0,1)");
+      if (!parse_double(arg[iarg + 1], mass_threshold) || mass_threshold < 0.0 || mass_threshold >= 1.0)
+        bad_arg(kw, "a fraction of the point mass in [0,1)", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(kw, "fill") == 0) {
+      need(iarg, 6, kw, "'region-ID nx ny nz type T'");
+      fill_region = arg[iarg + 1];
+      for (int d = 0; d < 3; ++d)
+        if (!parse_int(arg[iarg + 2 + d], fill_ppc[d]) || fill_ppc[d] < 1 || fill_ppc[d] > 8)
+          bad_arg(kw, "points per cell per direction, an integer 1..8", arg[iarg + 2 + d]);
+      if (strcmp(arg[iarg + 5], "type") != 0) bad_arg(kw, "'type T' after the points per cell", arg[iarg + 5]);
+      if (!parse_int(arg[iarg + 6], fill_type) || fill_type < 1 || fill_type > atom->ntypes)
+        bad_arg("fill type", "an existing atom type", arg[iarg + 6]);
+      if (domain->find_region(fill_region.c_str()) < 0) bad_arg(kw, "an existing region ID", arg[iarg + 1]);
+      iarg += 7;
+    } else if (strcmp(kw, "hydrostatic") == 0) {
+      need(iarg, 3, kw, "'axis surface g' (initial pressure rho g (surface - coordinate))");
+      hydro_axis = axis_of(arg[iarg + 1]);
+      if (hydro_axis < 0) bad_arg(kw, "an axis x, y or z", arg[iarg + 1]);
+      if (!parse_double(arg[iarg + 2], hydro_surface)) bad_arg(kw, "the surface coordinate", arg[iarg + 2]);
+      if (!parse_double(arg[iarg + 3], hydro_g) || hydro_g < 0.0) bad_arg(kw, "g >= 0", arg[iarg + 3]);
+      hydrostatic = true;
+      iarg += 4;
+    } else if (strcmp(kw, "front") == 0) {
+      need(iarg, 1, kw, "an axis x, y or z");
+      front_axis = axis_of(arg[iarg + 1]);
+      if (front_axis < 0) bad_arg(kw, "an axis x, y or z", arg[iarg + 1]);
+      iarg += 2;
+    } else if (strcmp(kw, "height") == 0) {
+      need(iarg, 3, kw, "'axis wall-axis wall-position'");
+      height_axis = axis_of(arg[iarg + 1]);
+      wall_axis = axis_of(arg[iarg + 2]);
+      if (height_axis < 0 || wall_axis < 0 || height_axis == wall_axis)
+        bad_arg(kw, "two different axes x, y or z", arg[iarg + 1]);
+      if (!parse_double(arg[iarg + 3], wall_pos)) bad_arg(kw, "a wall position", arg[iarg + 3]);
+      wall_pos_given = true;
+      iarg += 4;
+    } else if (strcmp(kw, "output") == 0) {
+      need(iarg, 3, kw, "'N prefix points f1 ... [grid g1 ...]'");
+      if (!parse_int(arg[iarg + 1], out_every) || out_every < 0)
+        bad_arg(kw, "an output interval N >= 0 (steps; 0 = no output)", arg[iarg + 1]);
+      out_prefix = arg[iarg + 2];
+      iarg += 3;
+      if (strcmp(arg[iarg], "points") != 0) bad_arg(kw, "'points' followed by field names", arg[iarg]);
+      ++iarg;
+      std::vector<std::string> *list = &out_point_fields;
+      while (iarg < narg) {
+        if (strcmp(arg[iarg], "grid") == 0 && list == &out_point_fields) {
+          list = &out_grid_fields;
+          ++iarg;
+          continue;
+        }
+        bool ok = false;
+        if (list == &out_point_fields) {
+          for (const char *f : kPointFields) ok = ok || strcmp(arg[iarg], f) == 0;
+        } else {
+          for (const char *f : kGridFields) ok = ok || strcmp(arg[iarg], f) == 0;
+        }
+        if (!ok) {
+          // The first word that is no field name ends the list only if it is a keyword.
+          static const char *keywords[] = {"cell", "grid", "density", "bulk", "viscosity", "eos", "shape",
+                                           "transfer", "update", "antilock", "boundary", "gate", "damping",
+                                           "cfl", "subcycle", "mass_threshold", "fill", "hydrostatic",
+                                           "front", "height", "output"};
+          bool is_kw = false;
+          for (const char *k : keywords) is_kw = is_kw || strcmp(arg[iarg], k) == 0;
+          if (is_kw) break;
+          bad_arg(list == &out_point_fields ? "output points" : "output grid",
+                  list == &out_point_fields ? "point fields v p rho vol tau theta id type affine mass"
+                                            : "grid fields mass v",
+                  arg[iarg]);
+        }
+        list->push_back(arg[iarg]);
+        ++iarg;
+      }
+    } else {
+      std::string msg = std::string("Fix mpm/fluid: unknown keyword '") + kw +
+                        "' (see docs/fix_mpm_fluid.md for the keywords)";
+      error->all(FLERR, msg.c_str());
+    }
+  }
+  if (!have_cell) error->all(FLERR, "Fix mpm/fluid: keyword 'cell' (cell size) is required");
+  if (!have_density) error->all(FLERR, "Fix mpm/fluid: keyword 'density' (reference density) is required");
+  if (!have_bulk) error->all(FLERR, "Fix mpm/fluid: keyword 'bulk' (bulk modulus) is required");
+
+  // Grid: cubic cells fitted exactly into the bounds.
+  double b[6];
+  for (int d = 0; d < 3; ++d) {
+    b[2 * d] = grid_bounds_given ? gbounds[2 * d] : domain->boxlo[d];
+    b[2 * d + 1] = grid_bounds_given ? gbounds[2 * d + 1] : domain->boxhi[d];
+    const double n = (b[2 * d + 1] - b[2 * d]) / gspec.dx;
+    const long nr = std::lround(n);
+    if (nr < 1 || std::fabs(n - nr) > 1e-6 * std::max(1.0, n)) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: keyword 'cell' expects a cell size that divides the grid extent in "
+         << "xyz"[d] << " (" << b[2 * d + 1] - b[2 * d] << "), got " << gspec.dx << " (" << n << " cells)";
+      error->all(FLERR, os.str().c_str());
+    }
+    gspec.origin[d] = b[2 * d];
+    gspec.ncell[d] = static_cast<int>(nr);
+    gspec.periodic[d] = domain->periodicity[d] != 0;
+    if (gspec.periodic[d] && (std::fabs(b[2 * d] - domain->boxlo[d]) > 1e-9 * gspec.dx ||
+                              std::fabs(b[2 * d + 1] - domain->boxhi[d]) > 1e-9 * gspec.dx))
+      error->all(FLERR, "Fix mpm/fluid: keyword 'grid' must span the whole box in a periodic dimension");
+    if (!gspec.periodic[d] && (b[2 * d] < domain->boxlo[d] - 1e-9 * gspec.dx ||
+                               b[2 * d + 1] > domain->boxhi[d] + 1e-9 * gspec.dx))
+      error->all(FLERR, "Fix mpm/fluid: keyword 'grid' bounds must lie inside the simulation box");
+  }
+  gspec.pad = shape == mpm::ShapeKind::QuadraticBSpline ? 1 : 0;
+  if (!wall_pos_given) wall_pos = gspec.origin[wall_axis];
+  if (gate.active && !gspec.periodic[gate.dim] &&
+      (gate.pos <= gspec.origin[gate.dim] || gate.pos >= gspec.upper(gate.dim)))
+    error->all(FLERR, "Fix mpm/fluid: keyword 'gate' expects a position inside the grid");
+}
+
+void FixMpmFluid::parse_face(const char *name, const char *kind, int narg, char **arg, int &iarg) {
+  int f0 = -1, f1 = -1;
+  if (strcmp(name, "all") == 0) {
+    f0 = 0;
+    f1 = 5;
+  } else {
+    for (int f = 0; f < 6; ++f)
+      if (strcmp(name, kFaceNames[f]) == 0) f0 = f1 = f;
+  }
+  if (f0 < 0) bad_arg("boundary", "a face xlo xhi ylo yhi zlo zhi or all", name);
+  Face fc;
+  int used = 3;
+  if (strcmp(kind, "noslip") == 0) {
+    fc.kind = BC_NOSLIP;
+    fc.sticky = 1.0;
+  } else if (strcmp(kind, "freeslip") == 0) {
+    fc.kind = BC_FREESLIP;
+    fc.sticky = 0.0;
+  } else if (strcmp(kind, "partial") == 0) {
+    if (iarg + 3 >= narg) bad_arg("boundary partial", "a sticky fraction in [0,1]", nullptr);
+    if (!parse_double(arg[iarg + 3], fc.sticky) || fc.sticky < 0.0 || fc.sticky > 1.0)
+      bad_arg("boundary partial", "a sticky fraction in [0,1]", arg[iarg + 3]);
+    fc.kind = BC_PARTIAL;
+    used = 4;
+  } else
+    bad_arg("boundary", "'noslip', 'freeslip' or 'partial f'", kind);
+  for (int f = f0; f <= f1; ++f) face[f] = fc;
+  iarg += used;
+}
+
+/* ---------------------------------------------------------------------- */
+
+bool FixMpmFluid::is_point(int i) const { return (atom->mask[i] & groupbit) != 0; }
+
+double FixMpmFluid::sim_time() const {
+  return update->atime + (update->ntimestep - update->atimestep) * update->dt;
+}
+
+void FixMpmFluid::post_create() {
+  // After a read_restart the points exist already (recent_restart is set
+  // when our global state came from the restart file).
+  if (!recent_restart && !fill_region.empty()) fill_points();
+}
+
+void FixMpmFluid::fill_points() {
+  Region *region = domain->regions[domain->find_region(fill_region.c_str())];
+  const double dx = gspec.dx;
+  double vol = dx * dx * dx;
+  for (int d = 0; d < 3; ++d) {
+    spacing[d] = dx / fill_ppc[d];
+    vol /= fill_ppc[d];
+  }
+  const int nlocal_before = atom->nlocal;
+  int lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = std::max(0, static_cast<int>(std::floor((domain->sublo[d] - gspec.origin[d]) / dx)) - 1);
+    hi[d] = std::min(gspec.ncell[d] - 1,
+                     static_cast<int>(std::floor((domain->subhi[d] - gspec.origin[d]) / dx)) + 1);
+  }
+  double x[3];
+  for (int k = lo[2]; k <= hi[2]; ++k)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i)
+        for (int c = 0; c < fill_ppc[2]; ++c)
+          for (int b = 0; b < fill_ppc[1]; ++b)
+            for (int a = 0; a < fill_ppc[0]; ++a) {
+              const int cell[3] = {i, j, k}, sub[3] = {a, b, c};
+              for (int d = 0; d < 3; ++d)
+                x[d] = gspec.origin[d] + cell[d] * dx + (sub[d] + 0.5) * spacing[d];
+              if (!region->match(x[0], x[1], x[2])) continue;
+              bool mine = true;
+              for (int d = 0; d < 3; ++d)
+                mine = mine && x[d] >= domain->sublo[d] && x[d] < domain->subhi[d];
+              if (!mine) continue;
+              atom->avec->create_atom(fill_type, x);
+              const int n = atom->nlocal - 1;
+              for (int m = 0; m < modify->nfix; ++m) {
+                Fix *f = modify->fix[m];
+                if (f && f->create_attribute && f != this) {
+                  f->pre_set_arrays();
+                  f->set_arrays(n);
+                }
+              }
+              double rho = eos.rho0, p = 0.0;
+              if (hydrostatic) {
+                p = std::max(0.0, eos.rho0 * hydro_g * (hydro_surface - x[hydro_axis]));
+                rho = eos.density(p);
+              }
+              atom->mask[n] |= groupbit;
+              atom->v[n][0] = atom->v[n][1] = atom->v[n][2] = 0.0;
+              // The point keeps the reference mass; a pre-compressed point is smaller.
+              atom->rmass[n] = eos.rho0 * vol;
+              atom->radius[n] = 0.5 * std::min(spacing[0], std::min(spacing[1], spacing[2]));
+              if (atom->density_flag && atom->density) atom->density[n] = eos.rho0;
+              double *s = pdata[n];
+              std::fill(s, s + NCOL, 0.0);
+              s[C_VOL] = atom->rmass[n] / rho;
+              s[C_RHO] = rho;
+              s[C_P] = p;
+              s[C_THETA] = 1.0;
+              s[C_FLAG] = 1.0;
+            }
+
+  bigint nnew = atom->nlocal - nlocal_before, nall = 0;
+  MPI_Allreduce(&nnew, &nall, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  if (nall == 0) error->all(FLERR, "Fix mpm/fluid: keyword 'fill' created no material points (region empty?)");
+  bigint nlocal = atom->nlocal;
+  MPI_Allreduce(&nlocal, &atom->natoms, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  atom->tag_extend();
+  if (atom->map_style) {
+    atom->nghost = 0;
+    atom->map_init();
+    atom->map_set();
+  }
+  point_mass_ref = eos.rho0 * vol;
+  filled = true;
+  if (comm->me == 0) {
+    std::ostringstream os;
+    os << "fix mpm/fluid: created " << nall << " material points (" << fill_ppc[0] << "x" << fill_ppc[1]
+       << "x" << fill_ppc[2] << " per cell of " << gspec.dx << "), grid " << gspec.ncell[0] << "x"
+       << gspec.ncell[1] << "x" << gspec.ncell[2] << " cells\n";
+    if (screen) fputs(os.str().c_str(), screen);
+    if (logfile) fputs(os.str().c_str(), logfile);
+  }
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixMpmFluid::init() {
+  if (!filled) error->all(FLERR, "Fix mpm/fluid: no material points; use keyword 'fill region-ID nx ny nz type T'");
+  // Material points must not be integrated twice.
+  for (int m = 0; m < modify->nfix; ++m) {
+    Fix *f = modify->fix[m];
+    if (f == this || !f->time_integrate) continue;
+    int clash = 0;
+    for (int i = 0; i < atom->nlocal; ++i)
+      if (is_point(i) && (atom->mask[i] & f->groupbit)) clash = 1;
+    int any = 0;
+    MPI_Allreduce(&clash, &any, 1, MPI_INT, MPI_MAX, world);
+    if (any) {
+      std::string msg = std::string("Fix mpm/fluid: fix ") + f->id + " (" + f->style +
+                        ") also integrates material points; restrict it to the grain group";
+      error->all(FLERR, msg.c_str());
+    }
+  }
+  int bad = 0;
+  for (int i = 0; i < atom->nlocal; ++i)
+    if (is_point(i) && pdata[i][C_FLAG] != 1.0) bad = 1;
+  int anybad = 0;
+  MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, world);
+  if (anybad)
+    error->all(FLERR, "Fix mpm/fluid: the fix group contains atoms that are not material points of this fix "
+                      "(use a group of the fill type only)");
+  vector_step = -1;
+}
+
+void FixMpmFluid::setup_grid() {
+  // Halo: support of the shape function plus the distance a point may travel
+  // before LIGGGHTS re-neighbours and migrates it (half the skin), rounded up.
+  const int halo = mpm::support(shape) + static_cast<int>(std::ceil(neighbor->skin / gspec.dx)) + 1;
+  grid.setup(gspec, world, domain->sublo, domain->subhi, halo);
+  g_p2g.assign(grid.size() * 7, 0.0);
+  g_vel.assign(grid.size() * 6, 0.0);
+  g_cell.assign(grid.size() * 4, 0.0);
+  if (musl) g_aux.assign(grid.size() * 3, 0.0);
+  grid_ready = true;
+}
+
+void FixMpmFluid::setup(int) {
+  setup_grid();
+  check_timestep(true);
+  if (out_every > 0 && update->ntimestep % out_every == 0) write_output();
+}
+
+/* ----------------------------------------------------------------------
+   stable time step: acoustic (CFL) and viscous limits (collective)
+------------------------------------------------------------------------- */
+
+double FixMpmFluid::stable_dt() {
+  double loc[2] = {0.0, eos.rho0};  // max |v|, max density
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const double *v = atom->v[i];
+    loc[0] = std::max(loc[0], std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    loc[1] = std::max(loc[1], pdata[i][C_RHO]);
+  }
+  double glob[2];
+  MPI_Allreduce(loc, glob, 2, MPI_DOUBLE, MPI_MAX, world);
+  // Sound speed: largest over the reference and the densest point (Tait stiffens).
+  const double c = std::sqrt(std::max(eos.sound_speed_sq(eos.rho0), eos.sound_speed_sq(glob[1])));
+  const double dt_ac = mpm::acoustic_dt_limit(cfl, gspec.dx, c, glob[0]);
+  const double dt_visc = mpm::viscous_dt_limit(gspec.dx, eos.rho0, viscosity, domain->dimension);
+  return std::min(dt_ac, dt_visc);
+}
+
+void FixMpmFluid::check_timestep(bool at_setup) {
+  dt_stable_last = stable_dt();
+  const double dt = update->dt;
+  if (!std::isfinite(dt_stable_last) || dt_stable_last <= 0.0)
+    error->all(FLERR, "Fix mpm/fluid: the fluid state is not finite (NaN velocity or density); "
+                      "the run was unstable before this check");
+  if (dt <= dt_stable_last) {
+    nsub_last = 1;
+    return;
+  }
+  if (!subcycle) {
+    std::ostringstream os;
+    os.precision(4);
+    os << "Fix mpm/fluid: timestep " << dt << " exceeds the largest stable time step " << dt_stable_last
+       << " (acoustic limit cfl*dx/(c+|v|max) with cfl = " << cfl << ", dx = " << gspec.dx
+       << ", c = " << std::sqrt(eos.sound_speed_sq(eos.rho0))
+       << ", or viscous limit dx^2 rho/(2 dim eta)); reduce the timestep to " << dt_stable_last
+       << " or use keyword 'subcycle yes'" << (at_setup ? "" : " (limit reached during the run)");
+    error->all(FLERR, os.str().c_str());
+  }
+  const int nsub = static_cast<int>(std::ceil(dt / dt_stable_last));
+  if (nsub > max_subcycle) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: 'subcycle yes' would need " << nsub << " sub-steps per timestep (more than "
+       << max_subcycle << "); reduce the timestep to at most " << max_subcycle * dt_stable_last;
+    error->all(FLERR, os.str().c_str());
+  }
+  if (at_setup && comm->me == 0 && nsub != nsub_last) {
+    std::ostringstream os;
+    os << "fix mpm/fluid: sub-cycling with " << nsub << " fluid sub-steps of " << dt / nsub
+       << " per timestep (stable limit " << dt_stable_last << ")\n";
+    if (screen) fputs(os.str().c_str(), screen);
+    if (logfile) fputs(os.str().c_str(), logfile);
+  }
+  nsub_last = nsub;
+}
+
+/* ----------------------------------------------------------------------
+   one LIGGGHTS time step: all external forces on the points (fix gravity,
+   fix addforce, ...) are in atom->f; the DEM integrator runs after us
+------------------------------------------------------------------------- */
+
+void FixMpmFluid::pre_final_integrate() {
+  if (!grid_ready) setup_grid();
+  if (gate.active && gate.release_time >= 0.0 && sim_time() >= gate.release_time - 0.5 * update->dt) {
+    gate.active = false;
+    if (comm->me == 0) {
+      std::ostringstream os;
+      os << "fix mpm/fluid: gate removed at time " << sim_time() << " (step " << update->ntimestep << ")\n";
+      if (screen) fputs(os.str().c_str(), screen);
+      if (logfile) fputs(os.str().c_str(), logfile);
+    }
+  }
+  check_timestep(false);
+  const double h = update->dt / nsub_last;
+  for (int s = 0; s < nsub_last; ++s) substep(h);
+  vector_step = -1;
+}
+
+void FixMpmFluid::substep(double h) {
+  compute_shapes();
+  particles_to_grid();
+  update_grid(h);
+  grid_to_particles(h);
+  if (musl) remap_velocity_musl();
+  update_stress(h);
+  advance_positions(h);
+}
+
+void FixMpmFluid::compute_shapes() {
+  const int nlocal = atom->nlocal;
+  if (static_cast<int>(shapes.size()) < nlocal) {
+    shapes.resize(nlocal);
+    vpic.resize(3 * static_cast<std::size_t>(nlocal));
+    velgrad.resize(9 * static_cast<std::size_t>(nlocal));
+  }
+  const int ns = mpm::support(shape);
+  double **x = atom->x;
+  const double inv = 1.0 / gspec.dx;
+  const mpm::IndexBox &pb = grid.patch();
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    PointShape &ps = shapes[i];
+    for (int d = 0; d < 3; ++d) {
+      const double xi = (x[i][d] - gspec.origin[d]) * inv;
+      if (!gspec.periodic[d] && (xi < 0.0 || xi > gspec.ncell[d])) {
+        std::ostringstream os;
+        os << "Fix mpm/fluid: material point " << atom->tag[i] << " at (" << x[i][0] << ", " << x[i][1]
+           << ", " << x[i][2] << ") left the grid in " << "xyz"[d] << " [" << gspec.origin[d] << ", "
+           << gspec.upper(d) << "] at step " << update->ntimestep
+           << " (enlarge 'grid' or check for an unstable run)";
+        fail_one(os.str());
+      }
+      mpm::Shape1D s;
+      mpm::shape_eval(shape, xi, s);
+      ps.base[d] = s.base;
+      for (int a = 0; a < 3; ++a) {
+        ps.w[d][a] = s.w[a];
+        ps.dw[d][a] = s.dw[a] * inv;
+      }
+      if (s.base < pb.lo[d] || s.base + ns - 1 > pb.hi[d]) {
+        std::ostringstream os;
+        os << "Fix mpm/fluid: material point " << atom->tag[i] << " at (" << x[i][0] << ", " << x[i][1]
+           << ", " << x[i][2] << ") is outside the grid patch of rank " << comm->me
+           << "; it moved too far between re-neighbourings (use neigh_modify every 1 check yes)";
+        fail_one(os.str());
+      }
+    }
+  }
+}
+
+// Loops over the nodes a point touches; fn(node index, w, grad w[3], offset (x_i - x_p)[3]).
+#define MPM_FOR_NODES(ps, xp, BODY)                                                     \
+  for (int c = 0; c < ns; ++c) {                                                        \
+    const int kk = ps.base[2] + c;                                                      \
+    for (int b = 0; b < ns; ++b) {                                                      \
+      const int jj = ps.base[1] + b;                                                    \
+      const double wyz = ps.w[1][b] * ps.w[2][c];                                       \
+      for (int a = 0; a < ns; ++a) {                                                    \
+        const int ii = ps.base[0] + a;                                                  \
+        const std::size_t n = grid.index(ii, jj, kk);                                   \
+        const double w = ps.w[0][a] * wyz;                                              \
+        const double gw[3] = {ps.dw[0][a] * wyz, ps.w[0][a] * ps.dw[1][b] * ps.w[2][c], \
+                              ps.w[0][a] * ps.w[1][b] * ps.dw[2][c]};                   \
+        const double off[3] = {gspec.origin[0] + ii * gspec.dx - xp[0],                 \
+                               gspec.origin[1] + jj * gspec.dx - xp[1],                 \
+                               gspec.origin[2] + kk * gspec.dx - xp[2]};                \
+        (void)w;                                                                        \
+        (void)gw;                                                                       \
+        (void)off;                                                                      \
+        BODY                                                                            \
+      }                                                                                 \
+    }                                                                                   \
+  }
+
+/* particles to grid: mass (8-19), momentum (8-10), internal force (8-24),
+   external forces (gravity (8-18) and whatever LIGGGHTS fixes add) */
+void FixMpmFluid::particles_to_grid() {
+  std::fill(g_p2g.begin(), g_p2g.end(), 0.0);
+  const int ns = mpm::support(shape);
+  const int nlocal = atom->nlocal;
+  double **x = atom->x, **v = atom->v, **f = atom->f;
+  double *rmass = atom->rmass;
+  const bool affine = transfer == TR_APIC;
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const PointShape &ps = shapes[i];
+    const double *s = pdata[i];
+    const double m = rmass[i], V = s[C_VOL], p = s[C_P];
+    const double *t = s + C_TAU;
+    // sigma = -p I + tau (symmetric), Voigt xx yy zz yz xz xy
+    const double sig[3][3] = {{t[0] - p, t[5], t[4]}, {t[5], t[1] - p, t[3]}, {t[4], t[3], t[2] - p}};
+    const double *C = s + C_AFF;
+    const double *xp = x[i];
+    MPM_FOR_NODES(ps, xp, {
+      double *g = &g_p2g[7 * n];
+      const double wm = w * m;
+      g[0] += wm;
+      for (int d = 0; d < 3; ++d) {
+        double vd = v[i][d];
+        if (affine) vd += C[3 * d] * off[0] + C[3 * d + 1] * off[1] + C[3 * d + 2] * off[2];
+        g[1 + d] += wm * vd;
+        g[4 + d] += w * f[i][d] - V * (sig[d][0] * gw[0] + sig[d][1] * gw[1] + sig[d][2] * gw[2]);
+      }
+    })
+  }
+  grid.reverse_sum(g_p2g.data(), 7);
+}
+
+// Wall, gate: velocity v of node (i,j,k) after the momentum update.
+void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k) {
+  const int idx[3] = {i, j, k};
+  for (int d = 0; d < 3; ++d) {
+    if (gspec.periodic[d]) continue;
+    int fc = -1;
+    if (idx[d] <= 0)
+      fc = 2 * d;
+    else if (idx[d] >= gspec.ncell[d])
+      fc = 2 * d + 1;
+    if (fc < 0) continue;
+    // normal component: no penetration; tangential: keep (1 - sticky) of it
+    const double keep = 1.0 - face[fc].sticky;
+    for (int e = 0; e < 3; ++e) vel[e] = (e == d) ? 0.0 : keep * vel[e];
+  }
+  if (gate.active) {
+    const int d = gate.dim;
+    const double xn = gspec.origin[d] + idx[d] * gspec.dx;
+    if (gate.fluid_below && xn >= gate.pos - 1e-9 * gspec.dx) vel[d] = std::min(vel[d], 0.0);
+    if (!gate.fluid_below && xn <= gate.pos + 1e-9 * gspec.dx) vel[d] = std::max(vel[d], 0.0);
+  }
+}
+
+/* grid momentum update (8-35), velocity (8-36), boundary conditions */
+void FixMpmFluid::update_grid(double h) {
+  const double mmin = mass_threshold * point_mass_ref;
+  const mpm::IndexBox &ob = grid.owned();
+  for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
+    for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
+      for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) {
+        const std::size_t n = grid.index(i, j, k);
+        const double *g = &g_p2g[7 * n];
+        double *gv = &g_vel[6 * n];
+        if (g[0] <= mmin || g[0] <= 0.0) {
+          // Nearly empty node at the free surface: its velocity would be a
+          // ratio of two round-off-sized numbers; it carries no information.
+          for (int c = 0; c < 6; ++c) gv[c] = 0.0;
+          continue;
+        }
+        const double inv = 1.0 / g[0];
+        double vnew[3];
+        for (int d = 0; d < 3; ++d) {
+          gv[3 + d] = g[1 + d] * inv;
+          // damping is implicit in time so that any rate is stable
+          vnew[d] = (gv[3 + d] + h * g[4 + d] * inv) / (1.0 + h * damping);
+        }
+        apply_grid_bc(vnew, i, j, k);
+        for (int d = 0; d < 3; ++d) gv[d] = vnew[d];
+      }
+  grid.forward(g_vel.data(), 6);
+}
+
+/* grid to particles: velocity (8-37)/(8-40), affine velocity, velocity gradient */
+void FixMpmFluid::grid_to_particles(double) {
+  const int ns = mpm::support(shape);
+  const int nlocal = atom->nlocal;
+  double **x = atom->x, **v = atom->v;
+  const double dinv = mpm::apic_dinv_bspline2() / (gspec.dx * gspec.dx);
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const PointShape &ps = shapes[i];
+    double *s = pdata[i];
+    const double *xp = x[i];
+    double vp[3] = {0, 0, 0}, dv[3] = {0, 0, 0}, L[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0},
+           B[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    MPM_FOR_NODES(ps, xp, {
+      const double *gv = &g_vel[6 * n];
+      for (int d = 0; d < 3; ++d) {
+        vp[d] += w * gv[d];
+        dv[d] += w * (gv[d] - gv[3 + d]);
+        for (int e = 0; e < 3; ++e) {
+          L[3 * d + e] += gv[d] * gw[e];
+          B[3 * d + e] += w * gv[d] * off[e];
+        }
+      }
+    })
+    for (int d = 0; d < 3; ++d) vpic[3 * i + d] = vp[d];
+    if (transfer == TR_FLIP) {
+      for (int d = 0; d < 3; ++d) v[i][d] = flip_alpha * (v[i][d] + dv[d]) + (1.0 - flip_alpha) * vp[d];
+    } else {
+      for (int d = 0; d < 3; ++d) v[i][d] = vp[d];
+    }
+    // Affine field: B D^-1 for the quadratic B-spline (exact inertia), the
+    // velocity gradient for linear shape functions.
+    if (transfer == TR_APIC && shape == mpm::ShapeKind::QuadraticBSpline)
+      for (int c = 0; c < 9; ++c) s[C_AFF + c] = B[c] * dinv;
+    else
+      for (int c = 0; c < 9; ++c) s[C_AFF + c] = L[c];
+    if (!(std::isfinite(v[i][0]) && std::isfinite(v[i][1]) && std::isfinite(v[i][2]))) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: velocity of material point " << atom->tag[i] << " is not finite at step "
+         << update->ntimestep << "; the fluid became unstable (reduce the timestep or the bulk modulus)";
+      fail_one(os.str());
+    }
+    // velocity gradient for the stress update (USL; MUSL recomputes it)
+    std::copy(L, L + 9, &velgrad[9 * static_cast<std::size_t>(i)]);
+  }
+}
+
+/* MUSL (Buzzi et al. 2008, text after (8-41)): map the updated point
+   momentum back to the grid and take the velocity gradient for the stress
+   update from it, still at the positions of the start of the step. */
+void FixMpmFluid::remap_velocity_musl() {
+  std::fill(g_aux.begin(), g_aux.end(), 0.0);
+  const int ns = mpm::support(shape);
+  const int nlocal = atom->nlocal;
+  double **x = atom->x, **v = atom->v;
+  double *rmass = atom->rmass;
+  const bool affine = transfer == TR_APIC;
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const PointShape &ps = shapes[i];
+    const double *C = pdata[i] + C_AFF;
+    const double *xp = x[i];
+    const double m = rmass[i];
+    MPM_FOR_NODES(ps, xp, {
+      double *g = &g_aux[3 * n];
+      for (int d = 0; d < 3; ++d) {
+        double vd = v[i][d];
+        if (affine) vd += C[3 * d] * off[0] + C[3 * d + 1] * off[1] + C[3 * d + 2] * off[2];
+        g[d] += w * m * vd;
+      }
+    })
+  }
+  grid.reverse_sum(g_aux.data(), 3);
+  const double mmin = mass_threshold * point_mass_ref;
+  const mpm::IndexBox &ob = grid.owned();
+  for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
+    for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
+      for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) {
+        const std::size_t n = grid.index(i, j, k);
+        const double m = g_p2g[7 * n];
+        double *g = &g_aux[3 * n];
+        if (m <= mmin || m <= 0.0) {
+          g[0] = g[1] = g[2] = 0.0;
+          continue;
+        }
+        for (int d = 0; d < 3; ++d) g[d] /= m;
+        apply_grid_bc(g, i, j, k);
+      }
+  grid.forward(g_aux.data(), 3);
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const PointShape &ps = shapes[i];
+    const double *xp = x[i];
+    double *L = &velgrad[9 * static_cast<std::size_t>(i)];
+    std::fill(L, L + 9, 0.0);
+    MPM_FOR_NODES(ps, xp, {
+      const double *g = &g_aux[3 * n];
+      for (int d = 0; d < 3; ++d)
+        for (int e = 0; e < 3; ++e) L[3 * d + e] += g[d] * gw[e];
+    })
+  }
+}
+
+/* Continuity (7-21) as a volume update, equation of state (7-23) or Tait,
+   Navier-Poisson (7-24). Anti-locking: the dilatation rate is averaged over
+   each grid cell and the cell's pressure follows from the cell's mean
+   density, so all points of a cell carry one pressure (Mast et al. 2012). */
+void FixMpmFluid::update_stress(double h) {
+  const int nlocal = atom->nlocal;
+  double **x = atom->x;
+  double *rmass = atom->rmass;
+  const double inv = 1.0 / gspec.dx;
+  auto cell_node = [&](int i) {
+    int c[3];
+    for (int d = 0; d < 3; ++d) c[d] = static_cast<int>(std::floor((x[i][d] - gspec.origin[d]) * inv));
+    for (int d = 0; d < 3; ++d)
+      if (!gspec.periodic[d]) c[d] = std::min(std::max(c[d], 0), gspec.ncell[d] - 1);
+    return grid.index(c[0], c[1], c[2]);
+  };
+  if (antilock) {
+    std::fill(g_cell.begin(), g_cell.end(), 0.0);
+    for (int i = 0; i < nlocal; ++i) {
+      if (!is_point(i)) continue;
+      const double *s = pdata[i];
+      const double *L = &velgrad[9 * static_cast<std::size_t>(i)];
+      double *c = &g_cell[4 * cell_node(i)];
+      const double V = s[C_VOL];
+      c[0] += V;
+      c[1] += V * (L[0] + L[4] + L[8]);
+      c[2] += s[C_THETA] * V;
+      c[3] += rmass[i];
+    }
+    grid.reverse_sum(g_cell.data(), 4);
+    grid.forward(g_cell.data(), 4);
+  }
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    double *s = pdata[i];
+    const double *L = &velgrad[9 * static_cast<std::size_t>(i)];
+    double div = L[0] + L[4] + L[8];
+    double p;
+    if (antilock) {
+      const double *c = &g_cell[4 * cell_node(i)];
+      div = c[1] / c[0];
+      const double rho_cell = c[3] / (c[2] * (1.0 + h * div));
+      p = eos.pressure(rho_cell);
+    }
+    const double J = 1.0 + h * div;
+    s[C_VOL] *= J;
+    s[C_RHO] = rmass[i] / (s[C_THETA] * s[C_VOL]);
+    if (!antilock) p = eos.pressure(s[C_RHO]);
+    if (!(J > 0.0) || !std::isfinite(p)) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: material point " << atom->tag[i] << " was compressed to a non-positive volume at step "
+         << update->ntimestep << "; the fluid became unstable (reduce the timestep)";
+      fail_one(os.str());
+    }
+    s[C_P] = p;
+    const double Lm[3][3] = {{L[0], L[1], L[2]}, {L[3], L[4], L[5]}, {L[6], L[7], L[8]}};
+    mpm::newtonian_deviatoric_stress(viscosity, Lm, s + C_TAU);
+  }
+}
+
+/* position update (8-41) with the grid velocity; a point that crossed a wall
+   (or the closed gate) by less than a cell is put back on the fluid side */
+void FixMpmFluid::advance_positions(double h) {
+  const int nlocal = atom->nlocal;
+  double **x = atom->x, **v = atom->v;
+  const double eps = 1e-6 * gspec.dx;
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    for (int d = 0; d < 3; ++d) x[i][d] += h * vpic[3 * i + d];
+    for (int d = 0; d < 3; ++d) {
+      if (gspec.periodic[d]) continue;
+      const double lo = gspec.origin[d], hi = gspec.upper(d);
+      if (x[i][d] < lo || x[i][d] > hi) {
+        if (x[i][d] < lo - gspec.dx || x[i][d] > hi + gspec.dx) continue;  // compute_shapes reports it
+        x[i][d] = x[i][d] < lo ? lo + eps : hi - eps;
+        v[i][d] = 0.0;
+        n_clamped += 1.0;
+      }
+    }
+    if (gate.active) {
+      const int d = gate.dim;
+      if (gate.fluid_below && x[i][d] > gate.pos) {
+        x[i][d] = gate.pos - eps;
+        v[i][d] = std::min(v[i][d], 0.0);
+        n_clamped += 1.0;
+      } else if (!gate.fluid_below && x[i][d] < gate.pos) {
+        x[i][d] = gate.pos + eps;
+        v[i][d] = std::max(v[i][d], 0.0);
+        n_clamped += 1.0;
+      }
+    }
+  }
+}
+
+/* ----------------------------------------------------------------------
+   global outputs f_ID[1..10]
+------------------------------------------------------------------------- */
+
+void FixMpmFluid::compute_outputs() {
+  const int nlocal = atom->nlocal;
+  double **x = atom->x, **v = atom->v;
+  double *rmass = atom->rmass;
+  double sum[4] = {0, 0, 0, n_clamped};  // mass, kinetic energy, points, clamped
+  double mx[4] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};  // |v|max, front, height, p max
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const double v2 = v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2];
+    sum[0] += rmass[i];
+    sum[1] += 0.5 * rmass[i] * v2;
+    sum[2] += 1.0;
+    mx[0] = std::max(mx[0], std::sqrt(v2));
+    mx[1] = std::max(mx[1], x[i][front_axis] + 0.5 * spacing[front_axis]);
+    if (std::fabs(x[i][wall_axis] - wall_pos) < gspec.dx)
+      mx[2] = std::max(mx[2], x[i][height_axis] + 0.5 * spacing[height_axis]);
+    mx[3] = std::max(mx[3], pdata[i][C_P]);
+  }
+  double gsum[4], gmx[4];
+  MPI_Allreduce(sum, gsum, 4, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(mx, gmx, 4, MPI_DOUBLE, MPI_MAX, world);
+  vector_cache[0] = gsum[0];
+  vector_cache[1] = gsum[1];
+  vector_cache[2] = gmx[0];
+  vector_cache[3] = std::isfinite(gmx[1]) ? gmx[1] : 0.0;
+  vector_cache[4] = std::isfinite(gmx[2]) ? gmx[2] - gspec.origin[height_axis] : 0.0;
+  vector_cache[5] = nsub_last;
+  vector_cache[6] = dt_stable_last;
+  vector_cache[7] = gsum[3];
+  vector_cache[8] = gsum[2];
+  vector_cache[9] = std::isfinite(gmx[3]) ? gmx[3] : 0.0;
+  vector_step = update->ntimestep;
+}
+
+double FixMpmFluid::compute_vector(int n) {
+  if (n < 0 || n >= size_vector) return 0.0;
+  if (vector_step != update->ntimestep) compute_outputs();
+  return vector_cache[n];
+}
+
+int FixMpmFluid::modify_param(int narg, char **arg) {
+  if (strcmp(arg[0], "gate") == 0) {
+    if (narg < 2 || strcmp(arg[1], "off") != 0) bad_arg("fix_modify gate", "'off'", narg < 2 ? nullptr : arg[1]);
+    gate.active = false;
+    return 2;
+  }
+  if (strcmp(arg[0], "damping") == 0) {
+    if (narg < 2 || !parse_double(arg[1], damping) || damping < 0.0)
+      bad_arg("fix_modify damping", "a damping rate (1/time) >= 0", narg < 2 ? nullptr : arg[1]);
+    return 2;
+  }
+  if (strcmp(arg[0], "subcycle") == 0) {
+    if (narg < 2 || !parse_yesno(arg[1], subcycle)) bad_arg("fix_modify subcycle", "'yes' or 'no'", narg < 2 ? nullptr : arg[1]);
+    return 2;
+  }
+  if (strcmp(arg[0], "cfl") == 0) {
+    if (narg < 2 || !parse_double(arg[1], cfl) || cfl <= 0.0 || cfl > 1.0)
+      bad_arg("fix_modify cfl", "a CFL number in (0,1]", narg < 2 ? nullptr : arg[1]);
+    return 2;
+  }
+  if (strcmp(arg[0], "boundary") == 0) {
+    if (narg < 3) bad_arg("fix_modify boundary", "a face and 'noslip', 'freeslip' or 'partial f'", nullptr);
+    int iarg = 0;  // arg[0] is the keyword, as in the fix command
+    parse_face(arg[1], arg[2], narg, arg, iarg);
+    return iarg;
+  }
+  return 0;
+}
+
+/* ----------------------------------------------------------------------
+   output: points (and grid) to HDF5 + XDMF, gathered on rank 0
+------------------------------------------------------------------------- */
+
+void FixMpmFluid::end_of_step() {
+  if (out_every > 0 && update->ntimestep % out_every == 0) write_output();
+}
+
+void FixMpmFluid::write_output() {
+  if (last_output_step == update->ntimestep) return;
+  last_output_step = update->ntimestep;
+
+  struct Spec { std::string name; int ncomp; };
+  std::vector<Spec> fields;
+  for (const auto &f : out_point_fields) {
+    int nc = 1;
+    if (f == "v") nc = 3;
+    else if (f == "tau") nc = 6;
+    else if (f == "affine") nc = 9;
+    fields.push_back({f, nc});
+  }
+  int stride = 3;
+  for (const auto &f : fields) stride += f.ncomp;
+
+  std::vector<double> buf;
+  const int nlocal = atom->nlocal;
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const double *s = pdata[i];
+    for (int d = 0; d < 3; ++d) buf.push_back(atom->x[i][d]);
+    for (const auto &f : fields) {
+      if (f.name == "v") for (int d = 0; d < 3; ++d) buf.push_back(atom->v[i][d]);
+      else if (f.name == "p") buf.push_back(s[C_P]);
+      else if (f.name == "rho") buf.push_back(s[C_RHO]);
+      else if (f.name == "vol") buf.push_back(s[C_VOL]);
+      else if (f.name == "tau") for (int c = 0; c < 6; ++c) buf.push_back(s[C_TAU + c]);
+      else if (f.name == "theta") buf.push_back(s[C_THETA]);
+      else if (f.name == "id") buf.push_back(static_cast<double>(atom->tag[i]));
+      else if (f.name == "type") buf.push_back(static_cast<double>(atom->type[i]));
+      else if (f.name == "affine") for (int c = 0; c < 9; ++c) buf.push_back(s[C_AFF + c]);
+      else if (f.name == "mass") buf.push_back(atom->rmass[i]);
+    }
+  }
+  int nmine = static_cast<int>(buf.size());
+  std::vector<int> counts(comm->nprocs), displs(comm->nprocs, 0);
+  MPI_Gather(&nmine, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, world);
+  std::vector<double> all;
+  if (comm->me == 0) {
+    for (int q = 1; q < comm->nprocs; ++q) displs[q] = displs[q - 1] + counts[q - 1];
+    all.resize(displs.back() + counts.back());
+  }
+  MPI_Gatherv(buf.data(), nmine, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, world);
+
+  // Grid: owned real nodes (not the padding) as (global index, values).
+  mpm::GridBlock gb;
+  std::vector<double> gall;
+  const bool want_grid = !out_grid_fields.empty();
+  int gstride = 1;
+  for (const auto &f : out_grid_fields) gstride += (f == "v") ? 3 : 1;
+  if (want_grid) {
+    std::vector<double> gbuf;
+    int nn[3];
+    for (int d = 0; d < 3; ++d) nn[d] = gspec.periodic[d] ? gspec.ncell[d] : gspec.ncell[d] + 1;
+    const mpm::IndexBox &ob = grid.owned();
+    for (int k = std::max(ob.lo[2], 0); k <= std::min(ob.hi[2], nn[2] - 1); ++k)
+      for (int j = std::max(ob.lo[1], 0); j <= std::min(ob.hi[1], nn[1] - 1); ++j)
+        for (int i = std::max(ob.lo[0], 0); i <= std::min(ob.hi[0], nn[0] - 1); ++i) {
+          const std::size_t n = grid.index(i, j, k);
+          gbuf.push_back(static_cast<double>((static_cast<long>(k) * nn[1] + j) * nn[0] + i));
+          for (const auto &f : out_grid_fields) {
+            if (f == "mass") gbuf.push_back(g_p2g[7 * n]);
+            else for (int d = 0; d < 3; ++d) gbuf.push_back(g_vel[6 * n + d]);
+          }
+        }
+    int gm = static_cast<int>(gbuf.size());
+    std::vector<int> gc(comm->nprocs), gd(comm->nprocs, 0);
+    MPI_Gather(&gm, 1, MPI_INT, gc.data(), 1, MPI_INT, 0, world);
+    if (comm->me == 0) {
+      for (int q = 1; q < comm->nprocs; ++q) gd[q] = gd[q - 1] + gc[q - 1];
+      gall.resize(gd.back() + gc.back());
+    }
+    MPI_Gatherv(gbuf.data(), gm, MPI_DOUBLE, gall.data(), gc.data(), gd.data(), MPI_DOUBLE, 0, world);
+    for (int d = 0; d < 3; ++d) {
+      gb.n[d] = nn[d];
+      gb.origin[d] = gspec.origin[d];
+      gb.spacing[d] = gspec.dx;
+    }
+  }
+
+  if (comm->me != 0) return;
+  mpm::PointBlock pb;
+  pb.n = all.size() / stride;
+  pb.xyz.resize(3 * pb.n);
+  for (const auto &f : fields) pb.fields.push_back({f.name, f.ncomp, std::vector<double>(pb.n * f.ncomp)});
+  for (std::size_t p = 0; p < pb.n; ++p) {
+    const double *r = &all[p * stride];
+    for (int d = 0; d < 3; ++d) pb.xyz[3 * p + d] = r[d];
+    int off = 3;
+    for (std::size_t fi = 0; fi < fields.size(); ++fi) {
+      for (int c = 0; c < fields[fi].ncomp; ++c) pb.fields[fi].data[p * fields[fi].ncomp + c] = r[off + c];
+      off += fields[fi].ncomp;
+    }
+  }
+  if (want_grid) {
+    const std::size_t nn = std::size_t(gb.n[0]) * gb.n[1] * gb.n[2];
+    for (const auto &f : out_grid_fields) gb.fields.push_back({f, f == "v" ? 3 : 1, std::vector<double>(nn * (f == "v" ? 3 : 1), 0.0)});
+    for (std::size_t r = 0; r + gstride <= gall.size(); r += gstride) {
+      const std::size_t n = static_cast<std::size_t>(gall[r]);
+      int off = 1;
+      for (auto &fl : gb.fields) {
+        for (int c = 0; c < fl.ncomp; ++c) fl.data[n * fl.ncomp + c] = gall[r + off + c];
+        off += fl.ncomp;
+      }
+    }
+  }
+  try {
+    if (!series) series.reset(new mpm::Hdf5Series(out_prefix));
+    series->write_step(static_cast<long>(update->ntimestep), sim_time(), pb, want_grid ? &gb : nullptr);
+  } catch (const std::exception &e) {
+    std::string msg = std::string("Fix mpm/fluid: keyword 'output': ") + e.what();
+    fail_one(msg);
+  }
+}
+
+/* ----------------------------------------------------------------------
+   per-point state: LIGGGHTS calls these when atoms grow, move between
+   ranks or go to/come from a restart file
+------------------------------------------------------------------------- */
+
+void FixMpmFluid::grow_arrays(int nmax) {
+  memory->grow(pdata, nmax, NCOL, "mpm/fluid:pdata");
+  for (int i = pdata_rows; i < nmax; ++i) std::fill(pdata[i], pdata[i] + NCOL, 0.0);
+  pdata_rows = std::max(pdata_rows, nmax);
+  array_atom = pdata;
+}
+
+void FixMpmFluid::copy_arrays(int i, int j, int) {
+  std::copy(pdata[i], pdata[i] + NCOL, pdata[j]);
+}
+
+void FixMpmFluid::set_arrays(int i) { std::fill(pdata[i], pdata[i] + NCOL, 0.0); }
+
+int FixMpmFluid::pack_exchange(int i, double *buf) {
+  std::copy(pdata[i], pdata[i] + NCOL, buf);
+  return NCOL;
+}
+
+int FixMpmFluid::unpack_exchange(int nlocal, double *buf) {
+  std::copy(buf, buf + NCOL, pdata[nlocal]);
+  return NCOL;
+}
+
+int FixMpmFluid::pack_restart(int i, double *buf) {
+  buf[0] = NCOL + 1;
+  std::copy(pdata[i], pdata[i] + NCOL, buf + 1);
+  return NCOL + 1;
+}
+
+void FixMpmFluid::unpack_restart(int nlocal, int nth) {
+  double **extra = atom->extra;
+  int m = 0;
+  for (int i = 0; i < nth; ++i) m += static_cast<int>(extra[nlocal][m]);
+  std::copy(&extra[nlocal][m + 1], &extra[nlocal][m + 1] + NCOL, pdata[nlocal]);
+}
+
+int FixMpmFluid::size_restart(int) { return NCOL + 1; }
+int FixMpmFluid::maxsize_restart() { return NCOL + 1; }
+
+namespace {
+enum { R_FILLED, R_PMASS, R_SP0, R_SP1, R_SP2, R_CLAMPED, R_GATE, R_NSUB, R_COUNT };
+}
+
+void FixMpmFluid::write_restart(FILE *fp) {
+  double list[R_COUNT];
+  list[R_FILLED] = filled ? 1.0 : 0.0;
+  list[R_PMASS] = point_mass_ref;
+  for (int d = 0; d < 3; ++d) list[R_SP0 + d] = spacing[d];
+  list[R_CLAMPED] = n_clamped;
+  list[R_GATE] = gate.active ? 1.0 : 0.0;
+  list[R_NSUB] = nsub_last;
+  if (comm->me == 0) {
+    int size = R_COUNT * sizeof(double);
+    fwrite(&size, sizeof(int), 1, fp);
+    fwrite(list, sizeof(double), R_COUNT, fp);
+  }
+}
+
+void FixMpmFluid::restart(char *buf) {
+  const double *list = reinterpret_cast<const double *>(buf);
+  filled = list[R_FILLED] != 0.0;
+  point_mass_ref = list[R_PMASS];
+  for (int d = 0; d < 3; ++d) spacing[d] = list[R_SP0 + d];
+  n_clamped = list[R_CLAMPED];
+  // a gate removed before the restart stays removed
+  if (list[R_GATE] == 0.0) gate.active = false;
+  nsub_last = static_cast<int>(list[R_NSUB]);
+}
+
+double FixMpmFluid::memory_usage() {
+  double bytes = static_cast<double>(atom->nmax) * NCOL * sizeof(double);
+  bytes += (g_p2g.size() + g_vel.size() + g_cell.size() + g_aux.size()) * sizeof(double);
+  bytes += shapes.size() * sizeof(PointShape) + (vpic.size() + velgrad.size()) * sizeof(double);
+  return bytes;
+}

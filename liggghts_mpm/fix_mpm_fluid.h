@@ -1,0 +1,176 @@
+/* fix mpm/fluid: a Material Point Method fluid (dissertation chapters 7-8)
+   whose material points are LIGGGHTS atoms of their own group. LIGGGHTS
+   migrates them between ranks, writes them to restart and dump files and
+   keeps them in regions; this fix owns the background grid and the per-point
+   state (volume, density, pressure, deviatoric stress, affine velocity).
+   See docs/fix_mpm_fluid.md and docs/design.md. */
+
+#ifdef FIX_CLASS
+
+FixStyle(mpm/fluid,FixMpmFluid)
+
+#else
+
+#ifndef LMP_FIX_MPM_FLUID_H
+#define LMP_FIX_MPM_FLUID_H
+
+#include "fix.h"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mpm/fluid_laws.h"
+#include "mpm/grid.h"
+#include "mpm/shape_functions.h"
+
+namespace mpm { class Hdf5Series; }
+
+namespace LAMMPS_NS {
+
+class FixMpmFluid : public Fix {
+ public:
+  // Columns of the per-point state (also the fix's per-atom array, 1-based in f_ID[n]).
+  enum Column {
+    C_VOL = 0,     // current volume of the point, m3
+    C_RHO = 1,     // fluid (micro) density, kg/m3
+    C_P = 2,       // pressure, Pa
+    C_TAU = 3,     // deviatoric stress xx yy zz yz xz xy (6), Pa
+    C_AFF = 9,     // APIC affine velocity / velocity gradient, row-major (9), 1/s
+    C_THETA = 18,  // fluid volume fraction at the point
+    C_FLAG = 19,   // 1 for a point set up by this fix
+    NCOL = 20
+  };
+
+  FixMpmFluid(class LAMMPS *, int, char **);
+  ~FixMpmFluid() override;
+  int setmask() override;
+  void post_create() override;
+  void init() override;
+  void setup(int) override;
+  void pre_final_integrate() override;
+  void end_of_step() override;
+
+  double compute_vector(int) override;
+  int modify_param(int, char **) override;
+
+  void grow_arrays(int) override;
+  void copy_arrays(int, int, int) override;
+  void set_arrays(int) override;
+  int pack_exchange(int, double *) override;
+  int unpack_exchange(int, double *) override;
+  int pack_restart(int, double *) override;
+  void unpack_restart(int, int) override;
+  int size_restart(int) override;
+  int maxsize_restart() override;
+  void write_restart(FILE *) override;
+  void restart(char *) override;
+  double memory_usage() override;
+
+  // Time-step limits of the current state (collective), for reports and tests.
+  double stable_dt();
+
+ private:
+  enum BcKind { BC_NOSLIP, BC_FREESLIP, BC_PARTIAL };
+  struct Face { int kind = BC_NOSLIP; double sticky = 1.0; };
+  struct Gate {
+    bool active = false;
+    int dim = 0;
+    double pos = 0.0;
+    bool fluid_below = true;   // fluid held on the low-coordinate side
+    double release_time = -1;  // simulation time of removal; < 0 = only by fix_modify
+  };
+  enum Transfer { TR_APIC, TR_PIC, TR_FLIP };
+
+  // settings
+  mpm::GridSpec gspec;
+  bool grid_bounds_given = false;
+  double gbounds[6];
+  mpm::ShapeKind shape = mpm::ShapeKind::QuadraticBSpline;
+  mpm::Eos eos;
+  double viscosity = 0.0;
+  Transfer transfer = TR_FLIP;  // the text's MUSL: FLIP velocity (8-40), grid velocity for x (8-41)
+  double flip_alpha = 1.0;      // FLIP fraction of a FLIP/PIC blend
+  bool musl = true;
+  bool antilock = true;
+  Face face[6];
+  Gate gate;
+  double damping = 0.0;
+  double cfl = 0.5;
+  bool subcycle = false;
+  int max_subcycle = 1000;
+  double mass_threshold = 1e-5;
+  int front_axis = 0;
+  int height_axis = 2, wall_axis = 0;
+  double wall_pos = 0.0;
+  bool wall_pos_given = false;
+
+  // filling
+  std::string fill_region;
+  int fill_ppc[3] = {2, 2, 2};
+  int fill_type = 1;
+  bool hydrostatic = false;
+  int hydro_axis = 2;
+  double hydro_surface = 0.0, hydro_g = 9.81;
+
+  // output
+  int out_every = 0;
+  std::string out_prefix;
+  std::vector<std::string> out_point_fields, out_grid_fields;
+  std::unique_ptr<mpm::Hdf5Series> series;
+  bigint last_output_step = -1;
+
+  // state (restart)
+  bool filled = false;
+  double point_mass_ref = 0.0;   // typical point mass, for the nodal mass threshold
+  double spacing[3] = {0, 0, 0}; // initial point spacing per direction
+  double n_clamped = 0;          // points put back inside a wall (cumulative)
+
+  // per-point state
+  double **pdata = nullptr;
+  int pdata_rows = 0;
+
+  // grid work arrays
+  mpm::LocalGrid grid;
+  bool grid_ready = false;
+  std::vector<double> g_p2g;    // per node: m, mv(3), f(3)
+  std::vector<double> g_vel;    // per node: v_new(3), v_old(3)
+  std::vector<double> g_cell;   // per cell (keyed by its low node): V, V div, theta V, m
+  std::vector<double> g_aux;    // per node: remapped momentum (MUSL)
+  struct PointShape { int base[3]; double w[3][3]; double dw[3][3]; };
+  std::vector<PointShape> shapes;
+  std::vector<double> vpic;     // grid (PIC) velocity at the points, for the position update
+  std::vector<double> velgrad;  // velocity gradient at the points, for the stress update
+  int nsub_last = 1;
+  double dt_stable_last = 0.0;
+
+  // cached global outputs
+  bigint vector_step = -1;
+  double vector_cache[12];
+
+  void parse_args(int narg, char **arg);
+  void parse_face(const char *name, const char *kind, int narg, char **arg, int &iarg);
+  void fill_points();
+  void setup_grid();
+  void check_timestep(bool at_setup);
+  void substep(double h);
+  void compute_shapes();
+  void particles_to_grid();
+  void update_grid(double h);
+  void apply_grid_bc(double *v, int nodeidx_i, int nodeidx_j, int nodeidx_k);
+  void grid_to_particles(double h);
+  void remap_velocity_musl();
+  void update_stress(double h);
+  void advance_positions(double h);
+  void write_output();
+  void compute_outputs();
+  bool is_point(int i) const;
+  double sim_time() const;
+  [[noreturn]] void fail_one(const std::string &msg);
+  [[noreturn]] void bad_arg(const char *keyword, const char *expected, const char *given);
+};
+
+}  // namespace LAMMPS_NS
+
+#endif
+#endif

@@ -1,0 +1,237 @@
+#include "mpm/grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace mpm {
+
+namespace {
+
+// First node index whose position is >= x (positions i*dx from the origin).
+int first_node_at_or_above(const GridSpec &g, int d, double x) {
+  const double xi = (x - g.origin[d]) / g.dx;
+  return static_cast<int>(std::ceil(xi - 1e-9));
+}
+
+IndexBox intersect(const IndexBox &a, const IndexBox &b) {
+  IndexBox r;
+  for (int d = 0; d < 3; ++d) {
+    r.lo[d] = std::max(a.lo[d], b.lo[d]);
+    r.hi[d] = std::min(a.hi[d], b.hi[d]);
+  }
+  return r;
+}
+
+IndexBox shifted(const IndexBox &a, const int s[3]) {
+  IndexBox r = a;
+  for (int d = 0; d < 3; ++d) {
+    r.lo[d] += s[d];
+    r.hi[d] += s[d];
+  }
+  return r;
+}
+
+// Periodic images k*ncell (k in a range) that can bring box b over box a.
+void image_range(const GridSpec &g, const IndexBox &a, const IndexBox &b, int kmin[3], int kmax[3]) {
+  for (int d = 0; d < 3; ++d) {
+    if (!g.periodic[d]) {
+      kmin[d] = kmax[d] = 0;
+      continue;
+    }
+    const int n = g.ncell[d];
+    kmin[d] = static_cast<int>(std::floor(double(a.lo[d] - b.hi[d]) / n));
+    kmax[d] = static_cast<int>(std::ceil(double(a.hi[d] - b.lo[d]) / n));
+  }
+}
+
+}  // namespace
+
+IndexBox owned_box(const GridSpec &g, const double sublo[3], const double subhi[3]) {
+  IndexBox b;
+  for (int d = 0; d < 3; ++d) {
+    const double glo = g.origin[d], ghi = g.upper(d);
+    const double tol = 1e-9 * g.dx;
+    b.lo[d] = (sublo[d] <= glo + tol) ? g.node_lo(d) : first_node_at_or_above(g, d, sublo[d]);
+    b.hi[d] = (subhi[d] >= ghi - tol) ? g.node_hi(d) : first_node_at_or_above(g, d, subhi[d]) - 1;
+    if (subhi[d] <= glo + tol || sublo[d] >= ghi - tol) b.hi[d] = b.lo[d] - 1;  // no overlap
+    if (g.periodic[d]) {
+      b.lo[d] = std::max(b.lo[d], 0);
+      b.hi[d] = std::min(b.hi[d], g.ncell[d] - 1);
+    }
+  }
+  return b;
+}
+
+void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3],
+                      const double subhi[3], int halo) {
+  spec_ = spec;
+  comm_ = comm;
+  MPI_Comm_rank(comm, &me_);
+  MPI_Comm_size(comm, &nprocs_);
+
+  owned_ = owned_box(spec, sublo, subhi);
+  // The patch: owned nodes (or, for a rank without any, the nodes nearest its
+  // subdomain) widened by the halo, clipped to the grid in non-periodic dims.
+  for (int d = 0; d < 3; ++d) {
+    int lo = owned_.lo[d], hi = owned_.hi[d];
+    if (hi < lo) {
+      lo = first_node_at_or_above(spec, d, sublo[d]);
+      hi = lo - 1;
+    }
+    patch_.lo[d] = lo - halo;
+    patch_.hi[d] = hi + halo;
+    if (!spec.periodic[d]) {
+      patch_.lo[d] = std::max(patch_.lo[d], spec.node_lo(d));
+      patch_.hi[d] = std::min(patch_.hi[d], spec.node_hi(d));
+    }
+    n_[d] = std::max(0, patch_.hi[d] - patch_.lo[d] + 1);
+  }
+  nnodes_ = std::size_t(n_[0]) * n_[1] * n_[2];
+
+  // Everybody's owned and patch boxes, to find who exchanges what with whom.
+  std::vector<int> boxes(12 * nprocs_);
+  int mine[12];
+  for (int d = 0; d < 3; ++d) {
+    mine[d] = owned_.lo[d];
+    mine[3 + d] = owned_.hi[d];
+    mine[6 + d] = patch_.lo[d];
+    mine[9 + d] = patch_.hi[d];
+  }
+  MPI_Allgather(mine, 12, MPI_INT, boxes.data(), 12, MPI_INT, comm);
+  auto box_of = [&](int r, int off) {
+    IndexBox b;
+    for (int d = 0; d < 3; ++d) {
+      b.lo[d] = boxes[12 * r + off + d];
+      b.hi[d] = boxes[12 * r + off + 3 + d];
+    }
+    return b;
+  };
+
+  halo_side_.clear();
+  owner_side_.clear();
+  for (int q = 0; q < nprocs_; ++q) {
+    // My halo nodes that are images of nodes q owns.
+    const IndexBox oq = box_of(q, 0);
+    if (!oq.empty() && !patch_.empty()) {
+      int kmin[3], kmax[3];
+      image_range(spec, patch_, oq, kmin, kmax);
+      for (int kz = kmin[2]; kz <= kmax[2]; ++kz)
+        for (int ky = kmin[1]; ky <= kmax[1]; ++ky)
+          for (int kx = kmin[0]; kx <= kmax[0]; ++kx) {
+            int s[3] = {kx * spec.ncell[0], ky * spec.ncell[1], kz * spec.ncell[2]};
+            if (q == me_ && s[0] == 0 && s[1] == 0 && s[2] == 0) continue;
+            IndexBox b = intersect(patch_, shifted(oq, s));
+            if (!b.empty()) halo_side_.push_back({q, b, {s[0], s[1], s[2]}});
+          }
+    }
+    // Nodes I own that are images of halo nodes of q (same enumeration order as q uses).
+    const IndexBox pq = box_of(q, 6);
+    if (!owned_.empty() && !pq.empty()) {
+      int kmin[3], kmax[3];
+      image_range(spec, pq, owned_, kmin, kmax);
+      for (int kz = kmin[2]; kz <= kmax[2]; ++kz)
+        for (int ky = kmin[1]; ky <= kmax[1]; ++ky)
+          for (int kx = kmin[0]; kx <= kmax[0]; ++kx) {
+            int s[3] = {kx * spec.ncell[0], ky * spec.ncell[1], kz * spec.ncell[2]};
+            if (q == me_ && s[0] == 0 && s[1] == 0 && s[2] == 0) continue;
+            IndexBox b = intersect(pq, shifted(owned_, s));  // q's halo indices
+            if (b.empty()) continue;
+            int ms[3] = {-s[0], -s[1], -s[2]};
+            owner_side_.push_back({q, shifted(b, ms), {s[0], s[1], s[2]}});
+          }
+    }
+  }
+}
+
+long LocalGrid::halo_nodes_sent() const {
+  long n = 0;
+  for (const auto &t : halo_side_)
+    if (t.peer != me_) n += t.mine.count();
+  return n;
+}
+
+void LocalGrid::reverse_sum(double *data, int stride) { exchange(data, stride, true); }
+void LocalGrid::forward(double *data, int stride) { exchange(data, stride, false); }
+
+void LocalGrid::exchange(double *data, int stride, bool reverse) {
+  // reverse: halo boxes are packed and sent, owner boxes receive and add.
+  // forward: owner boxes are packed and sent, halo boxes receive and store.
+  const std::vector<Transfer> &send = reverse ? halo_side_ : owner_side_;
+  const std::vector<Transfer> &recv = reverse ? owner_side_ : halo_side_;
+
+  auto for_box = [&](const IndexBox &b, auto &&fn) {
+    for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+      for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+        for (int i = b.lo[0]; i <= b.hi[0]; ++i) fn(index(i, j, k));
+  };
+
+  // Self images (periodic wrap on this rank): copy directly, in the same order.
+  {
+    std::vector<double> tmp;
+    for (const auto &t : send)
+      if (t.peer == me_) for_box(t.mine, [&](std::size_t n) {
+          for (int c = 0; c < stride; ++c) tmp.push_back(data[n * stride + c]);
+        });
+    std::size_t pos = 0;
+    for (const auto &t : recv)
+      if (t.peer == me_) for_box(t.mine, [&](std::size_t n) {
+          for (int c = 0; c < stride; ++c, ++pos) {
+            if (reverse)
+              data[n * stride + c] += tmp[pos];
+            else
+              data[n * stride + c] = tmp[pos];
+          }
+        });
+  }
+  if (nprocs_ == 1) return;
+
+  // One message per peer: all boxes for that peer, in list order.
+  std::vector<int> sendcount(nprocs_, 0), recvcount(nprocs_, 0);
+  for (const auto &t : send)
+    if (t.peer != me_) sendcount[t.peer] += int(t.mine.count()) * stride;
+  for (const auto &t : recv)
+    if (t.peer != me_) recvcount[t.peer] += int(t.mine.count()) * stride;
+  std::vector<int> soff(nprocs_ + 1, 0), roff(nprocs_ + 1, 0);
+  for (int q = 0; q < nprocs_; ++q) {
+    soff[q + 1] = soff[q] + sendcount[q];
+    roff[q + 1] = roff[q] + recvcount[q];
+  }
+  sendbuf_.resize(soff[nprocs_]);
+  recvbuf_.resize(roff[nprocs_]);
+  {
+    std::vector<int> pos(soff.begin(), soff.end() - 1);
+    for (const auto &t : send)
+      if (t.peer != me_) for_box(t.mine, [&](std::size_t n) {
+          for (int c = 0; c < stride; ++c) sendbuf_[pos[t.peer]++] = data[n * stride + c];
+        });
+  }
+  std::vector<MPI_Request> req;
+  req.reserve(2 * nprocs_);
+  for (int q = 0; q < nprocs_; ++q)
+    if (recvcount[q] > 0) {
+      req.emplace_back();
+      MPI_Irecv(recvbuf_.data() + roff[q], recvcount[q], MPI_DOUBLE, q, 7301, comm_, &req.back());
+    }
+  for (int q = 0; q < nprocs_; ++q)
+    if (sendcount[q] > 0) {
+      req.emplace_back();
+      MPI_Isend(sendbuf_.data() + soff[q], sendcount[q], MPI_DOUBLE, q, 7301, comm_, &req.back());
+    }
+  MPI_Waitall(int(req.size()), req.data(), MPI_STATUSES_IGNORE);
+  {
+    std::vector<int> pos(roff.begin(), roff.end() - 1);
+    for (const auto &t : recv)
+      if (t.peer != me_) for_box(t.mine, [&](std::size_t n) {
+          for (int c = 0; c < stride; ++c) {
+            const double v = recvbuf_[pos[t.peer]++];
+            if (reverse)
+              data[n * stride + c] += v;
+            else
+              data[n * stride + c] = v;
+          }
+        });
+  }
+}
+
+}  // namespace mpm

@@ -1,0 +1,86 @@
+// The background grid as one MPI rank sees it: a patch of nodes covering the
+// rank's subdomain plus a halo wide enough for every node its material points
+// can touch. Each node of the global grid is owned by exactly one rank (the
+// one whose subdomain contains the node, positions clamped into the grid);
+// the halo holds partial sums (particles-to-grid) that reverse_sum() adds
+// into the owners, and copies of owned values that forward() refreshes.
+#pragma once
+#include <mpi.h>
+#include <array>
+#include <cstddef>
+#include <vector>
+
+namespace mpm {
+
+struct IndexBox {
+  int lo[3] = {0, 0, 0};
+  int hi[3] = {-1, -1, -1};  // inclusive; empty if any hi < lo
+  bool empty() const { return hi[0] < lo[0] || hi[1] < lo[1] || hi[2] < lo[2]; }
+  long count() const {
+    return empty() ? 0 : long(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+  }
+};
+
+struct GridSpec {
+  double origin[3] = {0, 0, 0};
+  double dx = 1.0;
+  int ncell[3] = {1, 1, 1};
+  bool periodic[3] = {false, false, false};
+  int pad = 1;  // node layers outside a non-periodic face (support of the shape function)
+  double upper(int d) const { return origin[d] + ncell[d] * dx; }
+  // Global node index range: non-periodic 0-pad .. ncell+pad, periodic 0 .. ncell-1.
+  int node_lo(int d) const { return periodic[d] ? 0 : -pad; }
+  int node_hi(int d) const { return periodic[d] ? ncell[d] - 1 : ncell[d] + pad; }
+};
+
+// Owned node index range along one dimension of the subdomain [sublo, subhi).
+// Shared by all ranks so that neighbouring ranges tile the grid exactly.
+IndexBox owned_box(const GridSpec &g, const double sublo[3], const double subhi[3]);
+
+class LocalGrid {
+ public:
+  // Collective over comm. halo: node layers added around the owned box.
+  void setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3], const double subhi[3],
+             int halo);
+
+  const GridSpec &spec() const { return spec_; }
+  const IndexBox &patch() const { return patch_; }
+  const IndexBox &owned() const { return owned_; }
+  std::size_t size() const { return nnodes_; }
+  int extent(int d) const { return n_[d]; }
+  // Flat patch index of global (unwrapped) node indices; i fastest.
+  std::size_t index(int i, int j, int k) const {
+    return (std::size_t(k - patch_.lo[2]) * n_[1] + (j - patch_.lo[1])) * n_[0] + (i - patch_.lo[0]);
+  }
+  bool in_patch(int i, int j, int k) const {
+    return i >= patch_.lo[0] && i <= patch_.hi[0] && j >= patch_.lo[1] && j <= patch_.hi[1] &&
+           k >= patch_.lo[2] && k <= patch_.hi[2];
+  }
+
+  // Adds the halo partial sums of data (stride doubles per node) into their owners.
+  void reverse_sum(double *data, int stride);
+  // Copies owned values into every rank's halo images.
+  void forward(double *data, int stride);
+  // Doubles sent by this rank in one reverse_sum of stride 1 (for reports).
+  long halo_nodes_sent() const;
+
+ private:
+  struct Transfer {      // one box of nodes exchanged with one peer
+    int peer;
+    IndexBox mine;       // node indices in my patch (halo side) or my owned box (owner side)
+    int shift[3];        // peer index = my index - shift (halo side)
+  };
+  void exchange(double *data, int stride, bool reverse);
+
+  GridSpec spec_;
+  MPI_Comm comm_ = MPI_COMM_NULL;
+  int me_ = 0, nprocs_ = 1;
+  IndexBox patch_, owned_;
+  int n_[3] = {0, 0, 0};
+  std::size_t nnodes_ = 0;
+  std::vector<Transfer> halo_side_;   // my halo nodes -> owner (reverse sends, forward receives)
+  std::vector<Transfer> owner_side_;  // my owned nodes <- peer halos (reverse receives, forward sends)
+  std::vector<double> sendbuf_, recvbuf_;
+};
+
+}  // namespace mpm
