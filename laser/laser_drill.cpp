@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     validate(cfg);
-    const double dt_max = explicit_step_limit(cfg);
+    const double dt_max = cfg.implicit_melt ? 0.0 : explicit_step_limit(cfg);
     if (dt_max > 0.0 && cfg.dt > dt_max) {
       char buf[256];
       std::snprintf(buf, sizeof buf,

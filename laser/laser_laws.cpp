@@ -44,6 +44,36 @@ RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf,
   return r;
 }
 
+RootResult illinois_root(const std::function<double(double)>& f, double a, double b, double fa,
+                         double fb, double xtol, int maxit) {
+  RootResult r;
+  if ((fa > 0.0) == (fb > 0.0) && fa != 0.0 && fb != 0.0) {
+    r.x = std::numeric_limits<double>::quiet_NaN();
+    return r;
+  }
+  int side = 0;
+  double c = a;
+  for (int it = 1; it <= maxit; ++it) {
+    r.iterations = it;
+    c = (fa * b - fb * a) / (fa - fb);
+    if (!(c > std::min(a, b) && c < std::max(a, b))) c = 0.5 * (a + b);
+    const double fc = f(c);
+    if (fc == 0.0 || std::fabs(b - a) <= xtol) { r.converged = true; break; }
+    if ((fc > 0.0) == (fb > 0.0)) {
+      b = c; fb = fc;
+      if (side == -1) fa *= 0.5;
+      side = -1;
+    } else {
+      a = c; fa = fc;
+      if (side == 1) fb *= 0.5;
+      side = 1;
+    }
+    if (std::fabs(b - a) <= xtol) { r.converged = true; break; }
+  }
+  r.x = c;
+  return r;
+}
+
 Groups make_groups(const Material& m, double I0, double R) {
   Groups G;
   G.dT = m.Tsat0 - m.Tm;

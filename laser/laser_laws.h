@@ -26,6 +26,11 @@ struct RootResult {
 RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf,
                        double lo, double hi, double xtol, int maxit = 200);
 
+// Derivative-free bracketed root (Illinois variant of regula falsi): f(a) and
+// f(b) of opposite sign; superlinear and never leaves [a, b].
+RootResult illinois_root(const std::function<double(double)>& f, double a, double b, double fa,
+                         double fb, double xtol, int maxit = 200);
+
 // --------------------------------------------------------- Clausius-Clapeyron
 // (3-15): vapour pressure [Pa] at the surface temperature T [K].
 inline double clausius_clapeyron_pressure(double T, double p0, double Tsat0, double hlv,

@@ -280,6 +280,31 @@ void Drill::advance_interfaces(double ta, double tb) {
     const double grad_n = solid_gradient_mean(n, t0, tb);
     const double theta_mo = cfg_.moving_origin ? G_.theta_i : 0.0;
     const double L = (1.0 / (G_.Ste * G_.Nc) - Cc * theta_mo) / G_.Na;
+    if (cfg_.implicit_melt) {
+      // Backward Euler in g: g_new = g_old + dtau (dS2 - dS1 + v)(g_new), with
+      // the solid gradient, curvature, b2 and flow frozen over the step. The
+      // right side decreases with g, so the root is unique and bracketed.
+      auto rate = [&](double g) {
+        const InterfaceState st = solve_interface(G_, n.xi, g, n.b2);
+        const double d2 = std::max((Cc * grad_n * J + G_.k * st.grad_bottom) / L, 0.0);
+        const double d1 = std::max(recession_rate(G_, n.xi, st), 0.0);
+        return d2 - d1 + n.v;
+      };
+      const double g_old = n.g;
+      auto F = [&](double g) { return g - g_old - dtn * rate(g); };
+      double g_new;
+      const double F0 = F(0.0);
+      if (F0 >= 0.0) {
+        g_new = 0.0;
+      } else {
+        const double R0 = rate(g_old);
+        double hi = R0 > 0.0 ? g_old + dtn * R0 : g_old;
+        double Fhi = F(hi);
+        for (int k = 0; Fhi < 0.0 && k < 60; ++k) { hi = 2.0 * hi + 1e-12; Fhi = F(hi); }
+        g_new = illinois_root(F, 0.0, hi, F0, Fhi, 1e-12 * std::max(hi, 1e-12)).x;
+      }
+      n.itf = solve_interface(G_, n.xi, g_new, n.b2);
+    }
     const double drive = Cc * grad_n * J + G_.k * n.itf.grad_bottom;  // right side of (3-40)
     double dS2 = drive / L;
     if (dS2 < 0.0) {
@@ -292,7 +317,7 @@ void Drill::advance_interfaces(double ta, double tb) {
     n.dS2 = dS2;
     n.dS1 = dS1;
     // stability of the explicit update (4-14): d(dg/dtau)/dg
-    if (n.itf.theta_sat > 0.0 && n.g > 0.0) {
+    if (!cfg_.implicit_melt && n.itf.theta_sat > 0.0 && n.g > 0.0) {
       double dres;
       interface_residual(G_, n.itf.phi, n.xi, n.g, n.b2, &dres);
       const double dres_dg =
@@ -476,8 +501,17 @@ Result Drill::run() {
                    fmt(c.tau_m * G_.t_scale) + " s > pulse " + fmt(cfg_.tp) + " s";
     res_.T_peak = cfg_.mat.Tm + G_.dT * premelt_temperature(G_, 0.0, 0.0, tau_p);
   }
-  if (res_.status == "ok" && res_.curvature_clamps > 0)
-    res_.message = "curvature |a d| >= 2 clamped " + std::to_string(res_.curvature_clamps) + " times";
+  if (res_.status == "ok") {
+    // A finished run whose safeguards fired is reported, not passed off as ok.
+    const double imb = (res_.energy.sum() - res_.energy.laser_exact) / res_.energy.laser_exact;
+    if (std::fabs(imb) > 0.01 || res_.curvature_clamps > 0) {
+      res_.status = "inaccurate";
+      res_.message = "energy imbalance " + fmt(imb) + ", curvature |a d| >= 2 clamped " +
+                     std::to_string(res_.curvature_clamps) + " times, b2 limiter hit " +
+                     std::to_string(res_.b2_clamps) + " times, melt thickness clamped at 0 " +
+                     std::to_string(res_.melt_clamps) + " times";
+    }
+  }
   return res_;
 }
 

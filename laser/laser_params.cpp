@@ -126,6 +126,13 @@ const std::vector<Option>& options() {
     t.push_back(flag("no-curvature", "switch off the curvature factor (3-37)", &Config::curvature, false));
     t.push_back(flag("no-moving-origin", "switch off the moving-origin term in (3-39)/(3-40)",
                      &Config::moving_origin, false));
+    {
+      Option o{"melt-update", "", "melt thickness update: explicit = (4-14) as in the text, implicit = backward Euler in g",
+               Kind::Choice, 0, 0, true, true, "explicit|implicit", nullptr, nullptr};
+      o.set = [](Config& c, const std::string& v) { c.implicit_melt = v == "implicit"; };
+      o.get = [](const Config& c) { return std::string(c.implicit_melt ? "implicit" : "explicit"); };
+      t.push_back(o);
+    }
     t.push_back(real("dxi", "-", 0, 0.5, true, false, "radial grid spacing d(xi) = dr/R", &Config::dxi));
     t.push_back(real("xi-max", "-", 0, 10, false, false,
                      "outer end of the grid (0: just beyond the last node that melts)", &Config::xi_max));

@@ -29,6 +29,7 @@ struct Config {
   double shift = 3.0 / (4.0 * kPi);  // (3-36): shift of the Stefan solution in tau_m
   bool curvature = true;
   bool moving_origin = true;
+  bool implicit_melt = false;  // backward Euler for g instead of (4-14)
   double dxi = 0.0125;
   double xi_max = 0.0;     // 0: just beyond the last node that melts within the pulse
   double dt = 0.0;         // s; 0: 5e-7 s * min(1, (7.5e10 W/m2 / I0)^2)

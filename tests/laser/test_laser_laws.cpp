@@ -60,6 +60,16 @@ TEST(LaserLaws, SafeNewtonNeverDiverges) {
   EXPECT_TRUE(std::isnan(bad.x));
 }
 
+TEST(LaserLaws, IllinoisRootBracketed) {
+  int calls = 0;
+  auto f = [&](double x) { ++calls; return std::exp(x) - 5.0; };
+  const RootResult r = illinois_root(f, -10.0, 10.0, f(-10.0), f(10.0), 1e-14);
+  EXPECT_TRUE(r.converged);
+  EXPECT_NEAR(r.x, std::log(5.0), 1e-12);
+  EXPECT_LT(calls, 60);  // superlinear, bisection would need ~50
+  EXPECT_TRUE(std::isnan(illinois_root(f, 2.0, 3.0, f(2.0), f(3.0), 1e-12).x));
+}
+
 TEST(LaserLaws, InterfaceBalanceSatisfiesDimensionalLaws) {
   // The nondimensional balance (4-29) solved, then checked against the
   // dimensional (3-15), (3-17), (3-18): j_v (h_lv M + gamma R_g T/2) = I - k_l dT/dz.
