@@ -52,7 +52,8 @@ int main(int argc, char** argv) {
                 "p_peak %.4g Pa; wall %.3f s\n",
                 r.status.c_str(), r.depth_center, r.volume_removed, r.removal_rate, r.T_peak,
                 r.p_peak, wall);
-    if (r.status != "ok" && !r.message.empty())
+    std::fflush(stdout);
+    if (!r.message.empty())
       std::fprintf(stderr, "laser_drill: %s: %s\n", r.status.c_str(), r.message.c_str());
   } catch (const std::exception& e) {
     std::cerr << "laser_drill: internal error: " << e.what() << "\n";

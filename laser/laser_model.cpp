@@ -51,6 +51,7 @@ class Drill {
   double lambda_max_ = 0;
   double dtau_ = 0;
   std::string flow_failure_;
+  std::string first_clamp_;
   int idx_x1_ = 0;
 };
 
@@ -274,7 +275,10 @@ void Drill::advance_interfaces(double ta, double tb) {
     if (cfg_.curvature) {
       const double a = -s2xx / (J * J * J);
       const double d = h * J;
-      if (std::fabs(a * d) >= 2.0) ++res_.curvature_clamps;
+      if (std::fabs(a * d) >= 2.0) {
+        if (res_.curvature_clamps++ == 0)
+          first_clamp_ = "first at xi = " + fmt(n.xi) + ", t = " + fmt(tb * G_.t_scale) + " s";
+      }
       Cc = curvature_factor(a, d);
     }
     const double grad_n = solid_gradient_mean(n, t0, tb);
@@ -504,12 +508,16 @@ Result Drill::run() {
   if (res_.status == "ok") {
     // A finished run whose safeguards fired is reported, not passed off as ok.
     const double imb = (res_.energy.sum() - res_.energy.laser_exact) / res_.energy.laser_exact;
-    if (std::fabs(imb) > 0.01 || res_.curvature_clamps > 0) {
+    const double node_steps = double(res_.steps) * res_.nodes;
+    if (std::fabs(imb) > 0.01 || res_.curvature_clamps > 1e-4 * node_steps) {
       res_.status = "inaccurate";
       res_.message = "energy imbalance " + fmt(imb) + ", curvature |a d| >= 2 clamped " +
-                     std::to_string(res_.curvature_clamps) + " times, b2 limiter hit " +
+                     std::to_string(res_.curvature_clamps) + " times (" + first_clamp_ + "), b2 limiter hit " +
                      std::to_string(res_.b2_clamps) + " times, melt thickness clamped at 0 " +
                      std::to_string(res_.melt_clamps) + " times";
+    } else if (res_.curvature_clamps > 0) {
+      res_.message = "curvature |a d| >= 2 clamped " + std::to_string(res_.curvature_clamps) + " times (of " +
+                     fmt(node_steps) + " node steps; " + first_clamp_ + ")";
     }
   }
   return res_;
