@@ -118,6 +118,7 @@ bool Drill::solve_melt_flow() {
     int last_bl = 0;
     solve_boundary_layer(last_bl);
     first = last_bl + 1;
+    res_.bl_last_xi = std::max(res_.bl_last_xi, nodes_[last_bl].xi);
   }
   const double Pr = cfg_.mat.Pr, m = cfg_.m, xp = cfg_.xi_p;
   const bool rising = cfg_.model == FlowModel::Rising;

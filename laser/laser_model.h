@@ -57,6 +57,7 @@ struct Result {
   double removal_rate = 0;
   double T_peak = 0, p_peak = 0, u_peak_max = 0, A_last = 0;
   double xi_melt_edge = 0;
+  double bl_last_xi = 0;  // boundary model: outermost node where delta < g was met
   int steps = 0, nodes = 0;
   int melt_clamps = 0, melt_rate_clamps = 0, curvature_clamps = 0, b2_clamps = 0;
   double max_interface_residual = 0;

@@ -99,6 +99,7 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   o << "  \"u_peak_max_m_per_s\": " << num(r.u_peak_max) << ",\n";
   o << "  \"A_last\": " << num(r.A_last) << ",\n";
   o << "  \"xi_melt_edge\": " << num(r.xi_melt_edge) << ",\n";
+  o << "  \"boundary_layer_last_xi\": " << num(r.bl_last_xi) << ",\n";
   o << "  \"steps\": " << r.steps << ",\n";
   o << "  \"nodes\": " << r.nodes << ",\n";
   o << "  \"dt_s\": " << num(cfg.dt) << ",\n";
