@@ -39,7 +39,16 @@ int main(int argc, char** argv) {
       return 0;
     }
     const auto t0 = std::chrono::steady_clock::now();
-    const Result r = run_simulation(cfg);
+    Result r = run_simulation(cfg);
+    // The automatic step is halved (at most 6 times) when the run-time check of
+    // (4-14) fires; a step given by the user is never changed.
+    for (int k = 0; k < 6 && cfg.dt_auto && r.status == "unstable_time_step"; ++k) {
+      cfg.dt *= 0.5;
+      if (!cfg.quiet)
+        std::fprintf(stderr, "laser_drill: automatic step unstable (%s); retrying with dt = %.4g s\n",
+                     r.message.c_str(), cfg.dt);
+      r = run_simulation(cfg);
+    }
     const double wall =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (r.status == "unstable_time_step") {

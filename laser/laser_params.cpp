@@ -331,7 +331,10 @@ void validate(Config& c) {
   // Automatic step: converged to < 1e-4 in centre depth for Table 5.1 at
   // 7.5e10 W/m2; the explicit limit of (4-14) scales as the melt thickness
   // squared, i.e. as I0^-2.
-  if (!(c.dt > 0.0)) c.dt = 5e-7 * std::min(1.0, std::pow(7.5e10 / c.I0, 2));
+  if (!(c.dt > 0.0)) {
+    c.dt = 5e-7 * std::min(1.0, std::pow(7.5e10 / c.I0, 2));
+    c.dt_auto = true;
+  }
   if (!(c.dt < c.tp))
     throw UsageError("--dt/--dtau: the time step " + fmt(c.dt) + " s must be shorter than the pulse " +
                      fmt(c.tp) + " s");

@@ -34,6 +34,7 @@ struct Config {
   double xi_max = 0.0;     // 0: just beyond the last node that melts within the pulse
   double dt = 0.0;         // s; 0: 5e-7 s * min(1, (7.5e10 W/m2 / I0)^2)
   double dtau = 0.0;       // nondimensional; overrides dt when > 0
+  bool dt_auto = false;    // dt chosen by the program: halved on instability
   int frames = 200;        // HDF5 frames
   std::string out = "laser_out";
   bool quiet = false;
