@@ -282,7 +282,6 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       if (strcmp(arg[iarg + 5], "type") != 0) bad_arg(kw, "'type T' after the points per cell", arg[iarg + 5]);
       if (!parse_int(arg[iarg + 6], fill_type) || fill_type < 1 || fill_type > atom->ntypes)
         bad_arg("fill type", "an existing atom type", arg[iarg + 6]);
-      if (domain->find_region(fill_region.c_str()) < 0) bad_arg(kw, "an existing region ID", arg[iarg + 1]);
       iarg += 7;
     } else if (strcmp(kw, "hydrostatic") == 0) {
       need(iarg, 3, kw, "'axis surface g' (initial pressure rho g (surface - coordinate))");
@@ -429,7 +428,10 @@ void FixMpmFluid::post_create() {
 }
 
 void FixMpmFluid::fill_points() {
-  Region *region = domain->regions[domain->find_region(fill_region.c_str())];
+  // checked here, not at parse time: after read_restart no region is needed
+  const int iregion = domain->find_region(fill_region.c_str());
+  if (iregion < 0) bad_arg("fill", "an existing region ID", fill_region.c_str());
+  Region *region = domain->regions[iregion];
   const double dx = gspec.dx;
   double vol = dx * dx * dx;
   for (int d = 0; d < 3; ++d) {
