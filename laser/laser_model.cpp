@@ -32,7 +32,7 @@ class Drill {
 
  private:
   void setup();
-  void melt_onset(double ta, double tb);
+  void melt_onset(double tb);
   void solve_interfaces();
   bool solve_melt_flow();
   void solve_boundary_layer(int& last_bl);
@@ -86,15 +86,11 @@ void Drill::setup() {
   if (cfg_.solid == SolidModel::Exact) exact_ = std::make_unique<CorrectedConduction>(kTau0OverTauM);
 }
 
-void Drill::melt_onset(double ta, double tb) {
-  for (auto& n : nodes_) {
-    if (!n.molten && n.tau_m < tb) {
-      n.molten = true;
-      // Everything absorbed before onset went into the solid, (3-26).
-      const double t0 = std::max(ta, 0.0);
-      (void)t0;
-    }
-  }
+// A node melts inside [ta, tb) at its onset time (3-27); until then the beam
+// went into the solid (3-26), which advance_interfaces books.
+void Drill::melt_onset(double tb) {
+  for (auto& n : nodes_)
+    if (!n.molten && n.tau_m < tb) n.molten = true;
 }
 
 void Drill::solve_interfaces() {
@@ -436,7 +432,7 @@ Result Drill::run() {
   for (long step = 0; step < nsteps; ++step) {
     const double ta = tau;
     const double tb = (step == nsteps - 1) ? tau_p : std::min(tau_p, (step + 1) * dtau_);
-    melt_onset(ta, tb);
+    melt_onset(tb);
     solve_interfaces();
     if (!solve_melt_flow()) {
       res_.status = "no_flow_solution";

@@ -183,8 +183,6 @@ void write_conduction_table(const std::string& dir) {
        "shifted_flux_continuous,pre_melting\n";
   for (size_t k = 0; k < s.size(); ++k) {
     const double st = 1.0 / std::sqrt(kPi * (s[k] + kTau0OverTauM));
-    const double i = std::upper_bound(cc.s_table().begin(), cc.s_table().end(), s[k]) - cc.s_table().begin();
-    (void)i;
     // s2 and s3 separately, interpolated in the table
     auto interp = [&](const std::vector<double>& y) {
       const auto& S = cc.s_table();

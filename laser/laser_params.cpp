@@ -243,7 +243,6 @@ void read_config_file(Config& c, const std::string& path) {
       if (ch == '_') ch = '-';
     if (value.size() >= 2 && value.front() == '"' && value.back() == '"')
       value = value.substr(1, value.size() - 2);
-    if (key == "material") key = "material";
     const Option* o = find_option(key);
     if (!o || key == "config") throw UsageError(where + "unknown key '" + key + "'");
     apply(c, *o, value, where);

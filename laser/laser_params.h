@@ -38,7 +38,6 @@ struct Config {
   int frames = 200;        // HDF5 frames
   std::string out = "laser_out";
   bool quiet = false;
-  bool write_files = true;
   std::string config_file;
   std::string material = "superalloy";
 };

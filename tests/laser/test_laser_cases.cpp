@@ -13,7 +13,6 @@ namespace {
 Config base() {
   Config c;
   c.quiet = true;
-  c.write_files = false;
   validate(c);
   return c;
 }
