@@ -311,8 +311,8 @@ def plots(rows, cases, a, width, g):
     kf, kh = front["T"] <= tmax, height["T"] <= tmax
     axes[0].plot(front["T"][kf], front["Z"][kf], "ks", mfc="none", label="Martin & Moyce (1952)")
     axes[1].plot(height["T"][kh], height["H"][kh], "ks", mfc="none", label="Martin & Moyce (1952)")
-    axes[0].set_xlim(0, tmax)
-    axes[1].set_xlim(0, tmax)
+    axes[0].set_xlim(-0.02 * tmax, tmax)
+    axes[1].set_xlim(-0.02 * tmax, tmax)
     axes[0].set_xlabel(r"$T = t\,\sqrt{g/a}$")
     axes[1].set_xlabel(r"$T = t\,\sqrt{g/a}$")
     axes[0].set_ylabel(r"$Z = x_{front}/a$")

@@ -201,7 +201,7 @@ def main():
         axh.set_ylabel(r"$H = h_{wall}/a$", fontsize=9)
         axh.set_xlabel(r"$T = t\,\sqrt{g/a}$", fontsize=9)
         for ax in (axz, axh):
-            ax.set_xlim(0, tmax)
+            ax.set_xlim(-0.02 * tmax, tmax)
             ax.grid(True, alpha=0.3)
             ax.tick_params(labelsize=8)
             ax.legend(fontsize=7, loc="best")
