@@ -207,6 +207,29 @@ double curvature_factor(double a, double d) {
   return convex ? y / std::asin(y) : std::asin(y) / y;
 }
 
+double flow_shape(const FlowProfile& P, double A, double xi) {
+  return P.rising ? A * std::pow(xi, 1.0 / P.m) : A * xi * std::exp(-xi / P.xi_p);
+}
+
+double flow_surface_velocity(const FlowProfile& P, double A, double xi, double g) {
+  if (P.rising) return -(1.0 + P.m) / (2.0 * P.m) * A * std::pow(xi, 1.0 / P.m - 1.0) * g * g;
+  return -0.5 * A * g * g * (2.0 - xi / P.xi_p) * std::exp(-xi / P.xi_p);  // (4-22)
+}
+
+void flow_residual_coefficients(const FlowProfile& P, double Pr, double xi, double g, double dpdxi,
+                                double& a, double& b, double& c) {
+  if (P.rising) {  // (4-17)
+    a = g * g * std::pow(xi, 2.0 / P.m + 1.0);
+    b = -3.0 * Pr * g * std::pow(xi, 1.0 / P.m);
+    c = -6.0 * P.m / (P.m - 1.0) * xi * xi * dpdxi;
+  } else {  // (4-23)
+    const double e = std::exp(xi / P.xi_p);
+    a = g * g * xi * xi;
+    b = -3.0 * Pr * g * e;
+    c = -6.0 * P.xi_p * dpdxi * e * e;
+  }
+}
+
 CubicRoot select_flow_root(double Q1, double Q2, double Q3, double Q4) {
   CubicRoot out;
   if (!(Q1 > 0.0) || !std::isfinite(Q1) || !std::isfinite(Q2) || !std::isfinite(Q3) ||

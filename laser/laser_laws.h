@@ -140,6 +140,19 @@ double stefan_gradient_mean(double theta_i, double Na, double tau_m, double ta, 
 double curvature_factor(double a, double d);
 
 // ------------------------------------------------------------ melt flow
+// Integral radial profiles u = f(xi) zeta: rising f = A xi^(1/m) (4-17),
+// rising-fall f = A xi exp(-xi/xi_p) (4-22).
+struct FlowProfile {
+  bool rising = false;
+  double m = 2.0, xi_p = 1.0;
+};
+double flow_shape(const FlowProfile& P, double A, double xi);  // f(xi)
+// Vertical velocity at the melt surface, v(xi, g) = -(f' + f/xi) g^2 / 2.
+double flow_surface_velocity(const FlowProfile& P, double A, double xi, double g);
+// Local momentum residual a A^2 + b A + c of (4-17) / (4-23).
+void flow_residual_coefficients(const FlowProfile& P, double Pr, double xi, double g, double dpdxi,
+                                double& a, double& b, double& c);
+
 struct CubicRoot {
   double A = 0;
   int real_roots = 0;

@@ -118,6 +118,7 @@ bool Drill::solve_melt_flow() {
   }
   const double Pr = cfg_.mat.Pr, m = cfg_.m, xp = cfg_.xi_p;
   const bool rising = cfg_.model == FlowModel::Rising;
+  const FlowProfile profile{rising, m, xp};
   std::vector<double> dpdx(N, 0.0);
   for (int i = 1; i < N; ++i) {
     if (!nodes_[i].molten) continue;
@@ -136,16 +137,7 @@ bool Drill::solve_melt_flow() {
     if (!n.molten || !(n.g > 0.0)) continue;
     const double x = n.xi, g = n.g;
     double a, b, c;
-    if (rising) {  // (4-17)
-      a = g * g * std::pow(x, 2.0 / m + 1.0);
-      b = -3.0 * Pr * g * std::pow(x, 1.0 / m);
-      c = -6.0 * m / (m - 1.0) * x * x * dpdx[i];
-    } else {  // (4-23)
-      const double e = std::exp(x / xp);
-      a = g * g * x * x;
-      b = -3.0 * Pr * g * e;
-      c = -6.0 * xp * dpdx[i] * e * e;
-    }
+    flow_residual_coefficients(profile, Pr, x, g, dpdx[i], a, b, c);
     const double w = (i == N - 1) ? 0.5 * cfg_.dxi : cfg_.dxi;
     // W(A) = 2 int a^2 A^3 + 3 int ab A^2 + int (b^2 + 2ac) A + int bc, i.e. (4-20)/(4-24)
     Q1 += 2.0 * a * a * w;
@@ -167,13 +159,8 @@ bool Drill::solve_melt_flow() {
     Node& n = nodes_[i];
     if (!n.molten || !(n.g > 0.0) || (rising && n.xi == 0.0)) continue;
     const double x = n.xi, g = n.g;
-    if (rising) {
-      n.f = A_ * std::pow(x, 1.0 / m);
-      n.v = -(1.0 + m) / (2.0 * m) * A_ * std::pow(x, 1.0 / m - 1.0) * g * g;
-    } else {
-      n.f = A_ * x * std::exp(-x / xp);
-      n.v = -0.5 * A_ * g * g * (2.0 - x / xp) * std::exp(-x / xp);  // (4-22)
-    }
+    n.f = flow_shape(profile, A_, x);
+    n.v = flow_surface_velocity(profile, A_, x, g);
     u_peak_ = std::max(u_peak_, std::fabs(n.f * g));
   }
   return true;

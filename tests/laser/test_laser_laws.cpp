@@ -152,6 +152,33 @@ TEST(LaserLaws, CubicRootSelection) {
   EXPECT_FALSE(select_flow_root(0, 1, 1, 1).ok);
 }
 
+// (4-17) and (4-23) re-derived here independently: for u = f(xi) zeta the
+// momentum integral (4-16) reduces to
+//   M(A) = g^3 f (f' - f/xi)/6 - Pr g^2 (f' - f/xi)/(2 xi) + g dp/dxi = 0
+// (f' by finite differences). The printed residual must vanish with it, i.e.
+// be proportional to M for every A; and v(g) must equal -(f' + f/xi) g^2/2.
+TEST(LaserLaws, FlowProfilesMatchMomentumIntegral) {
+  for (const FlowProfile P : {FlowProfile{true, 1.5, 1.0}, FlowProfile{true, 4.0, 1.0},
+                              FlowProfile{false, 2.0, 0.6}, FlowProfile{false, 2.0, 1.5}}) {
+    for (double xi : {0.1, 0.7, 1.9}) {
+      const double g = 0.03, Pr = 0.142, dp = -2.5e6;
+      double a, b, c;
+      flow_residual_coefficients(P, Pr, xi, g, dp, a, b, c);
+      double ratio0 = 0;
+      for (double A : {1e3, 4e4, 2e5}) {
+        const double h = 1e-6 * xi;
+        const double f = flow_shape(P, A, xi);
+        const double fp = (flow_shape(P, A, xi + h) - flow_shape(P, A, xi - h)) / (2 * h);
+        const double M = g * g * g * f * (fp - f / xi) / 6 - Pr * g * g * (fp - f / xi) / (2 * xi) + g * dp;
+        const double ratio = (a * A * A + b * A + c) / M;
+        if (ratio0 == 0) ratio0 = ratio;
+        EXPECT_NEAR(ratio / ratio0, 1.0, 1e-6) << "rising " << P.rising << " xi " << xi << " A " << A;
+        EXPECT_NEAR(flow_surface_velocity(P, A, xi, g) / (-(fp + f / xi) * g * g / 2), 1.0, 1e-7);
+      }
+    }
+  }
+}
+
 TEST(LaserLaws, CurvatureFactor) {
   EXPECT_EQ(curvature_factor(0.0, 0.1), 1.0);
   // convex (a > 0) reduces, concave increases, and they are reciprocal
