@@ -5,7 +5,8 @@
 # inputs/dambreak/out-demo/ with HDF5 snapshots (~8 frames, one at gate removal),
 # writes the picture (snapshots coloured by |v| + front and wall height against
 # the experiment) and prints the RMS errors. Takes ~10 s after the build.
-# Installs nothing: python packages come from tools/python (its own venv).
+# Installs the Debian packages that are missing (tools/install_deps.sh);
+# python packages come from tools/python (its own venv).
 set -euo pipefail
 top=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 out="$top/dambreak-demo.png"
@@ -20,11 +21,11 @@ while [ $# -gt 0 ]; do
   esac
 done
 
+bash "$top/tools/install_deps.sh"
 exe="$top/build/liggghts_mpm"
 if [ ! -x "$exe" ]; then
   echo "== building $exe"
-  cmake -S "$top" -B "$top/build" -G Ninja
-  cmake --build "$top/build"
+  bash "$top/tools/build.sh"
 fi
 
 input="$top/inputs/dambreak/in.dambreak"
