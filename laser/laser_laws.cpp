@@ -199,6 +199,12 @@ double stefan_gradient_mean(double theta_i, double Na, double tau_m, double ta, 
   return 2.0 * theta_i / (std::sqrt(kPi * Na) * (std::sqrt(xa) + std::sqrt(xb)));
 }
 
+double melting_rate(const Groups& G, double Cc, double grad_n, double J, double grad_l_bottom,
+                    bool moving_origin) {
+  const double L = (1.0 / (G.Ste * G.Nc) - (moving_origin ? Cc * G.theta_i : 0.0)) / G.Na;
+  return (Cc * grad_n * J + G.k * grad_l_bottom) / L;
+}
+
 double curvature_factor(double a, double d) {
   double y = 0.5 * a * d;
   if (std::fabs(y) < 1e-8) return 1.0 - (a > 0 ? 1.0 : -1.0) * y * y / 6.0;

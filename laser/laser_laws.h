@@ -139,6 +139,12 @@ double stefan_gradient_mean(double theta_i, double Na, double tau_m, double ta, 
 // Curvature factor (3-37) for curvature a and arc d; clamps |a d| < 2.
 double curvature_factor(double a, double d);
 
+// (3-40): melting rate dS2/dtau (unclamped) from the solid gradient grad_n
+// (d theta_s/dn at the front, < 0), the slope factor J = sqrt(1 + S2'^2), the
+// curvature factor Cc and the melt gradient d theta_l/dzeta at zeta = 0.
+double melting_rate(const Groups& G, double Cc, double grad_n, double J, double grad_l_bottom,
+                    bool moving_origin);
+
 // ------------------------------------------------------------ melt flow
 // Integral radial profiles u = f(xi) zeta: rising f = A xi^(1/m) (4-17),
 // rising-fall f = A xi exp(-xi/xi_p) (4-22).

@@ -274,7 +274,7 @@ void Drill::advance_interfaces(double ta, double tb) {
       // right side decreases with g, so the root is unique and bracketed.
       auto rate = [&](double g) {
         const InterfaceState st = solve_interface(G_, n.xi, g, n.b2);
-        const double d2 = std::max((Cc * grad_n * J + G_.k * st.grad_bottom) / L, 0.0);
+        const double d2 = std::max(melting_rate(G_, Cc, grad_n, J, st.grad_bottom, cfg_.moving_origin), 0.0);
         const double d1 = std::max(recession_rate(G_, n.xi, st), 0.0);
         return d2 - d1 + n.v;
       };
@@ -294,7 +294,7 @@ void Drill::advance_interfaces(double ta, double tb) {
       n.itf = solve_interface(G_, n.xi, g_new, n.b2);
     }
     const double drive = Cc * grad_n * J + G_.k * n.itf.grad_bottom;  // right side of (3-40)
-    double dS2 = drive / L;
+    double dS2 = melting_rate(G_, Cc, grad_n, J, n.itf.grad_bottom, cfg_.moving_origin);
     if (dS2 < 0.0) {
       ++res_.melt_rate_clamps;
       E.clamp_defect += -drive * qscale_s * n.area * dtn * G_.t_scale;

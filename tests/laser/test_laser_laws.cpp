@@ -179,6 +179,23 @@ TEST(LaserLaws, FlowProfilesMatchMomentumIntegral) {
   }
 }
 
+// (3-40) against the dimensional Stefan condition (3-23) with the effective
+// solid flux of (3-39): rho h_ls ds2/dt = k_l |dT_l/dz| - C_c [k_s |dT_s/dn| J + rho c_ps (T_m - T_i) ds2/dt].
+TEST(LaserLaws, MeltingRateIsDimensionalStefanCondition) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  const Material& m = kMat;
+  for (double Cc : {0.8, 1.0, 1.3}) {
+    for (double J : {1.0, 1.4}) {
+      const double grad_n = -3.0, grad_l = 40.0;
+      const double ql = m.kl * G.dT / kR * grad_l, qs = m.ks * G.dT / kR * (-grad_n) * J;
+      const double ds2dt = (ql - Cc * qs) / (m.rho * (m.hls + Cc * m.cps * (m.Tm - m.Ti)));
+      EXPECT_NEAR(melting_rate(G, Cc, grad_n, J, grad_l, true) * G.v_scale / ds2dt, 1.0, 1e-12);
+      const double no_mo = (ql - Cc * qs) / (m.rho * m.hls);
+      EXPECT_NEAR(melting_rate(G, Cc, grad_n, J, grad_l, false) * G.v_scale / no_mo, 1.0, 1e-12);
+    }
+  }
+}
+
 TEST(LaserLaws, CurvatureFactor) {
   EXPECT_EQ(curvature_factor(0.0, 0.1), 1.0);
   // convex (a > 0) reduces, concave increases, and they are reciprocal
