@@ -343,32 +343,36 @@ void Drill::advance_interfaces(double ta, double tb) {
   }
 }
 
-// b2 of (4-25) from the integral energy balance (4-27), with the b2 of the last
-// step inside the xi-derivative (the text's lagged update).
+// b2 of (4-25) from the integral energy balance (4-27), an ODE in xi for
+// f J = f (theta_sat g^2/3 - b2 g^4/12) (u = f zeta), solved at every step by
+// marching with the flow (upwind, implicit in b2 at the node), given theta_sat,
+// g and f of this step. The text lags b2 between steps only in (4-30).
 void Drill::melt_temperature() {
   if (cfg_.model == FlowModel::Conduction) return;
   const int N = static_cast<int>(nodes_.size());
-  std::vector<double> fJ(N, 0.0);
-  for (int i = 0; i < N; ++i) {
-    const Node& n = nodes_[i];
-    if (n.molten && n.g > 0.0)
-      fJ[i] = n.f * (n.itf.theta_sat * n.g * n.g / 3.0 - n.b2 * std::pow(n.g, 4) / 12.0);
-  }
-  for (int i = 0; i < N; ++i) {
+  const double h = cfg_.dxi;
+  const bool outward = A_ >= 0.0;
+  double fJ_up = 0.0;  // f J at the upwind neighbour
+  for (int k = 0; k < N; ++k) {
+    const int i = outward ? k : N - 1 - k;
     Node& n = nodes_[i];
-    if (i == 0 || !n.molten || !(n.g > 0.0) || n.f == 0.0) { n.b2 = 0.0; continue; }
-    const double dfJ = (i + 1 < N) ? (fJ[i + 1] - fJ[i - 1]) / (2 * cfg_.dxi) : (fJ[i] - fJ[i - 1]) / cfg_.dxi;
-    const double g = n.g, th = n.itf.theta_sat;
-    const double num = dfJ + n.f / n.xi * th * g * g / 3.0 + n.v * th;
-    const double den = 2.0 * g + n.f / n.xi * std::pow(g, 4) / 12.0;
+    if (i == 0 || !n.molten || !(n.g > 0.0) || n.f == 0.0) {
+      n.b2 = 0.0;
+      fJ_up = 0.0;
+      continue;
+    }
+    const double g = n.g, th = n.itf.theta_sat, f = n.f, x = n.xi;
+    const double sgn = outward ? 1.0 : -1.0;  // d/dxi by the upwind difference
+    const double num = sgn * (f * th * g * g / 3.0 - fJ_up) / h + f / x * th * g * g / 3.0 + n.v * th;
+    const double den = 2.0 * g + f * std::pow(g, 4) / 12.0 * (sgn / h + 1.0 / x);
     n.b2 = num / den;
-    // Limiter: keep the profile (4-25) monotone in [0, g], |b2 g^2| <= theta_sat;
-    // beyond it the lagged update of (4-27) feeds back on itself and diverges.
+    // Safeguard: keep the profile (4-25) monotone in [0, g], |b2 g^2| <= theta_sat.
     const double bmax = th / (g * g);
     if (std::fabs(n.b2) > bmax || !std::isfinite(n.b2)) {
       ++res_.b2_clamps;
       n.b2 = std::isfinite(n.b2) ? std::copysign(bmax, n.b2) : 0.0;
     }
+    fJ_up = f * (th * g * g / 3.0 - n.b2 * std::pow(g, 4) / 12.0);
   }
 }
 
