@@ -254,6 +254,13 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
         bad_arg(kw, "a release time >= 0 or 'never'", arg[iarg + 4]);
       gate.active = true;
       iarg += 5;
+    } else if (strcmp(kw, "pmin") == 0) {
+      need(iarg, 1, kw, "the lowest (cavitation) pressure, a number or 'none'");
+      if (strcmp(arg[iarg + 1], "none") == 0)
+        pmin = -HUGE_VAL;
+      else if (!parse_double(arg[iarg + 1], pmin))
+        bad_arg(kw, "the lowest (cavitation) pressure, a number or 'none'", arg[iarg + 1]);
+      iarg += 2;
     } else if (strcmp(kw, "damping") == 0) {
       need(iarg, 1, kw, "a damping rate (1/time) >= 0");
       if (!parse_double(arg[iarg + 1], damping) || damping < 0.0)
@@ -330,7 +337,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
           // The first word that is no field name ends the list only if it is a keyword.
           static const char *keywords[] = {"cell", "grid", "density", "bulk", "viscosity", "eos", "shape",
                                            "transfer", "update", "antilock", "boundary", "gate", "damping",
-                                           "cfl", "subcycle", "mass_threshold", "fill", "hydrostatic",
+                                           "cfl", "subcycle", "mass_threshold", "fill", "hydrostatic", "pmin",
                                            "front", "height", "output"};
           bool is_kw = false;
           for (const char *k : keywords) is_kw = is_kw || strcmp(arg[iarg], k) == 0;
@@ -953,6 +960,9 @@ void FixMpmFluid::update_stress(double h) {
     s[C_VOL] *= J;
     s[C_RHO] = rmass[i] / (s[C_THETA] * s[C_VOL]);
     if (!antilock) p = eos.pressure(s[C_RHO]);
+    // Liquid cannot carry tension beyond its cavitation pressure: without the
+    // cut a stretched surface layer would hold itself together (and to walls).
+    p = std::max(p, pmin);
     if (!(J > 0.0) || !std::isfinite(p)) {
       std::ostringstream os;
       os << "Fix mpm/fluid: material point " << atom->tag[i] << " was compressed to a non-positive volume at step "

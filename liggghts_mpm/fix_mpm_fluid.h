@@ -16,6 +16,7 @@ FixStyle(mpm/fluid,FixMpmFluid)
 
 #include "fix.h"
 
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -89,6 +90,7 @@ class FixMpmFluid : public Fix {
   mpm::ShapeKind shape = mpm::ShapeKind::QuadraticBSpline;
   mpm::Eos eos;
   double viscosity = 0.0;
+  double pmin = -HUGE_VAL;     // cavitation pressure: no tension below it
   Transfer transfer = TR_FLIP;  // the text's MUSL: FLIP velocity (8-40), grid velocity for x (8-41)
   double flip_alpha = 1.0;      // FLIP fraction of a FLIP/PIC blend
   bool musl = true;
