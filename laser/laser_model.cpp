@@ -493,6 +493,12 @@ Result Drill::run() {
                    fmt(c.tau_m * G_.t_scale) + " s > pulse " + fmt(cfg_.tp) + " s";
     res_.T_peak = cfg_.mat.Tm + G_.dT * premelt_temperature(G_, 0.0, 0.0, tau_p);
   }
+  if (res_.status == "ok" && nodes_.back().molten) {
+    res_.status = "truncated";
+    res_.message = "the melt zone reaches the last node (xi = " + fmt(nodes_.back().xi) +
+                   "; melting would reach xi = " + fmt(res_.xi_melt_edge) +
+                   "): removed volume and energy are cut at --xi-max";
+  }
   if (res_.status == "ok") {
     // A finished run whose safeguards fired is reported, not passed off as ok.
     const double imb = (res_.energy.sum() - res_.energy.laser_exact) / res_.energy.laser_exact;
