@@ -323,6 +323,12 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       std::vector<std::string> *list = &out_point_fields;
       while (iarg < narg) {
         if (strcmp(arg[iarg], "grid") == 0 && list == &out_point_fields) {
+          // 'grid' starts the grid-field list only if a grid field follows;
+          // otherwise it is the fix's own 'grid' keyword
+          bool gfield = false;
+          if (iarg + 1 < narg)
+            for (const char *f : kGridFields) gfield = gfield || strcmp(arg[iarg + 1], f) == 0;
+          if (!gfield) break;
           list = &out_grid_fields;
           ++iarg;
           continue;
@@ -572,17 +578,21 @@ void FixMpmFluid::setup(int) {
 ------------------------------------------------------------------------- */
 
 double FixMpmFluid::stable_dt() {
-  double loc[2] = {0.0, eos.rho0};  // max |v|, max density
+  // max |v|, max density, -min density
+  double loc[3] = {0.0, eos.rho0, -eos.rho0};
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!is_point(i)) continue;
     const double *v = atom->v[i];
     loc[0] = std::max(loc[0], std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
     loc[1] = std::max(loc[1], pdata[i][C_RHO]);
+    loc[2] = std::max(loc[2], -pdata[i][C_RHO]);
   }
-  double glob[2];
-  MPI_Allreduce(loc, glob, 2, MPI_DOUBLE, MPI_MAX, world);
-  // Sound speed: largest over the reference and the densest point (Tait stiffens).
-  const double c = std::sqrt(std::max(eos.sound_speed_sq(eos.rho0), eos.sound_speed_sq(glob[1])));
+  double glob[3];
+  MPI_Allreduce(loc, glob, 3, MPI_DOUBLE, MPI_MAX, world);
+  // Sound speed: largest over the density range (Tait stiffens under
+  // compression, the linear law under tension).
+  c_max = std::sqrt(std::max(eos.sound_speed_sq(glob[1]), eos.sound_speed_sq(-glob[2])));
+  const double c = c_max;
   const double dt_ac = mpm::acoustic_dt_limit(cfl, gspec.dx, c, glob[0]);
   const double dt_visc = mpm::viscous_dt_limit(gspec.dx, eos.rho0, viscosity, domain->dimension);
   return std::min(dt_ac, dt_visc);
@@ -603,7 +613,7 @@ void FixMpmFluid::check_timestep(bool at_setup) {
     os.precision(4);
     os << "Fix mpm/fluid: timestep " << dt << " exceeds the largest stable time step " << dt_stable_last
        << " (acoustic limit cfl*dx/(c+|v|max) with cfl = " << cfl << ", dx = " << gspec.dx
-       << ", c = " << std::sqrt(eos.sound_speed_sq(eos.rho0))
+       << ", c = " << c_max
        << ", or viscous limit dx^2 rho/(2 dim eta)); reduce the timestep to " << dt_stable_last
        << " or use keyword 'subcycle yes'" << (at_setup ? "" : " (limit reached during the run)");
     error->all(FLERR, os.str().c_str());

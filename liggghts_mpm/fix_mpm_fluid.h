@@ -145,6 +145,7 @@ class FixMpmFluid : public Fix {
   std::vector<double> velgrad;  // velocity gradient at the points, for the stress update
   int nsub_last = 1;
   double dt_stable_last = 0.0;
+  double c_max = 0.0;           // sound speed used by the last time-step check
 
   // cached global outputs
   bigint vector_step = -1;
