@@ -233,3 +233,14 @@ TEST(LaserCases, ImplicitMeltUpdateAgreesWithExplicit) {
   EXPECT_NEAR(rb.depth_center / re.depth_center, 1.0, 2e-3);
   EXPECT_LT(std::fabs(rb.energy.sum() / rb.energy.laser_exact - 1.0), 0.01);
 }
+
+TEST(LaserCases, GridCuttingTheMeltZoneIsReported) {
+  Config c = with(7.5e10, FlowModel::Conduction, 100e-6);
+  c.xi_max = 1.0;  // the melt zone reaches xi = 2.18 at 7.5e10 W/m2
+  const Result r = run_simulation(c);
+  EXPECT_EQ(r.status, "truncated");
+  EXPECT_NE(r.message.find("--xi-max"), std::string::npos);
+  const Result full = run_simulation(with(7.5e10, FlowModel::Conduction, 100e-6));
+  EXPECT_EQ(full.status, "ok");
+  EXPECT_LT(r.volume_removed, full.volume_removed);
+}
