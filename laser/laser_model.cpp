@@ -132,13 +132,14 @@ bool Drill::solve_melt_flow() {
     }
   }
   double Q1 = 0, Q2 = 0, Q3 = 0, Q4 = 0;
-  for (int i = first; i < N; ++i) {
+  // trapezoid rule from the axis (the integrals of (4-20)/(4-24) start at 0)
+  for (int i = (first == 1 ? 0 : first); i < N; ++i) {
     const Node& n = nodes_[i];
     if (!n.molten || !(n.g > 0.0)) continue;
     const double x = n.xi, g = n.g;
     double a, b, c;
     flow_residual_coefficients(profile, Pr, x, g, dpdx[i], a, b, c);
-    const double w = (i == N - 1) ? 0.5 * cfg_.dxi : cfg_.dxi;
+    const double w = (i == 0 || i == N - 1) ? 0.5 * cfg_.dxi : cfg_.dxi;
     // W(A) = 2 int a^2 A^3 + 3 int ab A^2 + int (b^2 + 2ac) A + int bc, i.e. (4-20)/(4-24)
     Q1 += 2.0 * a * a * w;
     Q2 += -3.0 * a * b * w;
