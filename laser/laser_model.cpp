@@ -298,7 +298,8 @@ void Drill::advance_interfaces(double ta, double tb) {
     double dS2 = melting_rate(G_, Cc, grad_n, J, n.itf.grad_bottom, cfg_.moving_origin);
     if (dS2 < 0.0) {
       ++res_.melt_rate_clamps;
-      E.clamp_defect += -drive * qscale_s * n.area * dtn * G_.t_scale;
+      // the solid demand booked below exceeds what the melt delivers by -drive
+      E.clamp_defect += drive * qscale_s * n.area * dtn * G_.t_scale;
       dS2 = 0.0;
     }
     double dS1 = recession_rate(G_, n.xi, n.itf);

@@ -38,7 +38,7 @@ struct Energy {  // J, over the pulse
   double vapour_latent = 0;    // rho h_lv * j_v M/rho, flux from (3-15), (3-17)
   double vapour_kinetic = 0;   // 1/2 j_v M V_v^2, (3-13), (3-17)
   double flow_advected = 0;    // k_l (grad_top - grad_bottom): carried sideways by the flow
-  double clamp_defect = 0;     // energy lost where ds2/dt < 0 was clamped to 0
+  double clamp_defect = 0;     // (< 0) solid demand not delivered where ds2/dt < 0 was clamped to 0
   double sum() const {
     return solid_premelt + solid_conduction + solid_preheat + melt_latent + vapour_latent +
            vapour_kinetic + flow_advected + clamp_defect;

@@ -75,16 +75,22 @@ TEST(LaserCases, L1PremeltingSurfaceTemperatureAndOnsetTime) {
 // energy of the vapour (from (3-15), (3-17), not from (3-25)) + heat carried
 // sideways by the melt flow; the beam is integrated analytically over the disk.
 TEST(LaserCases, L3EnergyBalanceOverThePulse) {
-  for (FlowModel m : {FlowModel::Conduction, FlowModel::RisingFall, FlowModel::Rising}) {
+  // the shifted solid clamps dS2 < 0 right after onset: the clamp term is exercised
+  const std::pair<FlowModel, SolidModel> cases[] = {{FlowModel::Conduction, SolidModel::Exact},
+                                                    {FlowModel::RisingFall, SolidModel::Exact},
+                                                    {FlowModel::Rising, SolidModel::Exact},
+                                                    {FlowModel::RisingFall, SolidModel::Shifted}};
+  for (const auto& [m, solid] : cases) {
     Config c = with(7.5e10, m);
+    c.solid = solid;
     const Result r = run_simulation(c);
     ASSERT_EQ(r.status, "ok");
     const Energy& e = r.energy;
     const double imbalance = (e.sum() - e.laser_exact) / e.laser_exact;
-    std::printf("[ L3 ] %-10s laser %.4f J: solid %.4f + preheat %.4f + melt %.4f + vapour %.4f + kinetic %.4f + flow %.2e"
-                " -> imbalance %.2e\n",
-                to_string(m), e.laser_exact, e.solid_premelt + e.solid_conduction, e.solid_preheat,
-                e.melt_latent, e.vapour_latent, e.vapour_kinetic, e.flow_advected, imbalance);
+    std::printf("[ L3 ] %-10s %-7s laser %.4f J: solid %.4f + preheat %.4f + melt %.4f + vapour %.4f + kinetic %.4f"
+                " + flow %.2e + clamp %.2e -> imbalance %.2e\n",
+                to_string(m), to_string(solid), e.laser_exact, e.solid_premelt + e.solid_conduction, e.solid_preheat,
+                e.melt_latent, e.vapour_latent, e.vapour_kinetic, e.flow_advected, e.clamp_defect, imbalance);
     EXPECT_LT(std::fabs(imbalance), 0.01);
     // the vapour latent heat from the flux law agrees with the vaporized volume
     const double from_volume = c.mat.rho * c.mat.hlv * r.volume_vaporized;
