@@ -133,6 +133,37 @@ void FixMpmFluid::bad_arg(const char *keyword, const char *expected, const char 
 }
 
 /* ----------------------------------------------------------------------
+   numeric keywords, each declared once: target, valid range, what to say
+------------------------------------------------------------------------- */
+
+const FixMpmFluid::ScalarKeyword *FixMpmFluid::find_scalar(const char *kw) {
+  // lo/hi: bounds; open_lo/open_hi: bound excluded
+  static const ScalarKeyword table[] = {
+      {"cell", &FixMpmFluid::cell_size, 0.0, HUGE_VAL, true, true, "a positive cell size (length)"},
+      {"density", &FixMpmFluid::rho0_arg, 0.0, HUGE_VAL, true, true, "a positive reference density"},
+      {"bulk", &FixMpmFluid::bulk_arg, 0.0, HUGE_VAL, true, true, "a positive bulk modulus (pressure)"},
+      {"viscosity", &FixMpmFluid::viscosity, 0.0, HUGE_VAL, false, true, "a non-negative dynamic viscosity"},
+      {"damping", &FixMpmFluid::damping, 0.0, HUGE_VAL, false, true, "a damping rate (1/time) >= 0"},
+      {"cfl", &FixMpmFluid::cfl, 0.0, 1.0, true, false, "a CFL number in (0,1]"},
+      {"mass_threshold", &FixMpmFluid::mass_threshold, 0.0, 1.0, false, true,
+       "a fraction of the point mass in [0,1)"},
+  };
+  for (const ScalarKeyword &k : table)
+    if (strcmp(k.name, kw) == 0) return &k;
+  return nullptr;
+}
+
+void FixMpmFluid::parse_scalar(const ScalarKeyword &k, const char *s) {
+  double v;
+  const bool ok = parse_double(s, v) && (k.open_lo ? v > k.lo : v >= k.lo) && (k.open_hi ? v < k.hi : v <= k.hi);
+  if (!ok) bad_arg(k.name, k.expected, s);
+  this->*(k.target) = v;
+  gspec.dx = cell_size;
+  eos.rho0 = rho0_arg;
+  eos.K = bulk_arg;
+}
+
+/* ----------------------------------------------------------------------
    fix ID group mpm/fluid keyword value ...
 ------------------------------------------------------------------------- */
 
@@ -143,17 +174,16 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
   auto need = [&](int iarg, int n, const char *kw, const char *what) {
     if (iarg + n >= narg) bad_arg(kw, what, nullptr);
   };
-  auto positive = [&](const char *kw, const char *s, double &v) {
-    if (!parse_double(s, v) || v <= 0.0) bad_arg(kw, "a positive number", s);
-  };
 
   int iarg = 3;
   while (iarg < narg) {
     const char *kw = arg[iarg];
-    if (strcmp(kw, "cell") == 0) {
-      need(iarg, 1, kw, "the cell size (length units)");
-      positive(kw, arg[iarg + 1], gspec.dx);
-      have_cell = true;
+    if (const ScalarKeyword *sk = find_scalar(kw)) {
+      need(iarg, 1, kw, sk->expected);
+      parse_scalar(*sk, arg[iarg + 1]);
+      if (strcmp(kw, "cell") == 0) have_cell = true;
+      if (strcmp(kw, "density") == 0) have_density = true;
+      if (strcmp(kw, "bulk") == 0) have_bulk = true;
       iarg += 2;
     } else if (strcmp(kw, "grid") == 0) {
       need(iarg, 6, kw, "six bounds xlo xhi ylo yhi zlo zhi");
@@ -163,21 +193,6 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
         if (gbounds[2 * d + 1] <= gbounds[2 * d]) bad_arg(kw, "hi > lo in every dimension", arg[iarg + 2 + 2 * d]);
       grid_bounds_given = true;
       iarg += 7;
-    } else if (strcmp(kw, "density") == 0) {
-      need(iarg, 1, kw, "the reference density (mass/volume)");
-      positive(kw, arg[iarg + 1], eos.rho0);
-      have_density = true;
-      iarg += 2;
-    } else if (strcmp(kw, "bulk") == 0) {
-      need(iarg, 1, kw, "the bulk modulus (pressure units)");
-      positive(kw, arg[iarg + 1], eos.K);
-      have_bulk = true;
-      iarg += 2;
-    } else if (strcmp(kw, "viscosity") == 0) {
-      need(iarg, 1, kw, "the dynamic viscosity");
-      if (!parse_double(arg[iarg + 1], viscosity) || viscosity < 0.0)
-        bad_arg(kw, "a non-negative number", arg[iarg + 1]);
-      iarg += 2;
     } else if (strcmp(kw, "eos") == 0) {
       need(iarg, 1, kw, "'linear' or 'tait gamma'");
       if (strcmp(arg[iarg + 1], "linear") == 0) {
@@ -261,24 +276,9 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       else if (!parse_double(arg[iarg + 1], pmin))
         bad_arg(kw, "the lowest (cavitation) pressure, a number or 'none'", arg[iarg + 1]);
       iarg += 2;
-    } else if (strcmp(kw, "damping") == 0) {
-      need(iarg, 1, kw, "a damping rate (1/time) >= 0");
-      if (!parse_double(arg[iarg + 1], damping) || damping < 0.0)
-        bad_arg(kw, "a damping rate (1/time) >= 0", arg[iarg + 1]);
-      iarg += 2;
-    } else if (strcmp(kw, "cfl") == 0) {
-      need(iarg, 1, kw, "a CFL number in (0,1]");
-      if (!parse_double(arg[iarg + 1], cfl) || cfl <= 0.0 || cfl > 1.0)
-        bad_arg(kw, "a CFL number in (0,1]", arg[iarg + 1]);
-      iarg += 2;
     } else if (strcmp(kw, "subcycle") == 0) {
       need(iarg, 1, kw, "'yes' or 'no'");
       if (!parse_yesno(arg[iarg + 1], subcycle)) bad_arg(kw, "'yes' or 'no'", arg[iarg + 1]);
-      iarg += 2;
-    } else if (strcmp(kw, "mass_threshold") == 0) {
-      need(iarg, 1, kw, "a fraction of the point mass in [0,1)");
-      if (!parse_double(arg[iarg + 1], mass_threshold) || mass_threshold < 0.0 || mass_threshold >= 1.0)
-        bad_arg(kw, "a fraction of the point mass in [0,1)", arg[iarg + 1]);
       iarg += 2;
     } else if (strcmp(kw, "fill") == 0) {
       need(iarg, 6, kw, "'region-ID nx ny nz type T'");
@@ -1069,18 +1069,14 @@ int FixMpmFluid::modify_param(int narg, char **arg) {
     gate.active = false;
     return 2;
   }
-  if (strcmp(arg[0], "damping") == 0) {
-    if (narg < 2 || !parse_double(arg[1], damping) || damping < 0.0)
-      bad_arg("fix_modify damping", "a damping rate (1/time) >= 0", narg < 2 ? nullptr : arg[1]);
-    return 2;
-  }
   if (strcmp(arg[0], "subcycle") == 0) {
     if (narg < 2 || !parse_yesno(arg[1], subcycle)) bad_arg("fix_modify subcycle", "'yes' or 'no'", narg < 2 ? nullptr : arg[1]);
     return 2;
   }
-  if (strcmp(arg[0], "cfl") == 0) {
-    if (narg < 2 || !parse_double(arg[1], cfl) || cfl <= 0.0 || cfl > 1.0)
-      bad_arg("fix_modify cfl", "a CFL number in (0,1]", narg < 2 ? nullptr : arg[1]);
+  if (strcmp(arg[0], "damping") == 0 || strcmp(arg[0], "cfl") == 0) {
+    const ScalarKeyword *sk = find_scalar(arg[0]);
+    if (narg < 2) bad_arg(arg[0], sk->expected, nullptr);
+    parse_scalar(*sk, arg[1]);
     return 2;
   }
   if (strcmp(arg[0], "boundary") == 0) {

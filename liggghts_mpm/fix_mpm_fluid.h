@@ -83,7 +83,19 @@ class FixMpmFluid : public Fix {
   };
   enum Transfer { TR_APIC, TR_PIC, TR_FLIP };
 
+  // numeric keywords: one table (find_scalar) says target, range and message
+  struct ScalarKeyword {
+    const char *name;
+    double FixMpmFluid::*target;
+    double lo, hi;
+    bool open_lo, open_hi;
+    const char *expected;
+  };
+  static const ScalarKeyword *find_scalar(const char *kw);
+  void parse_scalar(const ScalarKeyword &k, const char *value);
+
   // settings
+  double cell_size = 0.0, rho0_arg = 1000.0, bulk_arg = 2.2e9;  // copied into gspec / eos
   mpm::GridSpec gspec;
   bool grid_bounds_given = false;
   double gbounds[6];

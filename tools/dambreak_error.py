@@ -34,6 +34,19 @@ def read_csv(path):
     return {n: vals[:, i] for i, n in enumerate(names)}
 
 
+def input_defaults(path):
+    """'variable NAME index VALUE' lines of a LIGGGHTS input, as a dict of strings ({} if missing)."""
+    import re
+    out = {}
+    if os.path.exists(path):
+        with open(path) as f:
+            for ln in f:
+                m = re.match(r"\s*variable\s+(\w+)\s+index\s+(\S+)", ln)
+                if m:
+                    out[m.group(1)] = m.group(2)
+    return out
+
+
 def load_reference():
     return (read_csv(find_data("martin_moyce_1952_square_front.csv")),
             read_csv(find_data("martin_moyce_1952_square_height.csv")))

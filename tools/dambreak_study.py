@@ -54,17 +54,6 @@ def say(*args):
         print(*args, flush=True)
 
 
-def input_defaults(path):
-    """'variable NAME index VALUE' lines of the input file, as a dict of strings."""
-    out = {}
-    with open(path) as f:
-        for ln in f:
-            m = re.match(r"\s*variable\s+(\w+)\s+index\s+(\S+)", ln)
-            if m:
-                out[m.group(1)] = m.group(2)
-    return out
-
-
 def bulk_label(k):
     s = "%.3g" % k
     return s.replace("e+0", "e").replace("e+", "e")
@@ -225,7 +214,7 @@ def write_outputs(rows, cases, a, width, g):
         f.write("Errors: RMS over the Martin & Moyce (1952) times inside the simulated range "
                 "(tend = %g, T = t sqrt(g/a)), in units of the column width a = %g m.\n" % (a.tend, width))
         f.write("Wall time: whole LIGGGHTS run including %s s settling, %s.\n\n"
-                % (input_defaults(a.input).get("tsettle", "0.3"),
+                % (dambreak_error.input_defaults(a.input).get("tsettle", "0.3"),
                    "one run at a time" if a.jobs == 1 else
                    "%d runs at a time (wall times are not comparable)" % a.jobs)
                 + ("MPI: %d ranks.\n\n" % a.np if a.np > 1 else "\n"))
@@ -355,7 +344,7 @@ def main():
         sys.exit("no executable %s (build: cmake -S . -B build -G Ninja && cmake --build build)" % a.exe)
     if a.np > 1 and shutil.which("mpirun") is None:
         sys.exit("--np %d needs mpirun" % a.np)
-    defaults = input_defaults(a.input)
+    defaults = dambreak_error.input_defaults(a.input)
     width, g = float(defaults.get("width", 4.0)), float(defaults.get("g", 9.81))
     os.makedirs(a.out, exist_ok=True)
     transfer = " ".join(a.transfer) if a.transfer else defaults.get("transfer", "flip")

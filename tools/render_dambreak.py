@@ -29,17 +29,6 @@ sys.path.insert(0, HERE)
 import dambreak_error  # noqa: E402
 
 
-def input_defaults(path):
-    out = {}
-    if os.path.exists(path):
-        with open(path) as f:
-            for ln in f:
-                m = re.match(r"\s*variable\s+(\w+)\s+index\s+(\S+)", ln)
-                if m:
-                    out[m.group(1)] = m.group(2)
-    return out
-
-
 def frames(rundir, prefix):
     import h5py
     out = []
@@ -88,7 +77,7 @@ def main():
     import matplotlib.pyplot as plt
     from matplotlib.gridspec import GridSpec
 
-    d = input_defaults(os.path.join(a.rundir, "in.dambreak"))
+    d = dambreak_error.input_defaults(os.path.join(a.rundir, "in.dambreak"))
     width = a.width or float(d.get("width", 4.0))
     height = float(d.get("height", width))
     length = a.length or float(d.get("length", 6 * width))

@@ -190,9 +190,9 @@ def case_bad_input(r):
     cases = [
         ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 colour red", "unknown keyword 'colour'"),
         ("cell 0.5 density 1000 bulk", "keyword 'bulk' expects"),
-        ("cell -0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1", "keyword 'cell' expects a positive number"),
-        ("cell 0.5 density 0 bulk 2e6 fill col 2 2 2 type 1", "keyword 'density' expects a positive number"),
-        ("cell 0.5 density 1000 bulk -1 fill col 2 2 2 type 1", "keyword 'bulk' expects a positive number"),
+        ("cell -0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1", "keyword 'cell' expects a positive cell size"),
+        ("cell 0.5 density 0 bulk 2e6 fill col 2 2 2 type 1", "keyword 'density' expects a positive reference density"),
+        ("cell 0.5 density 1000 bulk -1 fill col 2 2 2 type 1", "keyword 'bulk' expects a positive bulk modulus"),
         ("cell 0.3 density 1000 bulk 2e6 fill col 2 2 2 type 1", "divides the grid extent"),
         ("density 1000 bulk 2e6 fill col 2 2 2 type 1", "keyword 'cell' (cell size) is required"),
         (base + " eos tait 0.5", "'eos tait' expects an exponent"),
@@ -204,7 +204,9 @@ def case_bad_input(r):
         (base + " gate x 7 lower 0.1", "keyword 'gate' expects a position inside the grid"),
         ("cell 0.5 density 1000 bulk 2e6 fill nowhere 2 2 2 type 1", "'fill' expects an existing region ID"),
         (base + " output 10 out points velocity", "'output points' expects point fields"),
-        (base + " viscosity -1", "keyword 'viscosity' expects a non-negative number"),
+        (base + " cfl 0", "keyword 'cfl' expects a CFL number in (0,1]"),
+        (base + " mass_threshold 1", "keyword 'mass_threshold' expects a fraction of the point mass in [0,1)"),
+        (base + " viscosity -1", "keyword 'viscosity' expects a non-negative dynamic viscosity"),
     ]
     tmpl = """atom_style sphere
 atom_modify map array sort 0 0
