@@ -9,6 +9,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -84,7 +85,7 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   // the first setup and wipe the points' state; new rows are zeroed in grow_arrays
   time_integrate = 1;  // the fix moves its material points itself
   vector_flag = 1;
-  size_vector = 10;
+  size_vector = 13;
   global_freq = 1;
   extvector = 0;
   peratom_flag = 1;
@@ -147,6 +148,7 @@ const FixMpmFluid::ScalarKeyword *FixMpmFluid::find_scalar(const char *kw) {
       {"cfl", &FixMpmFluid::cfl, 0.0, 1.0, true, false, "a CFL number in (0,1]"},
       {"mass_threshold", &FixMpmFluid::mass_threshold, 0.0, 1.0, false, true,
        "a fraction of the point mass in [0,1)"},
+      {"theta_min", &FixMpmFluid::theta_min, 0.0, 1.0, true, true, "a lowest fluid fraction in (0,1)"},
   };
   for (const ScalarKeyword &k : table)
     if (strcmp(k.name, kw) == 0) return &k;
@@ -269,6 +271,22 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
         bad_arg(kw, "a release time >= 0 or 'never'", arg[iarg + 4]);
       gate.active = true;
       iarg += 5;
+    } else if (strcmp(kw, "couple") == 0) {
+      need(iarg, 1, kw, "the group-ID of the DEM grains");
+      couple_group = arg[iarg + 1];
+      if (group->find(arg[iarg + 1]) < 0) bad_arg(kw, "an existing group-ID of the DEM grains", arg[iarg + 1]);
+      coupled = true;
+      iarg += 2;
+    } else if (strcmp(kw, "drag") == 0) {
+      need(iarg, 1, kw, "a drag law ergun_wenyu, difelice or stokes");
+      if (!mpm::parse_drag_law(arg[iarg + 1], drag_law))
+        bad_arg(kw, "a drag law ergun_wenyu, difelice or stokes", arg[iarg + 1]);
+      iarg += 2;
+      if (iarg < narg && mpm::parse_drag_form(arg[iarg], drag_form)) ++iarg;
+    } else if (strcmp(kw, "cell_check") == 0) {
+      need(iarg, 1, kw, "'yes' or 'no'");
+      if (!parse_yesno(arg[iarg + 1], cell_check)) bad_arg(kw, "'yes' or 'no'", arg[iarg + 1]);
+      iarg += 2;
     } else if (strcmp(kw, "pmin") == 0) {
       need(iarg, 1, kw, "the lowest (cavitation) pressure, a number or 'none'");
       if (strcmp(arg[iarg + 1], "none") == 0)
@@ -344,6 +362,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
           static const char *keywords[] = {"cell", "grid", "density", "bulk", "viscosity", "eos", "shape",
                                            "transfer", "update", "antilock", "boundary", "gate", "damping",
                                            "cfl", "subcycle", "mass_threshold", "fill", "hydrostatic", "pmin",
+                                           "couple", "drag", "cell_check", "theta_min",
                                            "front", "height", "output"};
           bool is_kw = false;
           for (const char *k : keywords) is_kw = is_kw || strcmp(arg[iarg], k) == 0;
@@ -552,7 +571,51 @@ void FixMpmFluid::init() {
   if (anybad)
     error->all(FLERR, "Fix mpm/fluid: the fix group contains atoms that are not material points of this fix "
                       "(use a group of the fill type only)");
+  if (coupled) {
+    const int ig = group->find(couple_group.c_str());
+    if (ig < 0) bad_arg("couple", "an existing group-ID of the DEM grains", couple_group.c_str());
+    couple_groupbit = group->bitmask[ig];
+    double dmax = 0.0;
+    int overlap = 0;
+    for (int i = 0; i < atom->nlocal; ++i) {
+      if (!(atom->mask[i] & couple_groupbit)) continue;
+      if (is_point(i)) overlap = 1;
+      dmax = std::max(dmax, 2.0 * atom->radius[i]);
+    }
+    double gd = 0.0;
+    int go = 0;
+    MPI_Allreduce(&dmax, &gd, 1, MPI_DOUBLE, MPI_MAX, world);
+    MPI_Allreduce(&overlap, &go, 1, MPI_INT, MPI_MAX, world);
+    if (go) error->all(FLERR, "Fix mpm/fluid: keyword 'couple' expects a grain group without material points");
+    if (gd > gspec.dx) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: keyword 'cell' (" << gspec.dx << ") is smaller than the largest grain of group '"
+         << couple_group << "' (diameter " << gd << "); the volume fraction (8-11) needs cells that hold grains";
+      if (cell_check) {
+        os << " (keyword 'cell_check no' overrides)";
+        error->all(FLERR, os.str().c_str());
+      } else if (comm->me == 0)
+        error->warning(FLERR, os.str().c_str());
+    }
+  }
   vector_step = -1;
+}
+
+bool FixMpmFluid::is_grain(int i) const { return coupled && (atom->mask[i] & couple_groupbit) != 0; }
+
+// Integral of node i's shape function over the grid, in cell volumes per
+// dimension: 1 inside, less for nodes whose support crosses a wall (8-13).
+double FixMpmFluid::node_volume(int i, int j, int k) const {
+  const int idx[3] = {i, j, k};
+  double v = gspec.dx * gspec.dx * gspec.dx;
+  for (int d = 0; d < 3; ++d) {
+    if (gspec.periodic[d]) continue;
+    const int lo = idx[d], hi = gspec.ncell[d] - idx[d];  // distance in nodes to each wall
+    if (lo >= 0 && lo <= 2) v *= node_frac[d][0][lo];
+    else if (hi >= 0 && hi <= 2) v *= node_frac[d][1][hi];
+    else if (lo < 0 || hi < 0) v *= 0.0;
+  }
+  return v;
 }
 
 void FixMpmFluid::setup_grid() {
@@ -564,11 +627,33 @@ void FixMpmFluid::setup_grid() {
   g_vel.assign(grid.size() * 6, 0.0);
   g_cell.assign(grid.size() * 4, 0.0);
   if (musl) g_aux.assign(grid.size() * 3, 0.0);
+  if (coupled) {
+    g_cpl.assign(grid.size() * 3, 0.0);
+    g_st.assign(grid.size() * 6, 0.0);
+    g_rx.assign(grid.size() * 3, 0.0);
+    // node at distance n (in nodes) from a wall: integral of its shape function
+    // over the inside, by the midpoint rule on 4000 intervals of the support
+    for (int d = 0; d < 3; ++d)
+      for (int n = 0; n <= 2; ++n) {
+        double sum = 0.0;
+        const int nq = 4000;
+        for (int q = 0; q < nq; ++q) {
+          const double xi = -2.0 + 4.0 * (q + 0.5) / nq;  // offset from the node, cells
+          if (n + xi < 0.0) continue;                     // outside the wall
+          mpm::Shape1D sh;
+          mpm::shape_eval(shape, n + xi, sh);
+          const int a = n - sh.base;
+          if (a >= 0 && a < mpm::support(shape)) sum += sh.w[a] * 4.0 / nq;
+        }
+        node_frac[d][0][n] = node_frac[d][1][n] = sum;
+      }
+  }
   grid_ready = true;
 }
 
 void FixMpmFluid::setup(int) {
   setup_grid();
+  if (coupled && !theta_initialized) init_theta();
   check_timestep(true);
   if (out_every > 0 && update->ntimestep % out_every == 0) write_output();
 }
@@ -653,13 +738,25 @@ void FixMpmFluid::pre_final_integrate() {
   }
   check_timestep(false);
   const double h = update->dt / nsub_last;
+  if (coupled) grain_force.assign(3 * static_cast<std::size_t>(atom->nlocal), 0.0);
   for (int s = 0; s < nsub_last; ++s) substep(h);
+  if (coupled) {
+    // fluid force on the grains (mean over the sub-steps), for final_integrate
+    for (int k = 0; k < atom->nlocal; ++k) {
+      if (!is_grain(k)) continue;
+      for (int d = 0; d < 3; ++d) {
+        atom->f[k][d] += grain_force[3 * k + d];
+        pdata[k][C_FGRAIN + d] = grain_force[3 * k + d];
+      }
+    }
+  }
   vector_step = -1;
 }
 
 void FixMpmFluid::substep(double h) {
   compute_shapes();
   particles_to_grid();
+  if (coupled) couple_fluid_grains(h);
   update_grid(h);
   grid_to_particles(h);
   if (musl) remap_velocity_musl();
@@ -674,39 +771,44 @@ void FixMpmFluid::compute_shapes() {
     vpic.resize(3 * static_cast<std::size_t>(nlocal));
     velgrad.resize(9 * static_cast<std::size_t>(nlocal));
   }
-  const int ns = mpm::support(shape);
   double **x = atom->x;
-  const double inv = 1.0 / gspec.dx;
-  const mpm::IndexBox &pb = grid.patch();
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
-    PointShape &ps = shapes[i];
-    for (int d = 0; d < 3; ++d) {
-      const double xi = (x[i][d] - gspec.origin[d]) * inv;
-      if (!gspec.periodic[d] && (xi < 0.0 || xi > gspec.ncell[d])) {
-        std::ostringstream os;
-        os << "Fix mpm/fluid: material point " << atom->tag[i] << " at (" << x[i][0] << ", " << x[i][1]
-           << ", " << x[i][2] << ") left the grid in " << "xyz"[d] << " [" << gspec.origin[d] << ", "
-           << gspec.upper(d) << "] at step " << update->ntimestep
-           << " (enlarge 'grid' or check for an unstable run)";
-        fail_one(os.str());
-      }
-      mpm::Shape1D s;
-      mpm::shape_eval(shape, xi, s);
-      ps.base[d] = s.base;
-      for (int a = 0; a < 3; ++a) {
-        ps.w[d][a] = s.w[a];
-        ps.dw[d][a] = s.dw[a] * inv;
-      }
-      if (s.base < pb.lo[d] || s.base + ns - 1 > pb.hi[d]) {
-        std::ostringstream os;
-        os << "Fix mpm/fluid: material point " << atom->tag[i] << " at (" << x[i][0] << ", " << x[i][1]
-           << ", " << x[i][2] << ") is outside the grid patch of rank " << comm->me
-           << "; it moved too far between re-neighbourings (use neigh_modify every 1 check yes)";
-        fail_one(os.str());
-      }
+    if (!shape_of(x[i], shapes[i])) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: material point " << atom->tag[i] << " at (" << x[i][0] << ", " << x[i][1] << ", "
+         << x[i][2] << ") left the grid [" << gspec.origin[0] << ", " << gspec.upper(0) << "] x ["
+         << gspec.origin[1] << ", " << gspec.upper(1) << "] x [" << gspec.origin[2] << ", " << gspec.upper(2)
+         << "] at step " << update->ntimestep << " (enlarge 'grid' or check for an unstable run)";
+      fail_one(os.str());
     }
   }
+}
+
+// Weights and gradients of the nodes around x; false if x is outside the grid.
+bool FixMpmFluid::shape_of(const double *x, PointShape &ps) {
+  const int ns = mpm::support(shape);
+  const double inv = 1.0 / gspec.dx;
+  const mpm::IndexBox &pb = grid.patch();
+  for (int d = 0; d < 3; ++d) {
+    const double xi = (x[d] - gspec.origin[d]) * inv;
+    if (!gspec.periodic[d] && (xi < 0.0 || xi > gspec.ncell[d])) return false;
+    mpm::Shape1D s;
+    mpm::shape_eval(shape, xi, s);
+    ps.base[d] = s.base;
+    for (int a = 0; a < 3; ++a) {
+      ps.w[d][a] = s.w[a];
+      ps.dw[d][a] = s.dw[a] * inv;
+    }
+    if (s.base < pb.lo[d] || s.base + ns - 1 > pb.hi[d]) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: atom at (" << x[0] << ", " << x[1] << ", " << x[2]
+         << ") is outside the grid patch of rank " << comm->me
+         << "; it moved too far between re-neighbourings (use neigh_modify every 1 check yes)";
+      fail_one(os.str());
+    }
+  }
+  return true;
 }
 
 // Loops over the nodes a point touches; fn(node index, w, grad w[3], offset (x_i - x_p)[3]).
@@ -767,6 +869,130 @@ void FixMpmFluid::particles_to_grid() {
   grid.reverse_sum(g_p2g.data(), 7);
 }
 
+/* Two-way coupling with the DEM grains (chapter 7.2, 8.1-8.2):
+   fluid fraction at the nodes from the grains' volumes (8-11)-(8-14) and at
+   the points (8-16); fluid velocity, fraction and pressure gradient at each
+   grain; drag (7-7) integrated exactly over the sub-step for the two-body
+   system grain + fluid seen by it (stable for any stiffness) and the
+   pressure-gradient force -V grad p (7-15); the reaction of both goes to the
+   nodes with the same shape functions (8-25), (8-26), so momentum is kept. */
+void FixMpmFluid::couple_fluid_grains(double h) {
+  const int ns = mpm::support(shape);
+  const int nlocal = atom->nlocal;
+  double **x = atom->x, **v = atom->v;
+  double *radius = atom->radius, *rmass = atom->rmass;
+  if (static_cast<int>(grain_shapes.size()) < nlocal) grain_shapes.resize(nlocal);
+
+  // solid volume of the grains, pressure and volume of the points, at the nodes
+  std::fill(g_cpl.begin(), g_cpl.end(), 0.0);
+  for (int k = 0; k < nlocal; ++k) {
+    if (!is_grain(k)) continue;
+    PointShape &ps = grain_shapes[k];
+    if (!shape_of(x[k], ps)) {
+      ps.base[0] = INT_MIN;  // outside the grid: no fluid there
+      continue;
+    }
+    const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
+    const double *xp = x[k];
+    MPM_FOR_NODES(ps, xp, { g_cpl[3 * n] += w * Vk; })
+  }
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const PointShape &ps = shapes[i];
+    const double V = pdata[i][C_VOL], p = pdata[i][C_P];
+    const double *xp = x[i];
+    MPM_FOR_NODES(ps, xp, {
+      g_cpl[3 * n + 1] += w * V * p;
+      g_cpl[3 * n + 2] += w * V;
+    })
+  }
+  grid.reverse_sum(g_cpl.data(), 3);
+
+  const double mmin = mass_threshold * point_mass_ref;
+  const mpm::IndexBox &ob = grid.owned();
+  for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
+    for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
+      for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) {
+        const std::size_t n = grid.index(i, j, k);
+        const double *c = &g_cpl[3 * n];
+        const double *g = &g_p2g[7 * n];
+        double *st = &g_st[6 * n];
+        const double Vj = node_volume(i, j, k);
+        st[3] = Vj > 0.0 ? std::min(1.0, std::max(theta_min, 1.0 - c[0] / Vj)) : 1.0;  // (8-11), (8-14)
+        st[4] = c[2] > 0.0 ? c[1] / c[2] : 0.0;
+        st[5] = g[0];
+        for (int d = 0; d < 3; ++d) st[d] = g[0] > mmin ? g[1 + d] / g[0] : 0.0;
+      }
+  grid.forward(g_st.data(), 6);
+
+  // fluid fraction at the points (8-16)
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const PointShape &ps = shapes[i];
+    const double *xp = x[i];
+    double th = 0.0;
+    MPM_FOR_NODES(ps, xp, { th += w * g_st[6 * n + 3]; })
+    pdata[i][C_THETA] = th;
+  }
+
+  // forces on the grains, reaction on the nodes
+  std::fill(g_rx.begin(), g_rx.end(), 0.0);
+  const double mu = viscosity, rho_f = eos.rho0;
+  for (int k = 0; k < nlocal; ++k) {
+    if (!is_grain(k) || grain_shapes[k].base[0] == INT_MIN) continue;
+    const PointShape &ps = grain_shapes[k];
+    const double *xp = x[k];
+    // inv_mf = sum_j S_j^2 / M_j: the fluid velocity at the grain changes by
+    // -J inv_mf when the impulse -J is spread with the weights S_j
+    double u[3] = {0, 0, 0}, gradp[3] = {0, 0, 0}, th = 0.0, wet = 0.0, inv_mf = 0.0;
+    MPM_FOR_NODES(ps, xp, {
+      const double *st = &g_st[6 * n];
+      th += w * st[3];
+      for (int d = 0; d < 3; ++d) gradp[d] += st[4] * gw[d];
+      if (st[5] > mmin) {  // only nodes that hold fluid carry its velocity
+        wet += w;
+        inv_mf += w * w / st[5];
+        for (int d = 0; d < 3; ++d) u[d] += w * st[d];
+      }
+    })
+    double F[3] = {0, 0, 0};
+    if (wet > 0.0) {
+      for (int d = 0; d < 3; ++d) u[d] /= wet;
+      const double d_k = 2.0 * radius[k];
+      const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
+      const double urel = std::sqrt((u[0] - v[k][0]) * (u[0] - v[k][0]) + (u[1] - v[k][1]) * (u[1] - v[k][1]) +
+                                    (u[2] - v[k][2]) * (u[2] - v[k][2]));
+      // a grain partly out of the fluid feels the wet share of the drag
+      const double K = wet * mpm::drag_coefficient(drag_law, drag_form, rho_f, mu, d_k, Vk, th, urel, theta_min);
+      double J[3];
+      mpm::drag_exchange_impulse(v[k], u, rmass[k], 1.0 / inv_mf, K, h, J);
+      for (int d = 0; d < 3; ++d) F[d] = J[d] / h - Vk * gradp[d];  // drag + (7-15)
+    }
+    for (int d = 0; d < 3; ++d) grain_force[3 * static_cast<std::size_t>(k) + d] += F[d] / nsub_last;
+    MPM_FOR_NODES(ps, xp, {
+      for (int d = 0; d < 3; ++d) g_rx[3 * n + d] -= w * F[d];
+    })
+  }
+  grid.reverse_sum(g_rx.data(), 3);
+}
+
+// At the first run with grains: the fluid present in a point's volume is
+// theta of it, so its mass is reduced once to theta rho0 V (8-3): otherwise
+// the grains' volume would be counted as compressed fluid.
+void FixMpmFluid::init_theta() {
+  compute_shapes();
+  particles_to_grid();
+  grain_force.assign(3 * static_cast<std::size_t>(atom->nmax), 0.0);
+  couple_fluid_grains(update->dt);
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!is_point(i)) continue;
+    atom->rmass[i] *= pdata[i][C_THETA];
+    pdata[i][C_RHO] = atom->rmass[i] / (pdata[i][C_THETA] * pdata[i][C_VOL]);
+  }
+  std::fill(grain_force.begin(), grain_force.end(), 0.0);
+  theta_initialized = true;
+}
+
 // Wall, gate: velocity v of node (i,j,k) after the momentum update.
 void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k) {
   const int idx[3] = {i, j, k};
@@ -810,8 +1036,9 @@ void FixMpmFluid::update_grid(double h) {
         double vnew[3];
         for (int d = 0; d < 3; ++d) {
           gv[3 + d] = g[1 + d] * inv;
+          const double f = g[4 + d] + (coupled ? g_rx[3 * n + d] : 0.0);
           // damping is implicit in time so that any rate is stable
-          vnew[d] = (gv[3 + d] + h * g[4 + d] * inv) / (1.0 + h * damping);
+          vnew[d] = (gv[3 + d] + h * f * inv) / (1.0 + h * damping);
         }
         apply_grid_bc(vnew, i, j, k);
         for (int d = 0; d < 3; ++d) gv[d] = vnew[d];
@@ -1041,6 +1268,13 @@ void FixMpmFluid::compute_outputs() {
       mx[2] = std::max(mx[2], x[i][height_axis] + 0.5 * spacing[height_axis]);
     mx[3] = std::max(mx[3], pdata[i][C_P]);
   }
+  double fg[3] = {0, 0, 0}, gfg[3];
+  if (coupled)
+    for (int k = 0; k < nlocal; ++k)
+      if (is_grain(k))
+        for (int d = 0; d < 3; ++d) fg[d] += pdata[k][C_FGRAIN + d];
+  MPI_Allreduce(fg, gfg, 3, MPI_DOUBLE, MPI_SUM, world);
+  for (int d = 0; d < 3; ++d) vector_cache[10 + d] = gfg[d];
   double gsum[4], gmx[4];
   MPI_Allreduce(sum, gsum, 4, MPI_DOUBLE, MPI_SUM, world);
   MPI_Allreduce(mx, gmx, 4, MPI_DOUBLE, MPI_MAX, world);
@@ -1257,7 +1491,7 @@ int FixMpmFluid::size_restart(int) { return NCOL + 1; }
 int FixMpmFluid::maxsize_restart() { return NCOL + 1; }
 
 namespace {
-enum { R_FILLED, R_PMASS, R_SP0, R_SP1, R_SP2, R_CLAMPED, R_GATE, R_NSUB, R_COUNT };
+enum { R_FILLED, R_PMASS, R_SP0, R_SP1, R_SP2, R_CLAMPED, R_GATE, R_NSUB, R_THETA, R_COUNT };
 }
 
 void FixMpmFluid::write_restart(FILE *fp) {
@@ -1268,6 +1502,7 @@ void FixMpmFluid::write_restart(FILE *fp) {
   list[R_CLAMPED] = n_clamped;
   list[R_GATE] = gate.active ? 1.0 : 0.0;
   list[R_NSUB] = nsub_last;
+  list[R_THETA] = theta_initialized ? 1.0 : 0.0;
   if (comm->me == 0) {
     int size = R_COUNT * sizeof(double);
     fwrite(&size, sizeof(int), 1, fp);
@@ -1284,6 +1519,7 @@ void FixMpmFluid::restart(char *buf) {
   // a gate removed before the restart stays removed
   if (list[R_GATE] == 0.0) gate.active = false;
   nsub_last = static_cast<int>(list[R_NSUB]);
+  theta_initialized = list[R_THETA] != 0.0;
 }
 
 double FixMpmFluid::memory_usage() {

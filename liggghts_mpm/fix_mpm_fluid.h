@@ -21,6 +21,7 @@ FixStyle(mpm/fluid,FixMpmFluid)
 #include <string>
 #include <vector>
 
+#include "mpm/drag_laws.h"
 #include "mpm/fluid_laws.h"
 #include "mpm/grid.h"
 #include "mpm/shape_functions.h"
@@ -40,7 +41,8 @@ class FixMpmFluid : public Fix {
     C_AFF = 9,     // APIC affine velocity / velocity gradient, row-major (9), 1/s
     C_THETA = 18,  // fluid volume fraction at the point
     C_FLAG = 19,   // 1 for a point set up by this fix
-    NCOL = 20
+    C_FGRAIN = 20, // on a grain of the coupled group: force of the fluid on it (3), N
+    NCOL = 23
   };
 
   FixMpmFluid(class LAMMPS *, int, char **);
@@ -72,6 +74,7 @@ class FixMpmFluid : public Fix {
   double stable_dt();
 
  private:
+  struct PointShape { int base[3]; double w[3][3]; double dw[3][3]; };
   enum BcKind { BC_NOSLIP, BC_FREESLIP, BC_PARTIAL };
   struct Face { int kind = BC_NOSLIP; double sticky = 1.0; };
   struct Gate {
@@ -127,6 +130,22 @@ class FixMpmFluid : public Fix {
   int hydro_axis = 2;
   double hydro_surface = 0.0, hydro_g = 9.81;
 
+  // two-way coupling with DEM grains (keyword couple); none of it runs without
+  bool coupled = false;
+  std::string couple_group;
+  int couple_groupbit = 0;
+  mpm::DragLaw drag_law = mpm::DragLaw::ErgunWenYu;
+  mpm::DragForm drag_form = mpm::DragForm::Consistent;
+  double theta_min = mpm::kDragThetaMin;
+  bool cell_check = true;
+  bool theta_initialized = false;  // fluid mass reduced by the grains' volume once (restart)
+  std::vector<PointShape> grain_shapes;
+  std::vector<double> g_cpl;    // per node: solid volume, V p, V of the points (P2G)
+  std::vector<double> g_st;     // per node: u(3), theta, p, m (forwarded)
+  std::vector<double> g_rx;     // per node: reaction force of the grains on the fluid (3)
+  std::vector<double> grain_force;  // per local grain: fluid force averaged over sub-steps (3)
+  double node_frac[3][2][3];    // integral of a boundary node's shape function inside the grid (per dim, side, node)
+
   // output
   int out_every = 0;
   std::string out_prefix;
@@ -151,7 +170,6 @@ class FixMpmFluid : public Fix {
   std::vector<double> g_vel;    // per node: v_new(3), v_old(3)
   std::vector<double> g_cell;   // per cell (keyed by its low node): V, V div, theta V, m
   std::vector<double> g_aux;    // per node: remapped momentum (MUSL)
-  struct PointShape { int base[3]; double w[3][3]; double dw[3][3]; };
   std::vector<PointShape> shapes;
   std::vector<double> vpic;     // grid (PIC) velocity at the points, for the position update
   std::vector<double> velgrad;  // velocity gradient at the points, for the stress update
@@ -161,7 +179,7 @@ class FixMpmFluid : public Fix {
 
   // cached global outputs
   bigint vector_step = -1;
-  double vector_cache[12];
+  double vector_cache[16];
 
   void parse_args(int narg, char **arg);
   void parse_face(const char *name, const char *kind, int narg, char **arg, int &iarg);
@@ -170,6 +188,11 @@ class FixMpmFluid : public Fix {
   void check_timestep(bool at_setup);
   void substep(double h);
   void compute_shapes();
+  bool shape_of(const double *x, PointShape &ps);
+  void couple_fluid_grains(double h);
+  void init_theta();
+  double node_volume(int i, int j, int k) const;
+  bool is_grain(int i) const;
   void particles_to_grid();
   void update_grid(double h);
   void apply_grid_bc(double *v, int nodeidx_i, int nodeidx_j, int nodeidx_k);
