@@ -384,6 +384,8 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
   if (!have_cell) error->all(FLERR, "Fix mpm/fluid: keyword 'cell' (cell size) is required");
   if (!have_density) error->all(FLERR, "Fix mpm/fluid: keyword 'density' (reference density) is required");
   if (!have_bulk) error->all(FLERR, "Fix mpm/fluid: keyword 'bulk' (bulk modulus) is required");
+  if (coupled && !(viscosity > 0.0))
+    error->all(FLERR, "Fix mpm/fluid: keyword 'couple' needs keyword 'viscosity' > 0 (the drag laws scale with it)");
 
   // Grid: cubic cells fitted exactly into the bounds.
   double b[6];
@@ -611,9 +613,9 @@ double FixMpmFluid::node_volume(int i, int j, int k) const {
   for (int d = 0; d < 3; ++d) {
     if (gspec.periodic[d]) continue;
     const int lo = idx[d], hi = gspec.ncell[d] - idx[d];  // distance in nodes to each wall
-    if (lo >= 0 && lo <= 2) v *= node_frac[d][0][lo];
-    else if (hi >= 0 && hi <= 2) v *= node_frac[d][1][hi];
-    else if (lo < 0 || hi < 0) v *= 0.0;
+    if (lo >= -1 && lo <= 2) v *= node_frac[d][0][lo + 1];
+    else if (hi >= -1 && hi <= 2) v *= node_frac[d][1][hi + 1];
+    else if (lo < -1 || hi < -1) v *= 0.0;
   }
   return v;
 }
@@ -631,10 +633,11 @@ void FixMpmFluid::setup_grid() {
     g_cpl.assign(grid.size() * 3, 0.0);
     g_st.assign(grid.size() * 6, 0.0);
     g_rx.assign(grid.size() * 3, 0.0);
+    g_dr.assign(grid.size() * kDr, 0.0);
     // node at distance n (in nodes) from a wall: integral of its shape function
     // over the inside, by the midpoint rule on 4000 intervals of the support
     for (int d = 0; d < 3; ++d)
-      for (int n = 0; n <= 2; ++n) {
+      for (int n = -1; n <= 2; ++n) {
         double sum = 0.0;
         const int nq = 4000;
         for (int q = 0; q < nq; ++q) {
@@ -645,7 +648,7 @@ void FixMpmFluid::setup_grid() {
           const int a = n - sh.base;
           if (a >= 0 && a < mpm::support(shape)) sum += sh.w[a] * 4.0 / nq;
         }
-        node_frac[d][0][n] = node_frac[d][1][n] = sum;
+        node_frac[d][0][n + 1] = node_frac[d][1][n + 1] = sum;
       }
   }
   grid_ready = true;
@@ -935,45 +938,97 @@ void FixMpmFluid::couple_fluid_grains(double h) {
     pdata[i][C_THETA] = th;
   }
 
-  // forces on the grains, reaction on the nodes
-  std::fill(g_rx.begin(), g_rx.end(), 0.0);
+  // Drag, exchanged node by node. Each grain k has the coefficient K_k
+  // (frozen over the sub-step) and touches node j with weight S_jk. At every
+  // node the fluid (mass M_j, velocity u_j) and the grains' share of it
+  // (coefficient K_j = sum_k S_jk K_k, mass sum_k S_jk m_k, K-weighted mean
+  // velocity) exchange the backward-Euler two-body impulse J_j over h: the
+  // slip decays without overshoot however many grains share the node (a dense
+  // bed) and however stiff the drag, the fluid loses exactly what the grains
+  // gain, and a grain advanced by LIGGGHTS' velocity Verlet keeps the right
+  // terminal slip (see mpm::drag_implicit_impulse). Grain k
+  // receives the share S_jk K_k / K_j of J_j. The pressure-gradient force
+  // (7-15) is explicit (not stiff); its reaction goes to the nodes too.
   const double mu = viscosity, rho_f = eos.rho0;
+  const std::size_t ng = static_cast<std::size_t>(nlocal);
+  std::vector<double> Kgrain(ng, 0.0);
+  std::fill(g_dr.begin(), g_dr.end(), 0.0);
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes[k].base[0] == INT_MIN) continue;
     const PointShape &ps = grain_shapes[k];
     const double *xp = x[k];
-    // inv_mf = sum_j S_j^2 / M_j: the fluid velocity at the grain changes by
-    // -J inv_mf when the impulse -J is spread with the weights S_j
-    double u[3] = {0, 0, 0}, gradp[3] = {0, 0, 0}, th = 0.0, wet = 0.0, inv_mf = 0.0;
+    double u[3] = {0, 0, 0}, gradp[3] = {0, 0, 0}, th = 0.0, wet = 0.0;
     MPM_FOR_NODES(ps, xp, {
       const double *st = &g_st[6 * n];
       th += w * st[3];
       for (int d = 0; d < 3; ++d) gradp[d] += st[4] * gw[d];
       if (st[5] > mmin) {  // only nodes that hold fluid carry its velocity
         wet += w;
-        inv_mf += w * w / st[5];
         for (int d = 0; d < 3; ++d) u[d] += w * st[d];
       }
     })
-    double F[3] = {0, 0, 0};
+    const double d_k = 2.0 * radius[k];
+    const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
+    double K = 0.0;
     if (wet > 0.0) {
       for (int d = 0; d < 3; ++d) u[d] /= wet;
-      const double d_k = 2.0 * radius[k];
-      const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
       const double urel = std::sqrt((u[0] - v[k][0]) * (u[0] - v[k][0]) + (u[1] - v[k][1]) * (u[1] - v[k][1]) +
                                     (u[2] - v[k][2]) * (u[2] - v[k][2]));
-      // a grain partly out of the fluid feels the wet share of the drag
-      const double K = wet * mpm::drag_coefficient(drag_law, drag_form, rho_f, mu, d_k, Vk, th, urel, theta_min);
-      double J[3];
-      mpm::drag_exchange_impulse(v[k], u, rmass[k], 1.0 / inv_mf, K, h, J);
-      for (int d = 0; d < 3; ++d) F[d] = J[d] / h - Vk * gradp[d];  // drag + (7-15)
+      K = mpm::drag_coefficient(drag_law, drag_form, rho_f, mu, d_k, Vk, th, urel, theta_min);
     }
-    for (int d = 0; d < 3; ++d) grain_force[3 * static_cast<std::size_t>(k) + d] += F[d] / nsub_last;
+    Kgrain[k] = K;
+    double Fp[3];
+    mpm::pressure_gradient_force(Vk, gradp, Fp);
+    if (wet <= 0.0) Fp[0] = Fp[1] = Fp[2] = 0.0;
+    for (int d = 0; d < 3; ++d) grain_force[3 * static_cast<std::size_t>(k) + d] += Fp[d] / nsub_last;
+    // the grain's other accelerations (contacts, gravity: atom->f so far, and
+    // the pressure force), held over the step in the exact exchange
+    double ak[3];
+    for (int d = 0; d < 3; ++d) ak[d] = (atom->f[k][d] + Fp[d]) / rmass[k];
     MPM_FOR_NODES(ps, xp, {
-      for (int d = 0; d < 3; ++d) g_rx[3 * n + d] -= w * F[d];
+      double *q = &g_dr[kDr * n];
+      q[0] += w * K;
+      for (int d = 0; d < 3; ++d) q[1 + d] += w * K * v[k][d];
+      q[4] += w * rmass[k];
+      for (int d = 0; d < 3; ++d) q[5 + d] -= w * Fp[d];
+      for (int d = 0; d < 3; ++d) q[8 + d] += w * K * ak[d];
     })
   }
-  grid.reverse_sum(g_rx.data(), 3);
+  grid.reverse_sum(g_dr.data(), kDr);
+
+  // node-wise exact exchange; the fluid's share of it stays on the owner
+  std::fill(g_rx.begin(), g_rx.end(), 0.0);
+  for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
+    for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
+      for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) {
+        const std::size_t n = grid.index(i, j, k);
+        double *q = &g_dr[kDr * n];
+        const double *st = &g_st[6 * n];
+        double *rx = &g_rx[3 * n];
+        double J[3] = {0, 0, 0};
+        if (q[0] > 0.0 && st[5] > mmin) {
+          const double vg[3] = {q[1] / q[0], q[2] / q[0], q[3] / q[0]};
+          const double ag[3] = {q[8] / q[0], q[9] / q[0], q[10] / q[0]};
+          const double *f = &g_p2g[7 * n + 4];
+          const double af[3] = {(f[0] + q[5]) / st[5], (f[1] + q[6]) / st[5], (f[2] + q[7]) / st[5]};
+          mpm::drag_implicit_impulse(vg, st, q[4], st[5], q[0], h, J, ag, af);
+        }
+        for (int d = 0; d < 3; ++d) {
+          rx[d] = q[5 + d] - J[d] / h;                    // force on the fluid
+          q[1 + d] = q[0] > 0.0 ? J[d] / q[0] : 0.0;      // impulse per unit K, to the grains
+        }
+      }
+  grid.forward(g_dr.data(), kDr);
+  for (int k = 0; k < nlocal; ++k) {
+    if (!is_grain(k) || grain_shapes[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
+    const PointShape &ps = grain_shapes[k];
+    const double *xp = x[k];
+    double J[3] = {0, 0, 0};
+    MPM_FOR_NODES(ps, xp, {
+      for (int d = 0; d < 3; ++d) J[d] += w * Kgrain[k] * g_dr[kDr * n + 1 + d];
+    })
+    for (int d = 0; d < 3; ++d) grain_force[3 * static_cast<std::size_t>(k) + d] += J[d] / h / nsub_last;
+  }
 }
 
 // At the first run with grains: the fluid present in a point's volume is

@@ -142,9 +142,11 @@ class FixMpmFluid : public Fix {
   std::vector<PointShape> grain_shapes;
   std::vector<double> g_cpl;    // per node: solid volume, V p, V of the points (P2G)
   std::vector<double> g_st;     // per node: u(3), theta, p, m (forwarded)
-  std::vector<double> g_rx;     // per node: reaction force of the grains on the fluid (3)
+  std::vector<double> g_rx;     // per node: force of the grains on the fluid (3), owned nodes
+  static constexpr int kDr = 11;
+  std::vector<double> g_dr;     // per node: sum S K, sum S K v (3), sum S m, pressure reaction (3), sum S K a (3)
   std::vector<double> grain_force;  // per local grain: fluid force averaged over sub-steps (3)
-  double node_frac[3][2][3];    // integral of a boundary node's shape function inside the grid (per dim, side, node)
+  double node_frac[3][2][4];    // integral inside the grid of the shape function of a node -1..2 nodes from a wall
 
   // output
   int out_every = 0;

@@ -203,6 +203,22 @@ inline void drag_exchange_impulse(const double v_p[3], const double u_f[3], doub
   }
 }
 
+// Backward-Euler drag impulse over dt for the same two-body system:
+// w' = (w0 + (a_f - a_p) dt) / (1 + lambda dt), J = K dt w'. Unconditionally
+// stable and, unlike the exact exponential, it keeps the right steady slip
+// w = (a_f - a_p) / (K (1/m_p + 1/m_f)) when the particle is advanced by a
+// leapfrog / velocity-Verlet integrator that holds the force over the step
+// (LIGGGHTS' nve/sphere): the particle then follows exactly backward Euler.
+inline void drag_implicit_impulse(const double v_p[3], const double u_f[3], double m_p, double m_f,
+                                  double K, double dt, double J[3],
+                                  const double a_p[3] = nullptr, const double a_f[3] = nullptr) {
+  const double x = K * drag_inverse_reduced_mass(m_p, m_f) * dt;
+  for (int a = 0; a < 3; ++a) {
+    const double da = (a_f ? a_f[a] : 0.0) - (a_p ? a_p[a] : 0.0);
+    J[a] = K * dt * ((u_f[a] - v_p[a]) + da * dt) / (1.0 + x);
+  }
+}
+
 // ---------------------------------------------------------------- settling (C1)
 // Terminal settling velocity [m/s] of a sphere of diameter d and density
 // rho_p in quiescent fluid (rho_f, mu) under gravity g > 0 and buoyancy, at

@@ -318,8 +318,13 @@ def case_settling(r):
     check(abs(vn) < 0.02 * vt, "a sphere of the fluid's density stays (nearly) at rest: |v| < 2 % of v_t")
     d, _ = r.run("settling/light", inp, {"rhop": 1.0})
     vl = read_csv(os.path.join(d, "settling.csv"))["v_z"][-1]
-    print(f"  lighter sphere (rho 1): v_z = {vl:.2e} m/s")
+    # rise speed: the same balance with the density difference reversed
+    _, vrise = schiller_naumann_settling(1e-4, 19.0, 10.0, 1e-5, 9.81, 0.01)
+    print(f"  lighter sphere (rho 1): v_z = {vl:.2e} m/s; relative to the neutral one {vl - vn:.2e}, "
+          f"isolated rise speed {vrise:.2e} m/s")
     check(vl > 0.0, "a lighter sphere rises")
+    check(abs((vl - vn) - vrise) < 0.25 * vrise,
+          "its rise relative to the neutral sphere within 25 % of the isolated value")
 
 
 def main():
