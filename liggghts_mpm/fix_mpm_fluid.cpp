@@ -574,6 +574,9 @@ void FixMpmFluid::init() {
     error->all(FLERR, "Fix mpm/fluid: the fix group contains atoms that are not material points of this fix "
                       "(use a group of the fill type only)");
   if (coupled) {
+    integrated_groupbits = 0;
+    for (int m = 0; m < modify->nfix; ++m)
+      if (modify->fix[m] != this && modify->fix[m]->time_integrate) integrated_groupbits |= modify->fix[m]->groupbit;
     const int ig = group->find(couple_group.c_str());
     if (ig < 0) bad_arg("couple", "an existing group-ID of the DEM grains", couple_group.c_str());
     couple_groupbit = group->bitmask[ig];
@@ -985,6 +988,9 @@ void FixMpmFluid::couple_fluid_grains(double h) {
     // the pressure force), held over the step in the exact exchange
     double ak[3];
     for (int d = 0; d < 3; ++d) ak[d] = (atom->f[k][d] + Fp[d]) / rmass[k];
+    // a grain no integrator moves (a fixed bed) has, for the exchange, infinite mass
+    const bool mobile = (atom->mask[k] & integrated_groupbits) != 0;
+    if (!mobile) ak[0] = ak[1] = ak[2] = 0.0;
     MPM_FOR_NODES(ps, xp, {
       double *q = &g_dr[kDr * n];
       q[0] += w * K;
@@ -992,6 +998,7 @@ void FixMpmFluid::couple_fluid_grains(double h) {
       q[4] += w * rmass[k];
       for (int d = 0; d < 3; ++d) q[5 + d] -= w * Fp[d];
       for (int d = 0; d < 3; ++d) q[8 + d] += w * K * ak[d];
+      if (!mobile) q[11] += w * K;
     })
   }
   grid.reverse_sum(g_dr.data(), kDr);
@@ -1011,7 +1018,8 @@ void FixMpmFluid::couple_fluid_grains(double h) {
           const double ag[3] = {q[8] / q[0], q[9] / q[0], q[10] / q[0]};
           const double *f = &g_p2g[7 * n + 4];
           const double af[3] = {(f[0] + q[5]) / st[5], (f[1] + q[6]) / st[5], (f[2] + q[7]) / st[5]};
-          mpm::drag_implicit_impulse(vg, st, q[4], st[5], q[0], h, J, ag, af);
+          const double mg = q[11] > 0.0 ? HUGE_VAL : q[4];
+          mpm::drag_implicit_impulse(vg, st, mg, st[5], q[0], h, J, ag, af);
         }
         for (int d = 0; d < 3; ++d) {
           rx[d] = q[5 + d] - J[d] / h;                    // force on the fluid

@@ -143,8 +143,9 @@ class FixMpmFluid : public Fix {
   std::vector<double> g_cpl;    // per node: solid volume, V p, V of the points (P2G)
   std::vector<double> g_st;     // per node: u(3), theta, p, m (forwarded)
   std::vector<double> g_rx;     // per node: force of the grains on the fluid (3), owned nodes
-  static constexpr int kDr = 11;
-  std::vector<double> g_dr;     // per node: sum S K, sum S K v (3), sum S m, pressure reaction (3), sum S K a (3)
+  static constexpr int kDr = 12;
+  int integrated_groupbits = 0;   // groups moved by some integrator: other grains are fixed
+  std::vector<double> g_dr;     // per node: sum S K, sum S K v (3), sum S m, pressure reaction (3), sum S K a (3), sum S K of fixed grains
   std::vector<double> grain_force;  // per local grain: fluid force averaged over sub-steps (3)
   double node_frac[3][2][4];    // integral inside the grid of the shape function of a node -1..2 nodes from a wall
 
