@@ -23,10 +23,8 @@ done
 
 bash "$top/tools/install_deps.sh"
 exe="$top/build/liggghts_mpm"
-if [ ! -x "$exe" ]; then
-  echo "== building $exe"
-  bash "$top/tools/build.sh"
-fi
+echo "== building (incremental)"
+bash "$top/tools/build.sh" >/dev/null
 
 input="$top/inputs/dambreak/in.dambreak"
 work="$top/inputs/dambreak/out-demo"
