@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Dam-break demo (square water column, Martin & Moyce 1952) at MPM16.
 # Run from the repository top:  tools/demo.sh [--out dambreak-demo.png] [--cells 16]
-# Builds build/liggghts_mpm if it is missing, runs inputs/dambreak/in.dambreak in
+# Builds (incrementally), runs inputs/dambreak/in.dambreak in
 # inputs/dambreak/out-demo/ with HDF5 snapshots (~8 frames, one at gate removal),
 # writes the picture (snapshots coloured by |v| + front and wall height against
 # the experiment) and prints the RMS errors. Takes ~10 s after the build.
