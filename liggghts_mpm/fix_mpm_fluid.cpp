@@ -26,6 +26,7 @@
 #include "group.h"
 #include "memory.h"
 #include "modify.h"
+#include "fix_property_atom.h"
 #include "neighbor.h"
 #include "region.h"
 #include "update.h"
@@ -459,6 +460,16 @@ void FixMpmFluid::post_create() {
   // After a read_restart the points exist already (recent_restart is set
   // when our global state came from the restart file).
   if (!recent_restart && !fill_region.empty()) fill_points();
+  // The fluid force on each grain as the per-atom vector 'dragforce', the
+  // property/atom convention of LIGGGHTS/CFDEM (reused if the input made it).
+  if (coupled) {
+    const char *args[] = {"dragforce", "all", "property/atom", "dragforce", "vector", "yes", "no", "no",
+                          "0", "0", "0"};
+    fix_dragforce = static_cast<FixPropertyAtom *>(
+        modify->find_fix_property("dragforce", "property/atom", "vector", 3, 0, style, false));
+    if (!fix_dragforce)
+      fix_dragforce = modify->add_fix_property_atom(11, const_cast<char **>(args), style);
+  }
 }
 
 void FixMpmFluid::fill_points() {
@@ -753,6 +764,7 @@ void FixMpmFluid::pre_final_integrate() {
       for (int d = 0; d < 3; ++d) {
         atom->f[k][d] += grain_force[3 * k + d];
         pdata[k][C_FGRAIN + d] = grain_force[3 * k + d];
+        if (fix_dragforce) fix_dragforce->array_atom[k][d] = grain_force[3 * k + d];
       }
     }
   }

@@ -147,6 +147,7 @@ class FixMpmFluid : public Fix {
   int integrated_groupbits = 0;   // groups moved by some integrator: other grains are fixed
   std::vector<double> g_dr;     // per node: sum S K, sum S K v (3), sum S m, pressure reaction (3), sum S K a (3), sum S K of fixed grains
   std::vector<double> grain_force;  // per local grain: fluid force averaged over sub-steps (3)
+  class FixPropertyAtom *fix_dragforce = nullptr;  // per-atom vector 'dragforce' (LIGGGHTS convention)
   double node_frac[3][2][4];    // integral inside the grid of the shape function of a node -1..2 nodes from a wall
 
   // output
