@@ -156,6 +156,18 @@ const FixMpmFluid::ScalarKeyword *FixMpmFluid::find_scalar(const char *kw) {
   return nullptr;
 }
 
+// yes/no keywords
+bool FixMpmFluid::*FixMpmFluid::find_flag(const char *kw) {
+  static const struct { const char *name; bool FixMpmFluid::*flag; } table[] = {
+      {"antilock", &FixMpmFluid::antilock},
+      {"subcycle", &FixMpmFluid::subcycle},
+      {"cell_check", &FixMpmFluid::cell_check},
+  };
+  for (const auto &k : table)
+    if (strcmp(k.name, kw) == 0) return k.flag;
+  return nullptr;
+}
+
 void FixMpmFluid::parse_scalar(const ScalarKeyword &k, const char *s) {
   double v;
   const bool ok = parse_double(s, v) && (k.open_lo ? v > k.lo : v >= k.lo) && (k.open_hi ? v < k.hi : v <= k.hi);
@@ -187,6 +199,10 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       if (strcmp(kw, "cell") == 0) have_cell = true;
       if (strcmp(kw, "density") == 0) have_density = true;
       if (strcmp(kw, "bulk") == 0) have_bulk = true;
+      iarg += 2;
+    } else if (bool FixMpmFluid::*flag = find_flag(kw)) {
+      need(iarg, 1, kw, "'yes' or 'no'");
+      if (!parse_yesno(arg[iarg + 1], this->*flag)) bad_arg(kw, "'yes' or 'no'", arg[iarg + 1]);
       iarg += 2;
     } else if (strcmp(kw, "grid") == 0) {
       need(iarg, 6, kw, "six bounds xlo xhi ylo yhi zlo zhi");
@@ -248,10 +264,6 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       else
         bad_arg(kw, "'musl' or 'usl'", arg[iarg + 1]);
       iarg += 2;
-    } else if (strcmp(kw, "antilock") == 0) {
-      need(iarg, 1, kw, "'yes' or 'no'");
-      if (!parse_yesno(arg[iarg + 1], antilock)) bad_arg(kw, "'yes' or 'no'", arg[iarg + 1]);
-      iarg += 2;
     } else if (strcmp(kw, "boundary") == 0) {
       need(iarg, 2, kw, "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip' or 'partial f'");
       parse_face(arg[iarg + 1], arg[iarg + 2], narg, arg, iarg);
@@ -284,20 +296,12 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
         bad_arg(kw, "a drag law ergun_wenyu, difelice or stokes", arg[iarg + 1]);
       iarg += 2;
       if (iarg < narg && mpm::parse_drag_form(arg[iarg], drag_form)) ++iarg;
-    } else if (strcmp(kw, "cell_check") == 0) {
-      need(iarg, 1, kw, "'yes' or 'no'");
-      if (!parse_yesno(arg[iarg + 1], cell_check)) bad_arg(kw, "'yes' or 'no'", arg[iarg + 1]);
-      iarg += 2;
     } else if (strcmp(kw, "pmin") == 0) {
       need(iarg, 1, kw, "the lowest (cavitation) pressure, a number or 'none'");
       if (strcmp(arg[iarg + 1], "none") == 0)
         pmin = -HUGE_VAL;
       else if (!parse_double(arg[iarg + 1], pmin))
         bad_arg(kw, "the lowest (cavitation) pressure, a number or 'none'", arg[iarg + 1]);
-      iarg += 2;
-    } else if (strcmp(kw, "subcycle") == 0) {
-      need(iarg, 1, kw, "'yes' or 'no'");
-      if (!parse_yesno(arg[iarg + 1], subcycle)) bad_arg(kw, "'yes' or 'no'", arg[iarg + 1]);
       iarg += 2;
     } else if (strcmp(kw, "fill") == 0) {
       need(iarg, 6, kw, "'region-ID nx ny nz type T'");
@@ -1378,8 +1382,8 @@ int FixMpmFluid::modify_param(int narg, char **arg) {
     gate.active = false;
     return 2;
   }
-  if (strcmp(arg[0], "subcycle") == 0) {
-    if (narg < 2 || !parse_yesno(arg[1], subcycle)) bad_arg("fix_modify subcycle", "'yes' or 'no'", narg < 2 ? nullptr : arg[1]);
+  if (bool FixMpmFluid::*flag = find_flag(arg[0])) {
+    if (narg < 2 || !parse_yesno(arg[1], this->*flag)) bad_arg(arg[0], "'yes' or 'no'", narg < 2 ? nullptr : arg[1]);
     return 2;
   }
   if (strcmp(arg[0], "damping") == 0 || strcmp(arg[0], "cfl") == 0) {

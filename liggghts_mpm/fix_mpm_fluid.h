@@ -96,6 +96,7 @@ class FixMpmFluid : public Fix {
   };
   static const ScalarKeyword *find_scalar(const char *kw);
   void parse_scalar(const ScalarKeyword &k, const char *value);
+  static bool FixMpmFluid::*find_flag(const char *kw);  // yes/no keywords
 
   // settings
   double cell_size = 0.0, rho0_arg = 1000.0, bulk_arg = 2.2e9;  // copied into gspec / eos

@@ -74,6 +74,8 @@ class MeshWalls {
   const std::vector<MeshWallSpec> &specs() const { return specs_; }
   // Offset used by push_back (length); 0 = 1e-3 * reach.
   void set_offset(double off) { offset_ = off; }
+  // Testing: false = every query scans all gathered triangles (no bins).
+  void set_use_bins(bool on) { use_bins_ = on; }
 
   struct Tri {
     double p[3][3];   // node positions
@@ -91,7 +93,7 @@ class MeshWalls {
     bool face;        // p lies strictly inside the triangle (face region)
   };
   static void closest_point(const Tri &t, const double x[3], Hit &h);
-  void bins_build();
+  void bins_build(const double box[6]);
   // Candidate triangles for a query ball (x, r); returns null if x lies outside the bins (then
   // every triangle is a candidate).
   const std::vector<int> *candidates(const double x[3]) const;
@@ -101,6 +103,7 @@ class MeshWalls {
   std::vector<MeshWallSpec> specs_;
   std::vector<Tri> tris_;
   double offset_ = 0.0;
+  bool use_bins_ = true;
   double margin_ = 0.0;
   // uniform bins over [blo_, blo_ + nb_*bsize_]
   double blo_[3] = {0, 0, 0}, bsize_ = 1.0;

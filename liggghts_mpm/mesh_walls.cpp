@@ -1,0 +1,572 @@
+// Fluid boundary conditions on LIGGGHTS wall meshes; see mesh_walls.h and docs/mesh_walls.md.
+#include "mesh_walls.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+// LIGGGHTS
+#include "domain.h"
+#include "fix.h"
+#include "fix_mesh_surface.h"
+#include "lammps.h"
+#include "modify.h"
+#include "multi_vector_container.h"
+#include "tri_mesh.h"
+
+using LAMMPS_NS::FixMeshSurface;
+using LAMMPS_NS::MultiVectorContainer;
+using LAMMPS_NS::TriMesh;
+
+namespace mpm {
+
+namespace {
+
+constexpr int kPack = 19;  // doubles per packed triangle: 9 positions, 9 velocities, mesh index
+
+inline double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline void sub3(const double *a, const double *b, double *c) {
+  c[0] = a[0] - b[0];
+  c[1] = a[1] - b[1];
+  c[2] = a[2] - b[2];
+}
+
+std::string fix_msg(const std::string &id, const std::string &what) {
+  return "mesh wall: fix ID '" + id + "': " + what;
+}
+
+// Velocity of the wall at barycentric weights b.
+inline void wall_velocity(const MeshWalls::Tri &t, const double b[3], double w[3]) {
+  for (int d = 0; d < 3; ++d) w[d] = b[0] * t.w[0][d] + b[1] * t.w[1][d] + b[2] * t.w[2][d];
+}
+
+// Relative velocity r = v - w: normal part along unit n -> max(0, r.n) (fluid side) or 0 (behind),
+// tangential part scaled by (1 - sticky).
+inline void constrain(double v[3], const double w[3], const double n[3], bool behind, double sticky) {
+  double r[3];
+  sub3(v, w, r);
+  const double rn = dot3(r, n);
+  const double rn_new = behind ? 0.0 : std::max(0.0, rn);
+  const double keep = 1.0 - sticky;
+  for (int d = 0; d < 3; ++d) {
+    const double rt = r[d] - rn * n[d];
+    v[d] = w[d] + rn_new * n[d] + keep * rt;
+  }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+MeshWalls::MeshWalls(LAMMPS_NS::LAMMPS *lmp, std::vector<MeshWallSpec> specs)
+    : lmp_(lmp), specs_(std::move(specs)) {
+  if (!lmp_) throw std::runtime_error("mesh wall: no LAMMPS instance");
+  for (size_t k = 0; k < specs_.size(); ++k) {
+    MeshWallSpec &s = specs_[k];
+    for (size_t j = 0; j < k; ++j)
+      if (specs_[j].fix_id == s.fix_id) throw std::runtime_error(fix_msg(s.fix_id, "given twice"));
+    switch (s.kind) {
+      case 0: s.sticky = 1.0; break;
+      case 1: s.sticky = 0.0; break;
+      case 2:
+        if (!(s.sticky >= 0.0 && s.sticky <= 1.0)) {
+          std::ostringstream m;
+          m << "sticky fraction " << s.sticky << " of a partial-slip wall must lie in [0,1]";
+          throw std::runtime_error(fix_msg(s.fix_id, m.str()));
+        }
+        break;
+      default:
+        throw std::runtime_error(fix_msg(s.fix_id, "unknown wall kind " + std::to_string(s.kind) +
+                                                       " (0 noslip, 1 freeslip, 2 partial)"));
+    }
+    if (s.side != SIDE_NORMAL && s.side != SIDE_OPPOSITE && s.side != SIDE_AUTO && s.side != SIDE_BOTH)
+      throw std::runtime_error(fix_msg(s.fix_id, "unknown fluid side " + std::to_string(s.side)));
+    resolve(static_cast<int>(k));  // throws with the reason
+  }
+}
+
+void *MeshWalls::resolve(int k) const {
+  const std::string &id = specs_[k].fix_id;
+  const int ifix = lmp_->modify->find_fix(id.c_str());
+  if (ifix < 0) throw std::runtime_error(fix_msg(id, "no such fix"));
+  LAMMPS_NS::Fix *f = lmp_->modify->fix[ifix];
+  auto *fm = dynamic_cast<FixMeshSurface *>(f);
+  if (!fm)
+    throw std::runtime_error(fix_msg(id, std::string("is a fix ") + (f->style ? f->style : "?") +
+                                             ", not a fix mesh/surface"));
+  if (!fm->triMesh() || fm->triMesh()->numNodes() != 3)
+    throw std::runtime_error(fix_msg(id, "has no triangle mesh"));
+  return fm;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Gathering
+
+void MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], double margin) {
+  MPI_Comm world = lmp_->world;
+  int me = 0, nprocs = 1;
+  MPI_Comm_rank(world, &me);
+  MPI_Comm_size(world, &nprocs);
+  margin_ = std::max(0.0, margin);
+
+  // everyone's box (patch widened by the margin); empty if lo > hi
+  double mybox[6];
+  for (int d = 0; d < 3; ++d) {
+    mybox[d] = patch_lo[d] - margin_;
+    mybox[3 + d] = patch_hi[d] + margin_;
+  }
+  std::vector<double> boxes(6 * nprocs);
+  MPI_Allgather(mybox, 6, MPI_DOUBLE, boxes.data(), 6, MPI_DOUBLE, world);
+
+  // periodic image shifts
+  const LAMMPS_NS::Domain *dom = lmp_->domain;
+  std::vector<double> shifts[3];
+  for (int d = 0; d < 3; ++d) {
+    shifts[d].push_back(0.0);
+    if (dom->periodicity[d]) {
+      shifts[d].push_back(-dom->prd[d]);
+      shifts[d].push_back(dom->prd[d]);
+    }
+  }
+
+  // pack my triangles for every rank whose box they (or an image) touch
+  std::vector<std::vector<double>> out(nprocs);
+  for (size_t k = 0; k < specs_.size(); ++k) {
+    auto *fm = static_cast<FixMeshSurface *>(resolve(static_cast<int>(k)));
+    TriMesh *m = fm->triMesh();
+    // A parallel mesh holds each triangle as local on exactly one rank. Before the first setup
+    // a mesh is not parallel yet and every rank holds all of it: rank 0 then speaks for all.
+    const bool parallel = m->isParallel();
+    if (!parallel && me != 0) continue;
+    const int nloc = m->sizeLocal();
+    MultiVectorContainer<double, 3, 3> *vel =
+        m->prop().getElementProperty<MultiVectorContainer<double, 3, 3>>("v");
+    const int nvel = vel ? vel->size() : 0;
+    for (int i = 0; i < nloc; ++i) {
+      double rec[kPack];
+      for (int j = 0; j < 3; ++j) {
+        m->node(i, j, &rec[3 * j]);
+        for (int d = 0; d < 3; ++d) rec[9 + 3 * j + d] = (i < nvel) ? (*vel)(i)[j][d] : 0.0;
+      }
+      rec[18] = static_cast<double>(k);
+      double lo[3], hi[3];
+      for (int d = 0; d < 3; ++d) {
+        lo[d] = std::min({rec[d], rec[3 + d], rec[6 + d]});
+        hi[d] = std::max({rec[d], rec[3 + d], rec[6 + d]});
+      }
+      for (int q = 0; q < nprocs; ++q) {
+        const double *bx = &boxes[6 * q];
+        if (bx[0] > bx[3] || bx[1] > bx[4] || bx[2] > bx[5]) continue;
+        for (double sx : shifts[0])
+          for (double sy : shifts[1])
+            for (double sz : shifts[2]) {
+              const double s[3] = {sx, sy, sz};
+              bool hit = true;
+              for (int d = 0; d < 3 && hit; ++d)
+                hit = lo[d] + s[d] <= bx[3 + d] && hi[d] + s[d] >= bx[d];
+              if (!hit) continue;
+              std::vector<double> &o = out[q];
+              const size_t at = o.size();
+              o.insert(o.end(), rec, rec + kPack);
+              for (int j = 0; j < 3; ++j)
+                for (int d = 0; d < 3; ++d) o[at + 3 * j + d] += s[d];
+            }
+      }
+    }
+  }
+
+  // exchange
+  std::vector<int> scount(nprocs), rcount(nprocs), sdisp(nprocs), rdisp(nprocs);
+  for (int q = 0; q < nprocs; ++q) scount[q] = static_cast<int>(out[q].size());
+  MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, world);
+  int stot = 0, rtot = 0;
+  for (int q = 0; q < nprocs; ++q) {
+    sdisp[q] = stot;
+    rdisp[q] = rtot;
+    stot += scount[q];
+    rtot += rcount[q];
+  }
+  std::vector<double> sbuf(std::max(stot, 1)), rbuf(std::max(rtot, 1));
+  for (int q = 0; q < nprocs; ++q) std::copy(out[q].begin(), out[q].end(), sbuf.begin() + sdisp[q]);
+  MPI_Alltoallv(sbuf.data(), scount.data(), sdisp.data(), MPI_DOUBLE, rbuf.data(), rcount.data(),
+                rdisp.data(), MPI_DOUBLE, world);
+
+  // unpack
+  tris_.clear();
+  tris_.reserve(rtot / kPack);
+  for (int at = 0; at + kPack <= rtot; at += kPack) {
+    Tri t;
+    const double *r = &rbuf[at];
+    for (int j = 0; j < 3; ++j)
+      for (int d = 0; d < 3; ++d) {
+        t.p[j][d] = r[3 * j + d];
+        t.w[j][d] = r[9 + 3 * j + d];
+      }
+    t.mesh = static_cast<int>(r[18]);
+    double e1[3], e2[3];
+    sub3(t.p[1], t.p[0], e1);
+    sub3(t.p[2], t.p[0], e2);
+    t.n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    t.n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    t.n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    const double a2 = std::sqrt(dot3(t.n, t.n));
+    const double l2 = std::max(dot3(e1, e1), dot3(e2, e2));
+    if (!(a2 > 1e-12 * l2) || l2 <= 0.0) continue;  // degenerate (zero area) triangle
+    for (int d = 0; d < 3; ++d) {
+      t.n[d] /= a2;
+      t.lo[d] = std::min({t.p[0][d], t.p[1][d], t.p[2][d]});
+      t.hi[d] = std::max({t.p[0][d], t.p[1][d], t.p[2][d]});
+    }
+    tris_.push_back(t);
+  }
+
+  // bins over my box
+  for (int d = 0; d < 3; ++d) {
+    blo_[d] = mybox[d];
+    nb_[d] = 0;
+  }
+  bins_.clear();
+  if (mybox[0] <= mybox[3] && mybox[1] <= mybox[4] && mybox[2] <= mybox[5]) bins_build(mybox);
+}
+
+void MeshWalls::bins_build(const double box[6]) {
+  // Bins of edge >= 2 margin (at most ~1e6 of them); a triangle goes into every bin that its
+  // bounding box widened by the margin overlaps and whose centre is within (half diagonal +
+  // margin) of its plane. Any triangle within 'margin' of a point of a bin is then in that bin.
+  double ext[3], vol = 1.0;
+  for (int d = 0; d < 3; ++d) {
+    ext[d] = std::max(box[3 + d] - box[d], 1e-300);
+    vol *= ext[d];
+  }
+  bsize_ = std::max({2.0 * margin_, std::cbrt(vol / 1.0e6), 1e-12 * std::max({ext[0], ext[1], ext[2]})});
+  size_t nbin = 1;
+  for (int d = 0; d < 3; ++d) {
+    blo_[d] = box[d];
+    nb_[d] = std::max(1, static_cast<int>(std::ceil(ext[d] / bsize_)));
+    nbin *= nb_[d];
+  }
+  bins_.assign(nbin, {});
+  const double half_diag = 0.5 * std::sqrt(3.0) * bsize_;
+  for (size_t i = 0; i < tris_.size(); ++i) {
+    const Tri &t = tris_[i];
+    int lo[3], hi[3];
+    bool out = false;
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = static_cast<int>(std::floor((t.lo[d] - margin_ - blo_[d]) / bsize_));
+      hi[d] = static_cast<int>(std::floor((t.hi[d] + margin_ - blo_[d]) / bsize_));
+      lo[d] = std::max(lo[d], 0);
+      hi[d] = std::min(hi[d], nb_[d] - 1);
+      if (lo[d] > hi[d]) out = true;
+    }
+    if (out) continue;
+    for (int k = lo[2]; k <= hi[2]; ++k)
+      for (int j = lo[1]; j <= hi[1]; ++j)
+        for (int ii = lo[0]; ii <= hi[0]; ++ii) {
+          const double c[3] = {blo_[0] + (ii + 0.5) * bsize_, blo_[1] + (j + 0.5) * bsize_,
+                               blo_[2] + (k + 0.5) * bsize_};
+          double d[3];
+          sub3(c, t.p[0], d);
+          if (std::fabs(dot3(d, t.n)) > half_diag + margin_) continue;
+          bins_[(static_cast<size_t>(k) * nb_[1] + j) * nb_[0] + ii].push_back(static_cast<int>(i));
+        }
+  }
+}
+
+const std::vector<int> *MeshWalls::candidates(const double x[3]) const {
+  if (bins_.empty() || !use_bins_) return nullptr;
+  int c[3];
+  for (int d = 0; d < 3; ++d) {
+    const double f = (x[d] - blo_[d]) / bsize_;
+    if (!(f >= 0.0) || f >= nb_[d]) return nullptr;
+    c[d] = static_cast<int>(f);
+  }
+  return &bins_[(static_cast<size_t>(c[2]) * nb_[1] + c[1]) * nb_[0] + c[0]];
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geometry
+
+// Closest point of triangle t to x, with barycentric weights; the case analysis over the
+// Voronoi regions of the vertices, edges and face of the triangle.
+void MeshWalls::closest_point(const Tri &t, const double x[3], Hit &h) {
+  const double *a = t.p[0], *b = t.p[1], *c = t.p[2];
+  double ab[3], ac[3], ap[3], bp[3], cp[3];
+  sub3(b, a, ab);
+  sub3(c, a, ac);
+  sub3(x, a, ap);
+  auto finish = [&](double wa, double wb, double wc, bool face) {
+    h.b[0] = wa;
+    h.b[1] = wb;
+    h.b[2] = wc;
+    h.face = face;
+    double dd = 0.0;
+    for (int d = 0; d < 3; ++d) {
+      h.p[d] = wa * a[d] + wb * b[d] + wc * c[d];
+      dd += (x[d] - h.p[d]) * (x[d] - h.p[d]);
+    }
+    h.dist2 = dd;
+  };
+  const double d1 = dot3(ab, ap), d2 = dot3(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return finish(1, 0, 0, false);
+  sub3(x, b, bp);
+  const double d3 = dot3(ab, bp), d4 = dot3(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return finish(0, 1, 0, false);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double s = d1 / (d1 - d3);
+    return finish(1 - s, s, 0, false);
+  }
+  sub3(x, c, cp);
+  const double d5 = dot3(ab, cp), d6 = dot3(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return finish(0, 0, 1, false);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double s = d2 / (d2 - d6);
+    return finish(1 - s, 0, s, false);
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double s = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return finish(0, 1 - s, s, false);
+  }
+  const double inv = 1.0 / (va + vb + vc);
+  const double sb = vb * inv, sc = vc * inv;
+  finish(1 - sb - sc, sb, sc, true);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Grid nodes
+
+bool MeshWalls::apply(const double x[3], double vel[3], double reach) const {
+  if (tris_.empty()) return false;
+  const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
+  const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+  const double r2 = reach * reach;
+
+  constexpr int kMax = 64;
+  int idx[kMax];
+  Hit hits[kMax];
+  int nh = 0;
+  for (int c = 0; c < ncand && nh < kMax; ++c) {
+    const int i = cand ? (*cand)[c] : c;
+    const Tri &t = tris_[i];
+    if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
+        x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
+      continue;
+    closest_point(t, x, hits[nh]);
+    if (hits[nh].dist2 > r2) continue;
+    idx[nh++] = i;
+  }
+  if (nh == 0) return false;
+
+  bool touched = false;
+  for (size_t k = 0; k < specs_.size(); ++k) {
+    // face-region hits of this mesh take precedence over its edge/vertex hits (so that the
+    // internal edges of a flat or gently curved wall add no constraint)
+    bool any_face = false;
+    for (int h = 0; h < nh; ++h)
+      if (tris_[idx[h]].mesh == static_cast<int>(k) && hits[h].face) any_face = true;
+    const int side = specs_[k].side;
+    const double sticky = specs_[k].sticky;
+    for (int h = 0; h < nh; ++h) {
+      const Tri &t = tris_[idx[h]];
+      if (t.mesh != static_cast<int>(k) || hits[h].face != any_face) continue;
+      double d[3], n[3], w[3];
+      sub3(x, hits[h].p, d);
+      bool behind = false;
+      if (any_face) {
+        const double s = dot3(d, t.n);
+        double sg;
+        if (side == SIDE_NORMAL) sg = 1.0;
+        else if (side == SIDE_OPPOSITE) sg = -1.0;
+        else sg = s >= 0.0 ? 1.0 : -1.0;  // both sides (or side not decided yet)
+        for (int q = 0; q < 3; ++q) n[q] = sg * t.n[q];
+        behind = sg * s < 0.0;
+      } else {
+        // beyond the triangle's edges: a rounded edge, normal from the closest point to the node
+        const double dl = std::sqrt(hits[h].dist2);
+        if (dl <= 1e-12 * reach) continue;
+        for (int q = 0; q < 3; ++q) n[q] = d[q] / dl;
+      }
+      wall_velocity(t, hits[h].b, w);
+      constrain(vel, w, n, behind, sticky);
+      touched = true;
+    }
+  }
+  return touched;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Material points
+
+bool MeshWalls::push_back(double x[3], double v[3], double reach, const double *x_old) const {
+  if (tris_.empty()) return false;
+  const double off = offset_ > 0.0 ? offset_ : 1e-3 * reach;
+  bool moved = false;
+
+  // (a) crossings of the segment x_old -> x
+  if (x_old) {
+    for (int iter = 0; iter < 4; ++iter) {
+      double seg[3];
+      sub3(x, x_old, seg);
+      const double len = std::sqrt(dot3(seg, seg));
+      if (len == 0.0) break;
+      const std::vector<int> *cand = (len <= margin_) ? candidates(x) : nullptr;
+      const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+      double best = 2.0, bq[3] = {0, 0, 0}, bn[3] = {0, 0, 0}, bb[3] = {0, 0, 0};
+      int bi = -1;
+      for (int c = 0; c < ncand; ++c) {
+        const int i = cand ? (*cand)[c] : c;
+        const Tri &t = tris_[i];
+        bool out = false;
+        for (int d = 0; d < 3 && !out; ++d)
+          out = std::max(x[d], x_old[d]) < t.lo[d] || std::min(x[d], x_old[d]) > t.hi[d];
+        if (out) continue;
+        double a0[3], a1[3];
+        sub3(x_old, t.p[0], a0);
+        sub3(x, t.p[0], a1);
+        const double sa = dot3(a0, t.n), sb = dot3(a1, t.n);
+        const int side = specs_[t.mesh].side;
+        double sg;
+        if (side == SIDE_NORMAL) sg = 1.0;
+        else if (side == SIDE_OPPOSITE) sg = -1.0;
+        else sg = sa >= 0.0 ? 1.0 : -1.0;
+        // only a move from the fluid side to the other side (or onto the plane) counts
+        if (!(sg * sa > 0.0 && sg * sb <= 0.0)) continue;
+        const double f = sa / (sa - sb);
+        if (f >= best) continue;
+        double q[3];
+        for (int d = 0; d < 3; ++d) q[d] = x_old[d] + f * seg[d];
+        Hit h;
+        closest_point(t, q, h);
+        const double tol = 1e-10 * (len + std::sqrt(dot3(a0, a0)));
+        if (h.dist2 > tol * tol) continue;  // q lies outside the triangle
+        best = f;
+        bi = i;
+        for (int d = 0; d < 3; ++d) {
+          bq[d] = q[d];
+          bn[d] = sg * t.n[d];
+          bb[d] = h.b[d];
+        }
+      }
+      if (bi < 0) break;
+      double w[3];
+      wall_velocity(tris_[bi], bb, w);
+      // back to the fluid side, no closer than 'off' to the plane (and not beyond x_old)
+      double sa_old[3];
+      sub3(x_old, bq, sa_old);
+      const double back = std::min(off, std::max(0.0, dot3(sa_old, bn)) * 0.5);
+      for (int d = 0; d < 3; ++d) x[d] = bq[d] + back * bn[d];
+      double r[3];
+      sub3(v, w, r);
+      const double rn = dot3(r, bn);
+      for (int d = 0; d < 3; ++d) v[d] -= rn * bn[d];
+      moved = true;
+    }
+  }
+
+  // (b) one-sided meshes: a point behind a face, less than 'reach' deep
+  for (int iter = 0; iter < 4; ++iter) {
+    const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
+    const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+    double best = reach;
+    int bi = -1;
+    Hit bh;
+    double bn[3] = {0, 0, 0};
+    for (int c = 0; c < ncand; ++c) {
+      const int i = cand ? (*cand)[c] : c;
+      const Tri &t = tris_[i];
+      const int side = specs_[t.mesh].side;
+      if (side != SIDE_NORMAL && side != SIDE_OPPOSITE) continue;
+      if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
+          x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
+        continue;
+      Hit h;
+      closest_point(t, x, h);
+      if (!h.face) continue;
+      double d[3];
+      sub3(x, h.p, d);
+      const double s = side * dot3(d, t.n);
+      if (s >= 0.0 || -s >= best) continue;
+      best = -s;
+      bi = i;
+      bh = h;
+      for (int q = 0; q < 3; ++q) bn[q] = side * t.n[q];
+    }
+    if (bi < 0) break;
+    double w[3];
+    wall_velocity(tris_[bi], bh.b, w);
+    for (int d = 0; d < 3; ++d) x[d] = bh.p[d] + off * bn[d];
+    double r[3];
+    sub3(v, w, r);
+    const double rn = dot3(r, bn);
+    for (int d = 0; d < 3; ++d) v[d] -= rn * bn[d];
+    moved = true;
+  }
+  return moved;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Fluid side from the points
+
+std::string MeshWalls::infer_sides(const double *const *x, int n, double reach) {
+  const size_t nm = specs_.size();
+  std::vector<long> votes(2 * nm, 0);  // [k][0] normal side, [k][1] opposite side
+  for (int i = 0; i < n; ++i) {
+    const double *xi = x[i];
+    const std::vector<int> *cand = reach <= margin_ ? candidates(xi) : nullptr;
+    const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+    std::vector<double> best(nm, reach * reach);
+    std::vector<int> vote(nm, 0);
+    for (int c = 0; c < ncand; ++c) {
+      const Tri &t = tris_[cand ? (*cand)[c] : c];
+      if (specs_[t.mesh].side != SIDE_AUTO) continue;
+      Hit h;
+      closest_point(t, xi, h);
+      if (!h.face || h.dist2 > best[t.mesh]) continue;
+      double d[3];
+      sub3(xi, h.p, d);
+      const double s = dot3(d, t.n);
+      if (s == 0.0) continue;
+      best[t.mesh] = h.dist2;
+      vote[t.mesh] = s > 0.0 ? 1 : -1;
+    }
+    for (size_t k = 0; k < nm; ++k) {
+      if (vote[k] > 0) ++votes[2 * k];
+      if (vote[k] < 0) ++votes[2 * k + 1];
+    }
+  }
+  std::vector<long> total(2 * nm, 0);
+  MPI_Allreduce(votes.data(), total.data(), static_cast<int>(2 * nm), MPI_LONG, MPI_SUM, lmp_->world);
+  std::ostringstream log;
+  for (size_t k = 0; k < nm; ++k) {
+    MeshWallSpec &s = specs_[k];
+    if (s.side != SIDE_AUTO) continue;
+    const long np = total[2 * k], no = total[2 * k + 1];
+    if (np == 0 && no == 0)
+      throw std::runtime_error(fix_msg(s.fix_id, "no fluid point lies within reach of a triangle face; "
+                                                 "cannot infer the fluid side (give it explicitly)"));
+    s.side = np >= no ? SIDE_NORMAL : SIDE_OPPOSITE;
+    log << "mesh wall " << s.fix_id << ": fluid on the " << (np >= no ? "normal" : "opposite")
+        << " side (" << std::max(np, no) << " of " << np + no << " points near its faces agree)\n";
+  }
+  return log.str();
+}
+
+long MeshWalls::global_triangles() const {
+  int me = 0;
+  MPI_Comm_rank(lmp_->world, &me);
+  long mine = 0;
+  for (size_t k = 0; k < specs_.size(); ++k) {
+    TriMesh *m = static_cast<FixMeshSurface *>(resolve(static_cast<int>(k)))->triMesh();
+    if (m->isParallel() || me == 0) mine += m->sizeLocal();
+  }
+  long all = 0;
+  MPI_Allreduce(&mine, &all, 1, MPI_LONG, MPI_SUM, lmp_->world);
+  return all;
+}
+
+}  // namespace mpm
