@@ -340,59 +340,67 @@ void MeshWalls::closest_point(const Tri &t, const double x[3], Hit &h) {
 // ---------------------------------------------------------------------------------------------
 // Grid nodes
 
-bool MeshWalls::apply(const double x[3], double vel[3], double reach) const {
+bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, double reach_behind) const {
   if (tris_.empty()) return false;
+  if (reach_behind < 0.0) reach_behind = reach_fluid;
+  const double reach = std::max(reach_fluid, reach_behind);
   const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
   const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
-  const double r2 = reach * reach;
+  const double r2 = reach * reach, rf2 = reach_fluid * reach_fluid, rb2 = reach_behind * reach_behind;
 
   constexpr int kMax = 64;
   int idx[kMax];
   Hit hits[kMax];
   int nh = 0;
+  double nrm[kMax][3];
+  bool behind[kMax];
   for (int c = 0; c < ncand && nh < kMax; ++c) {
     const int i = cand ? (*cand)[c] : c;
     const Tri &t = tris_[i];
     if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
         x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
       continue;
-    closest_point(t, x, hits[nh]);
-    if (hits[nh].dist2 > r2) continue;
+    Hit &h = hits[nh];
+    closest_point(t, x, h);
+    if (h.dist2 > r2) continue;
+    double d[3];
+    sub3(x, h.p, d);
+    behind[nh] = false;
+    if (h.face) {
+      const int side = specs_[t.mesh].side;
+      const double s = dot3(d, t.n);
+      double sg;
+      if (side == SIDE_NORMAL) sg = 1.0;
+      else if (side == SIDE_OPPOSITE) sg = -1.0;
+      else sg = s >= 0.0 ? 1.0 : -1.0;  // both sides (or side not decided yet)
+      for (int q = 0; q < 3; ++q) nrm[nh][q] = sg * t.n[q];
+      behind[nh] = sg * s < 0.0;
+      if (h.dist2 > (behind[nh] ? rb2 : rf2)) continue;
+    } else {
+      // beyond the triangle's edges: a rounded edge, normal from the closest point to the node
+      if (h.dist2 > rf2) continue;
+      const double dl = std::sqrt(h.dist2);
+      if (dl <= 1e-12 * reach) continue;
+      for (int q = 0; q < 3; ++q) nrm[nh][q] = d[q] / dl;
+    }
     idx[nh++] = i;
   }
   if (nh == 0) return false;
 
   bool touched = false;
   for (size_t k = 0; k < specs_.size(); ++k) {
-    // face-region hits of this mesh take precedence over its edge/vertex hits (so that the
-    // internal edges of a flat or gently curved wall add no constraint)
+    // face-region hits of a mesh take precedence over its edge/vertex hits (so that the internal
+    // edges of a flat or gently curved wall add no constraint)
     bool any_face = false;
     for (int h = 0; h < nh; ++h)
       if (tris_[idx[h]].mesh == static_cast<int>(k) && hits[h].face) any_face = true;
-    const int side = specs_[k].side;
     const double sticky = specs_[k].sticky;
     for (int h = 0; h < nh; ++h) {
       const Tri &t = tris_[idx[h]];
       if (t.mesh != static_cast<int>(k) || hits[h].face != any_face) continue;
-      double d[3], n[3], w[3];
-      sub3(x, hits[h].p, d);
-      bool behind = false;
-      if (any_face) {
-        const double s = dot3(d, t.n);
-        double sg;
-        if (side == SIDE_NORMAL) sg = 1.0;
-        else if (side == SIDE_OPPOSITE) sg = -1.0;
-        else sg = s >= 0.0 ? 1.0 : -1.0;  // both sides (or side not decided yet)
-        for (int q = 0; q < 3; ++q) n[q] = sg * t.n[q];
-        behind = sg * s < 0.0;
-      } else {
-        // beyond the triangle's edges: a rounded edge, normal from the closest point to the node
-        const double dl = std::sqrt(hits[h].dist2);
-        if (dl <= 1e-12 * reach) continue;
-        for (int q = 0; q < 3; ++q) n[q] = d[q] / dl;
-      }
+      double w[3];
       wall_velocity(t, hits[h].b, w);
-      constrain(vel, w, n, behind, sticky);
+      constrain(vel, w, nrm[h], behind[h], sticky);
       touched = true;
     }
   }

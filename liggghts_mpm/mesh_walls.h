@@ -49,8 +49,10 @@ class MeshWalls {
   void refresh(const double patch_lo[3], const double patch_hi[3], double margin);
 
   // Applies the wall condition to the velocity vel of a grid node at x, for every gathered
-  // triangle within 'reach' of x (reach <= margin of the last refresh). Returns true if touched.
-  bool apply(const double x[3], double vel[3], double reach) const;
+  // triangle within 'reach' of x on its fluid side, or within 'reach_behind' (default: reach) of x
+  // behind it (one-sided meshes only). Both reaches <= margin of the last refresh, else the query
+  // scans all gathered triangles. Returns true if touched.
+  bool apply(const double x[3], double vel[3], double reach, double reach_behind = -1.0) const;
 
   // Material points. Undoes a crossing: (a) if x_old is given and the segment x_old -> x crosses a
   // triangle, x goes back to x_old's side of it; (b) for one-sided meshes, a point behind a

@@ -5,9 +5,7 @@
 // ranks and periodic images).
 //
 // Build by hand from the repository root (until it is in tests/mpm/CMakeLists.txt):
-//   mpicxx -std=c++17 -O2 -Iliggghts_mpm -I/usr/include/liggghts \
-//       tests/mpm/test_mesh_walls_unit.cpp liggghts_mpm/mesh_walls.cpp \
-//       -o build/test_mesh_walls_unit -lliggghts -lgtest -pthread
+//   mpicxx -std=c++17 -O2 -Iliggghts_mpm -I/usr/include/liggghts tests/mpm/test_mesh_walls_unit.cpp liggghts_mpm/mesh_walls.cpp -o build/test_mesh_walls_unit -lliggghts -lgtest -pthread
 //   build/test_mesh_walls_unit
 //   mpirun --allow-run-as-root --oversubscribe -np 2 build/test_mesh_walls_unit
 // (own main(): MPI_Init before GoogleTest; do not link gtest_main.)
@@ -194,6 +192,13 @@ TEST_F(MeshWallsTest, StaticPlateNoslipFreeslipPartial) {
   freeslip.apply(behind, b2, 0.075);
   expect_v(b1, 1, 0, 0);
   expect_v(b2, 1, 0, 0);
+  // separate reaches: nodes behind the wall are constrained farther out than those in front
+  const double front9[3] = {0.3, 0.6, 0.59}, back9[3] = {0.3, 0.6, 0.41};
+  double h1[3] = {0, 0, -1}, h2[3] = {0, 0, 1};
+  EXPECT_FALSE(freeslip.apply(front9, h1, 0.05, 0.1));
+  EXPECT_TRUE(freeslip.apply(back9, h2, 0.05, 0.1));
+  expect_v(h1, 0, 0, -1);
+  expect_v(h2, 0, 0, 0);
   // beyond the plate's edge: rounded edge, normal from the edge to the node
   const double edge[3] = {1.05, 0.5, 0.5};
   double e[3] = {-2, 1, 0};
