@@ -1,0 +1,210 @@
+#!/usr/bin/env python3
+"""Whole-program tests of the fluid boundary condition on LIGGGHTS wall meshes (mesh_wall of
+fix mpm/fluid, liggghts_mpm/mesh_walls.h; docs/mesh_walls.md). Standard library only.
+
+    test_mesh_walls.py CASE --exe build/liggghts_mpm --work DIR [--mpirun "mpirun ..."]
+                            [--unit build/test_mesh_walls_unit]
+
+CASE is one of: box, box_np2, gate, gate_np2, bad_input, unit, unit_np2, all.
+The inputs are tests/mpm/in.mesh_walls_box and in.mesh_walls_gate with the STL files
+tests/mpm/box.stl and gate.stl. Exit status 0 when every check passes.
+"""
+import argparse
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+FAILURES = []
+
+
+def check(cond, what):
+    print(("ok    " if cond else "FAIL  ") + what)
+    if not cond:
+        FAILURES.append(what)
+
+
+def read_csv(path):
+    with open(path) as f:
+        rows = [ln.strip() for ln in f if ln.strip() and not ln.lstrip().startswith("#")]
+    names = rows[0].split(",")
+    cols = {n: [] for n in names}
+    for r in rows[1:]:
+        for n, v in zip(names, r.split(",")):
+            cols[n].append(float(v))
+    return cols
+
+
+class Runner:
+    def __init__(self, a):
+        self.exe = os.path.abspath(a.exe) if a.exe else None
+        self.work = os.path.abspath(a.work)
+        self.mpirun = shlex.split(a.mpirun)
+        self.unit = os.path.abspath(a.unit) if a.unit else None
+
+    def run(self, case, infile, stl, variables, np=1, expect_ok=True):
+        if not self.exe:
+            raise RuntimeError("--exe is required for this case")
+        d = os.path.join(self.work, case)
+        shutil.rmtree(d, ignore_errors=True)
+        os.makedirs(d)
+        shutil.copy(os.path.join(HERE, infile), d)
+        shutil.copy(os.path.join(HERE, stl), d)
+        cmd = [self.exe, "-in", infile, "-echo", "none"]
+        for k, v in variables.items():
+            cmd += ["-var", k, str(v)]  # one word: "partial 0.5" stays one value
+        if np > 1:
+            cmd = self.mpirun + ["-np", str(np)] + cmd
+        p = subprocess.run(cmd, cwd=d, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                           errors="replace", timeout=900)
+        with open(os.path.join(d, "output.txt"), "w") as f:
+            f.write(p.stdout)
+        if expect_ok and p.returncode != 0:
+            tail = "\n".join(p.stdout.splitlines()[-15:])
+            raise RuntimeError(f"{case}: liggghts_mpm exited with {p.returncode}:\n{tail}")
+        return d, p
+
+
+# ---------------------------------------------------------------- cases
+
+def box_checks(d, label):
+    r = read_csv(os.path.join(d, "mesh_walls_box.csv"))
+    v = {k: c[0] for k, c in r.items()}
+    lo, hi, top = v["lo"], v["hi"], v["top"]
+    tol = 1e-9
+    inside = all(lo - tol <= v[k] <= hi + tol for k in ("xmin", "xmax", "ymin", "ymax", "zmin", "zmax"))
+    check(inside, f"{label}: every point inside the mesh box [{lo}, {hi}]^3 "
+                  f"(x {v['xmin']:.4f}..{v['xmax']:.4f}, y {v['ymin']:.4f}..{v['ymax']:.4f}, "
+                  f"z {v['zmin']:.4f}..{v['zmax']:.4f})")
+    check(v["mass"] == v["mass0"], f"{label}: fluid mass exact ({v['mass']!r})")
+    # settled: the free surface stays near its initial height, the fluid nearly at rest
+    check(v["zmax"] <= top + 1e-9, f"{label}: no point above the initial free surface (zmax {v['zmax']:.4f})")
+    vref = (v["g"] * (top - lo)) ** 0.5
+    check(v["vmax"] < 0.05 * vref, f"{label}: nearly at rest, largest speed {v['vmax']:.3g} < 5 % of sqrt(g h)")
+    p0 = v["rho"] * v["g"] * (top - lo)
+    check(0.6 < v["pmax"] / p0 < 1.2, f"{label}: bottom pressure {v['pmax']:.1f} Pa near rho g h = {p0:.1f} Pa")
+    return v
+
+
+def case_box(r):
+    """Closed box of 12 triangles (fluid side inferred), fluid at rest: nobody leaves the mesh box."""
+    for kind in ("freeslip", "noslip"):
+        d, _ = r.run(f"box_{kind}", "in.mesh_walls_box", "box.stl", {"kind": kind})
+        box_checks(d, f"box {kind}")
+    # explicit side: box.stl has outward normals, the fluid is inside
+    d, _ = r.run("box_opposite", "in.mesh_walls_box", "box.stl", {"fside": "opposite"})
+    box_checks(d, "box side opposite")
+    # a mesh box not aligned with the grid nodes
+    d, _ = r.run("box_offset", "in.mesh_walls_box", "box.stl", {"lo": 0.112, "side": 0.28, "fill": 0.14})
+    box_checks(d, "box off the grid nodes")
+
+
+def case_box_np2(r):
+    """The same on 2 ranks (the box's triangles are split between the ranks)."""
+    d1, _ = r.run("box_np1", "in.mesh_walls_box", "box.stl", {})
+    d2, _ = r.run("box_np2", "in.mesh_walls_box", "box.stl", {}, np=2)
+    v1 = box_checks(d1, "box np1")
+    v2 = box_checks(d2, "box np2")
+    check(abs(v2["pmax"] - v1["pmax"]) <= 0.02 * v1["pmax"],
+          f"np2 vs np1: largest pressure {v2['pmax']:.2f} vs {v1['pmax']:.2f} within 2 %")
+
+
+def gate_checks(d, label, dx, min_advance):
+    r = read_csv(os.path.join(d, "mesh_walls_gate.csv"))
+    width = r["width"][0]
+    check(all(m == r["mass0"][0] for m in r["mass"]), f"{label}: fluid mass exact")
+    check(r["front_settled"][0] <= width + 0.25 * dx,
+          f"{label}: held by the gate while it rests (front {r['front_settled'][0]:.4f} <= {width} + dx/4)")
+    closed = [f for f, b in zip(r["front"], r["gate_bottom"]) if b < -0.5 * dx]
+    check(bool(closed) and max(closed) <= width + 0.25 * dx,
+          f"{label}: held while the gate's lower edge is below the padding nodes "
+          f"(front {max(closed) if closed else float('nan'):.4f})")
+    check(r["front"][-1] >= width + min_advance,
+          f"{label}: released by the rising gate (front {r['front'][-1]:.4f} >= {width} + {min_advance})")
+    return r
+
+
+def case_gate(r):
+    """Column held by a mesh gate (thin plate, side both), lifted by fix move/mesh."""
+    dx = 0.025
+    for kind in ("freeslip", "noslip"):
+        d, _ = r.run(f"gate_{kind}", "in.mesh_walls_gate", "gate.stl", {"kind": kind, "dx": dx})
+        gate_checks(d, f"gate {kind}", dx, 0.2)
+    # one-sided gate: the fluid is on the opposite side of the normal (+x)
+    d, _ = r.run("gate_opposite", "in.mesh_walls_gate", "gate.stl", {"fside": "opposite", "dx": dx})
+    gate_checks(d, "gate side opposite", dx, 0.2)
+
+
+def case_gate_np2(r):
+    """2 ranks split at the gate (channel 0.4 m, gate at 0.2 m) against 1 rank."""
+    dx = 0.025
+    v = {"dx": dx, "length": 0.4, "tlift": 0.15}
+    d1, _ = r.run("gate_np1", "in.mesh_walls_gate", "gate.stl", v)
+    d2, _ = r.run("gate_np2", "in.mesh_walls_gate", "gate.stl", v, np=2)
+    g1 = gate_checks(d1, "gate np1", dx, 0.05)
+    g2 = gate_checks(d2, "gate np2", dx, 0.05)
+    f1, f2 = g1["front"][-1], g2["front"][-1]
+    check(abs(f2 - f1) <= 0.5 * dx, f"np2 vs np1: front {f2:.4f} vs {f1:.4f} within half a cell")
+
+
+def case_bad_input(r):
+    """Clear errors that name the fix ID or the bad value."""
+    bad = [({"wallfix": "nosuch"}, "nosuch"),
+           ({"wallfix": "grav"}, "mesh/surface"),
+           ({"kind": "partial 1.5"}, "[0,1]"),
+           ({"fside": "sideways"}, "sideways")]
+    for i, (v, needle) in enumerate(bad):
+        d, p = r.run(f"bad_input/{i}", "in.mesh_walls_box", "box.stl", dict(v, steps=10), expect_ok=False)
+        ok = p.returncode != 0 and "ERROR" in p.stdout and needle in p.stdout
+        last = [ln for ln in p.stdout.splitlines() if "ERROR" in ln][-1:] or ["(no ERROR line)"]
+        check(ok, f"bad input {v}: error mentioning '{needle}': {last[0].strip()}")
+
+
+def run_unit(r, np):
+    if not r.unit:
+        raise RuntimeError("--unit is required for this case")
+    cmd = [r.unit] if np == 1 else r.mpirun + ["-np", str(np), r.unit]
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
+                       timeout=600)
+    lines = [ln for ln in p.stdout.splitlines() if "PASSED" in ln or "FAILED" in ln]
+    check(p.returncode == 0, f"unit tests on {np} rank(s): " + ("; ".join(lines[-2:]) or "no summary"))
+
+
+def case_unit(r):
+    """GoogleTest unit tests of MeshWalls (test_mesh_walls_unit.cpp) on 1 rank."""
+    run_unit(r, 1)
+
+
+def case_unit_np2(r):
+    """The unit tests on 2 ranks (triangles owned by the other rank, periodic images)."""
+    run_unit(r, 2)
+
+
+CASES = {"box": case_box, "box_np2": case_box_np2, "gate": case_gate, "gate_np2": case_gate_np2,
+         "bad_input": case_bad_input, "unit": case_unit, "unit_np2": case_unit_np2}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("case", choices=sorted(CASES) + ["all"])
+    ap.add_argument("--exe", help="build/liggghts_mpm")
+    ap.add_argument("--unit", help="the test_mesh_walls_unit executable")
+    ap.add_argument("--work", default="mesh_walls_work")
+    ap.add_argument("--mpirun", default="mpirun --allow-run-as-root --oversubscribe")
+    a = ap.parse_args()
+    r = Runner(a)
+    names = sorted(CASES) if a.case == "all" else [a.case]
+    for n in names:
+        print(f"== {n}: {CASES[n].__doc__}")
+        try:
+            CASES[n](r)
+        except (RuntimeError, FileNotFoundError, IndexError, KeyError, ValueError) as e:
+            check(False, f"{n}: {e}")
+    print(f"{len(FAILURES)} failure(s)")
+    return 1 if FAILURES else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
