@@ -351,9 +351,9 @@ bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, doub
   constexpr int kMax = 64;
   int idx[kMax];
   Hit hits[kMax];
+  double dd[kMax][3];   // x - closest point
+  bool back[kMax];      // behind the triangle's plane (one-sided meshes)
   int nh = 0;
-  double nrm[kMax][3];
-  bool behind[kMax];
   for (int c = 0; c < ncand && nh < kMax; ++c) {
     const int i = cand ? (*cand)[c] : c;
     const Tri &t = tris_[i];
@@ -363,44 +363,56 @@ bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, doub
     Hit &h = hits[nh];
     closest_point(t, x, h);
     if (h.dist2 > r2) continue;
-    double d[3];
-    sub3(x, h.p, d);
-    behind[nh] = false;
-    if (h.face) {
-      const int side = specs_[t.mesh].side;
-      const double s = dot3(d, t.n);
-      double sg;
-      if (side == SIDE_NORMAL) sg = 1.0;
-      else if (side == SIDE_OPPOSITE) sg = -1.0;
-      else sg = s >= 0.0 ? 1.0 : -1.0;  // both sides (or side not decided yet)
-      for (int q = 0; q < 3; ++q) nrm[nh][q] = sg * t.n[q];
-      behind[nh] = sg * s < 0.0;
-      if (h.dist2 > (behind[nh] ? rb2 : rf2)) continue;
-    } else {
-      // beyond the triangle's edges: a rounded edge, normal from the closest point to the node
-      if (h.dist2 > rf2) continue;
-      const double dl = std::sqrt(h.dist2);
-      if (dl <= 1e-12 * reach) continue;
-      for (int q = 0; q < 3; ++q) nrm[nh][q] = d[q] / dl;
-    }
+    sub3(x, h.p, dd[nh]);
+    const int side = specs_[t.mesh].side;
+    const bool one_sided = side == SIDE_NORMAL || side == SIDE_OPPOSITE;
+    back[nh] = one_sided && side * dot3(dd[nh], t.n) < 0.0;
     idx[nh++] = i;
   }
   if (nh == 0) return false;
 
   bool touched = false;
   for (size_t k = 0; k < specs_.size(); ++k) {
-    // face-region hits of a mesh take precedence over its edge/vertex hits (so that the internal
-    // edges of a flat or gently curved wall add no constraint)
-    bool any_face = false;
-    for (int h = 0; h < nh; ++h)
-      if (tris_[idx[h]].mesh == static_cast<int>(k) && hits[h].face) any_face = true;
+    // Face-region hits of a mesh take precedence over its edge/vertex hits, so that the internal
+    // edges of a flat or gently curved wall add no constraint. A node near edges/vertices only is
+    // behind the mesh if it is behind the planes of all those triangles (outside a closed box's
+    // edge or corner); else it faces a rounded edge.
+    bool any_face = false, any = false, all_back = true;
+    for (int h = 0; h < nh; ++h) {
+      if (tris_[idx[h]].mesh != static_cast<int>(k)) continue;
+      any = true;
+      if (hits[h].face) any_face = true;
+    }
+    if (!any) continue;
+    if (!any_face)
+      for (int h = 0; h < nh; ++h)
+        if (tris_[idx[h]].mesh == static_cast<int>(k) && !back[h]) all_back = false;
+    const int side = specs_[k].side;
     const double sticky = specs_[k].sticky;
     for (int h = 0; h < nh; ++h) {
       const Tri &t = tris_[idx[h]];
       if (t.mesh != static_cast<int>(k) || hits[h].face != any_face) continue;
+      double n[3];
+      bool behind;
+      if (any_face) {
+        double sg;
+        if (side == SIDE_NORMAL) sg = 1.0;
+        else if (side == SIDE_OPPOSITE) sg = -1.0;
+        else sg = dot3(dd[h], t.n) >= 0.0 ? 1.0 : -1.0;  // both sides (or side not decided yet)
+        for (int q = 0; q < 3; ++q) n[q] = sg * t.n[q];
+        behind = back[h];
+      } else {
+        const double dl = std::sqrt(hits[h].dist2);
+        if (dl <= 1e-12 * reach) continue;
+        behind = all_back;
+        // normal from the edge towards the fluid
+        const double f = behind ? -1.0 / dl : 1.0 / dl;
+        for (int q = 0; q < 3; ++q) n[q] = f * dd[h][q];
+      }
+      if (hits[h].dist2 > (behind ? rb2 : rf2)) continue;
       double w[3];
       wall_velocity(t, hits[h].b, w);
-      constrain(vel, w, nrm[h], behind[h], sticky);
+      constrain(vel, w, n, behind, sticky);
       touched = true;
     }
   }
@@ -441,9 +453,10 @@ bool MeshWalls::push_back(double x[3], double v[3], double reach, const double *
         double sg;
         if (side == SIDE_NORMAL) sg = 1.0;
         else if (side == SIDE_OPPOSITE) sg = -1.0;
-        else sg = sa >= 0.0 ? 1.0 : -1.0;
-        // only a move from the fluid side to the other side (or onto the plane) counts
-        if (!(sg * sa > 0.0 && sg * sb <= 0.0)) continue;
+        else if (sa != 0.0) sg = sa > 0.0 ? 1.0 : -1.0;
+        else sg = sb >= 0.0 ? 1.0 : -1.0;  // two-sided, starting on the plane: leaving it is fine
+        // only a move from the fluid side (or the plane) to the other side counts
+        if (!(sg * sa >= 0.0 && sg * sb < 0.0)) continue;
         const double f = sa / (sa - sb);
         if (f >= best) continue;
         double q[3];
@@ -463,11 +476,8 @@ bool MeshWalls::push_back(double x[3], double v[3], double reach, const double *
       if (bi < 0) break;
       double w[3];
       wall_velocity(tris_[bi], bb, w);
-      // back to the fluid side, no closer than 'off' to the plane (and not beyond x_old)
-      double sa_old[3];
-      sub3(x_old, bq, sa_old);
-      const double back = std::min(off, std::max(0.0, dot3(sa_old, bn)) * 0.5);
-      for (int d = 0; d < 3; ++d) x[d] = bq[d] + back * bn[d];
+      // back to the fluid side, 'off' from the plane
+      for (int d = 0; d < 3; ++d) x[d] = bq[d] + off * bn[d];
       double r[3];
       sub3(v, w, r);
       const double rn = dot3(r, bn);
@@ -476,15 +486,20 @@ bool MeshWalls::push_back(double x[3], double v[3], double reach, const double *
     }
   }
 
-  // (b) one-sided meshes: a point behind a face, less than 'reach' deep
+  // (b) one-sided meshes: a point behind the mesh, less than 'reach' deep. Behind = behind the
+  // planes of all the triangles whose closest point is the nearest one (one triangle in its face
+  // region, or the triangles sharing the nearest edge or vertex); the point goes to the nearest
+  // point of the mesh plus 'off' towards the fluid.
   for (int iter = 0; iter < 4; ++iter) {
     const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
     const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
-    double best = reach;
-    int bi = -1;
-    Hit bh;
-    double bn[3] = {0, 0, 0};
-    for (int c = 0; c < ncand; ++c) {
+    const double r2 = reach * reach;
+    constexpr int kMax = 64;
+    int idx[kMax];
+    Hit hits[kMax];
+    int nh = 0;
+    double dmin = r2;
+    for (int c = 0; c < ncand && nh < kMax; ++c) {
       const int i = cand ? (*cand)[c] : c;
       const Tri &t = tris_[i];
       const int side = specs_[t.mesh].side;
@@ -492,26 +507,41 @@ bool MeshWalls::push_back(double x[3], double v[3], double reach, const double *
       if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
           x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
         continue;
-      Hit h;
-      closest_point(t, x, h);
-      if (!h.face) continue;
-      double d[3];
-      sub3(x, h.p, d);
-      const double s = side * dot3(d, t.n);
-      if (s >= 0.0 || -s >= best) continue;
-      best = -s;
-      bi = i;
-      bh = h;
-      for (int q = 0; q < 3; ++q) bn[q] = side * t.n[q];
+      closest_point(t, x, hits[nh]);
+      if (hits[nh].dist2 >= r2) continue;
+      dmin = std::min(dmin, hits[nh].dist2);
+      idx[nh++] = i;
     }
-    if (bi < 0) break;
+    if (nh == 0) break;
+    const double tie = dmin + 1e-12 * r2;
+    bool behind = true;
+    int first = -1;
+    for (int h = 0; h < nh && behind; ++h) {
+      if (hits[h].dist2 > tie) continue;
+      const Tri &t = tris_[idx[h]];
+      double d[3];
+      sub3(x, hits[h].p, d);
+      if (specs_[t.mesh].side * dot3(d, t.n) >= 0.0) behind = false;
+      if (first < 0) first = h;
+    }
+    if (!behind || first < 0) break;
+    const Tri &t = tris_[idx[first]];
+    const Hit &bh = hits[first];
+    double d[3], bn[3];
+    sub3(x, bh.p, d);
+    const double dl = std::sqrt(bh.dist2);
+    if (bh.face || dl <= 1e-12 * reach) {
+      for (int q = 0; q < 3; ++q) bn[q] = specs_[t.mesh].side * t.n[q];
+    } else {
+      for (int q = 0; q < 3; ++q) bn[q] = -d[q] / dl;
+    }
     double w[3];
-    wall_velocity(tris_[bi], bh.b, w);
-    for (int d = 0; d < 3; ++d) x[d] = bh.p[d] + off * bn[d];
+    wall_velocity(t, bh.b, w);
+    for (int q = 0; q < 3; ++q) x[q] = bh.p[q] + off * bn[q];
     double r[3];
     sub3(v, w, r);
     const double rn = dot3(r, bn);
-    for (int d = 0; d < 3; ++d) v[d] -= rn * bn[d];
+    for (int q = 0; q < 3; ++q) v[q] -= rn * bn[q];
     moved = true;
   }
   return moved;

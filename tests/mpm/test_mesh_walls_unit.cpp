@@ -333,6 +333,25 @@ TEST_F(MeshWallsTest, ClosedBoxCornersAndInferredSide) {
   EXPECT_GT(p[2], 0.0);
   EXPECT_LT(p[2], 1e-3);
   expect_v(pv, 0, 0, 0);
+  // outside the box's edge x = 0, y = 0 (behind both faces, near neither face): the node's
+  // velocity along the diagonal is zeroed both ways, the point comes back in across the edge
+  const double oc[3] = {-0.03, -0.03, 0.5};
+  double ov1[3] = {-1, -1, 0.3}, ov2[3] = {1, 1, 0.3};
+  EXPECT_TRUE(w.apply(oc, ov1, 0.075));
+  EXPECT_TRUE(w.apply(oc, ov2, 0.075));
+  expect_v(ov1, 0, 0, 0.3);
+  expect_v(ov2, 0, 0, 0.3);
+  double pc[3] = {-0.02, -0.02, 0.5}, pcv[3] = {-1, -1, 0};
+  EXPECT_TRUE(w.push_back(pc, pcv, 0.075));
+  const double off = 1e-3 * 0.075 / std::sqrt(2.0);
+  EXPECT_NEAR(pc[0], off, 1e-12);
+  EXPECT_NEAR(pc[1], off, 1e-12);
+  expect_v(pcv, 0, 0, 0);
+  // a point lying exactly on a face that steps out is caught by the crossing test
+  const double on[3] = {0.0, 0.5, 0.5};
+  double step[3] = {-0.001, 0.5, 0.5}, sv[3] = {-1, 0, 0};
+  EXPECT_TRUE(w.push_back(step, sv, 0.075, on));
+  EXPECT_NEAR(step[0], 1e-3 * 0.075, 1e-12);
 }
 
 TEST_F(MeshWallsTest, NoAutoVoteIsAnError) {
