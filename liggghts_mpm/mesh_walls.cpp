@@ -298,6 +298,31 @@ void MeshWalls::closest_point(const Tri &t, const double x[3], Hit &h) {
   sub3(c, a, ac);
   sub3(x, a, ap);
   auto finish = [&](double wa, double wb, double wc, bool face) {
+    if (!face) {
+      // A point whose projection falls on the triangle's boundary (a grid node on a box edge or
+      // on the diagonal of a split face) counts as facing the triangle: project and test the
+      // barycentric weights of the projection with a small tolerance.
+      const double s = dot3(ap, t.n);
+      const double q[3] = {ap[0] - s * t.n[0], ap[1] - s * t.n[1], ap[2] - s * t.n[2]};
+      const double d00 = dot3(ab, ab), d01 = dot3(ab, ac), d11 = dot3(ac, ac);
+      const double d20 = dot3(q, ab), d21 = dot3(q, ac);
+      const double den = d00 * d11 - d01 * d01;
+      if (den > 0.0) {
+        const double bv = (d11 * d20 - d01 * d21) / den, bw = (d00 * d21 - d01 * d20) / den;
+        const double bu = 1.0 - bv - bw;
+        const double tol = 1e-9;
+        if (bu >= -tol && bv >= -tol && bw >= -tol) {
+          wa = std::max(0.0, bu);
+          wb = std::max(0.0, bv);
+          wc = std::max(0.0, bw);
+          const double sum = wa + wb + wc;
+          wa /= sum;
+          wb /= sum;
+          wc /= sum;
+          face = true;
+        }
+      }
+    }
     h.b[0] = wa;
     h.b[1] = wb;
     h.b[2] = wc;

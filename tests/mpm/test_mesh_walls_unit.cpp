@@ -322,6 +322,14 @@ TEST_F(MeshWallsTest, ClosedBoxCornersAndInferredSide) {
   double u[3] = {1, -1, 0};
   w.apply(f, u, 0.075);
   expect_v(u, 1, -1, 0);
+  // nodes exactly on a face's diagonal (the edge between its two triangles) and on a box edge
+  // are on the wall: the approach is removed
+  const double diag[3] = {0.0, 0.4, 0.4}, bedge[3] = {0.0, 0.3, 0.0};
+  double dv[3] = {-1, 1, 1}, bv[3] = {-1, 1, -1};
+  EXPECT_TRUE(w.apply(diag, dv, 0.075));
+  EXPECT_TRUE(w.apply(bedge, bv, 0.075));
+  expect_v(dv, 0, 1, 1);
+  expect_v(bv, 0, 1, 0);
   // a node outside the box behind the face z = 0: normal velocity zeroed
   const double out[3] = {0.5, 0.4, -0.04};
   double o[3] = {1, 0, -1};
