@@ -426,6 +426,9 @@ bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, doub
         else sg = dot3(dd[h], t.n) >= 0.0 ? 1.0 : -1.0;  // both sides (or side not decided yet)
         for (int q = 0; q < 3; ++q) n[q] = sg * t.n[q];
         behind = back[h];
+        // a node in the plane of a two-sided wall is inside the wall: no normal motion either way
+        if (side != SIDE_NORMAL && side != SIDE_OPPOSITE && hits[h].dist2 <= 1e-18 * reach * reach)
+          behind = true;
       } else {
         const double dl = std::sqrt(hits[h].dist2);
         if (dl <= 1e-12 * reach) continue;

@@ -225,6 +225,13 @@ TEST_F(MeshWallsTest, TwoSidedAndOppositeSides) {
   expect_v(b, 0, 0, -3);
   expect_v(c, 0, 0, 0);
   expect_v(d, 0, 0, 3);
+  // a node in the plane of a two-sided wall cannot leave it either way
+  const double in[3] = {0.3, 0.6, 0.5};
+  double u1[3] = {1, 0, 3}, u2[3] = {1, 0, -3};
+  both.apply(in, u1, 0.075);
+  both.apply(in, u2, 0.075);
+  expect_v(u1, 1, 0, 0);
+  expect_v(u2, 1, 0, 0);
   // opposite: the fluid is below; above is behind
   double e[3] = {0, 0, -3}, g[3] = {0, 0, 3};
   opp.apply(below, e, 0.075);
