@@ -25,7 +25,8 @@ namespace mpm {
 
 namespace {
 
-constexpr int kPack = 19;  // doubles per packed triangle: 9 positions, 9 velocities, mesh index
+constexpr int kPack = 21;  // doubles per packed triangle: 9 positions, 9 velocities, mesh index,
+                           // global triangle ID, periodic image code
 
 inline double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 inline void sub3(const double *a, const double *b, double *c) {
@@ -152,6 +153,7 @@ void MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
         for (int d = 0; d < 3; ++d) rec[9 + 3 * j + d] = (i < nvel) ? (*vel)(i)[j][d] : 0.0;
       }
       rec[18] = static_cast<double>(k);
+      rec[19] = static_cast<double>(m->id(i));
       double lo[3], hi[3];
       for (int d = 0; d < 3; ++d) {
         lo[d] = std::min({rec[d], rec[3 + d], rec[6 + d]});
@@ -160,10 +162,10 @@ void MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
       for (int q = 0; q < nprocs; ++q) {
         const double *bx = &boxes[6 * q];
         if (bx[0] > bx[3] || bx[1] > bx[4] || bx[2] > bx[5]) continue;
-        for (double sx : shifts[0])
-          for (double sy : shifts[1])
-            for (double sz : shifts[2]) {
-              const double s[3] = {sx, sy, sz};
+        for (size_t ix = 0; ix < shifts[0].size(); ++ix)
+          for (size_t iy = 0; iy < shifts[1].size(); ++iy)
+            for (size_t iz = 0; iz < shifts[2].size(); ++iz) {
+              const double s[3] = {shifts[0][ix], shifts[1][iy], shifts[2][iz]};
               bool hit = true;
               for (int d = 0; d < 3 && hit; ++d)
                 hit = lo[d] + s[d] <= bx[3 + d] && hi[d] + s[d] >= bx[d];
@@ -173,6 +175,7 @@ void MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
               o.insert(o.end(), rec, rec + kPack);
               for (int j = 0; j < 3; ++j)
                 for (int d = 0; d < 3; ++d) o[at + 3 * j + d] += s[d];
+              o[at + 20] = static_cast<double>(9 * ix + 3 * iy + iz);
             }
       }
     }
@@ -206,6 +209,7 @@ void MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
         t.w[j][d] = r[9 + 3 * j + d];
       }
     t.mesh = static_cast<int>(r[18]);
+    t.key = static_cast<long long>(r[19]) * 27 + static_cast<long long>(r[20]);
     double e1[3], e2[3];
     sub3(t.p[1], t.p[0], e1);
     sub3(t.p[2], t.p[0], e2);
@@ -222,6 +226,13 @@ void MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
     }
     tris_.push_back(t);
   }
+
+  // A fixed order (mesh, triangle ID, image), whatever the ranks: where triangles with different
+  // wall velocities act on one node (a rotating mesh), the last one applied wins, so the result
+  // must not depend on the decomposition.
+  std::sort(tris_.begin(), tris_.end(), [](const Tri &a, const Tri &b) {
+    return a.mesh != b.mesh ? a.mesh < b.mesh : a.key < b.key;
+  });
 
   // bins over my box
   for (int d = 0; d < 3; ++d) {

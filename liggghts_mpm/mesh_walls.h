@@ -85,6 +85,7 @@ class MeshWalls {
     double n[3];      // unit normal of the winding (not yet oriented)
     double lo[3], hi[3];
     int mesh;         // index into specs_
+    long long key;    // 27 * global triangle ID + periodic image code (the order of application)
   };
 
  private:
