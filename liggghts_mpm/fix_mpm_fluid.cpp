@@ -368,7 +368,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
                                            "transfer", "update", "antilock", "boundary", "gate", "damping",
                                            "cfl", "subcycle", "mass_threshold", "fill", "hydrostatic", "pmin",
                                            "couple", "drag", "cell_check", "theta_min",
-                                           "front", "height", "output"};
+                                           "front", "height", "output", "mesh_wall"};
           bool is_kw = false;
           for (const char *k : keywords) is_kw = is_kw || strcmp(arg[iarg], k) == 0;
           if (is_kw) break;
@@ -380,6 +380,31 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
         list->push_back(arg[iarg]);
         ++iarg;
       }
+    } else if (strcmp(kw, "mesh_wall") == 0) {
+      need(iarg, 2, kw, "a fix ID and noslip | freeslip | partial f");
+      mpm::MeshWallSpec ms;
+      ms.fix_id = arg[iarg + 1];
+      ms.side = mpm::SIDE_AUTO;
+      const char *k = arg[iarg + 2];
+      iarg += 3;
+      if (strcmp(k, "noslip") == 0) ms.kind = 0;
+      else if (strcmp(k, "freeslip") == 0) ms.kind = 1;
+      else if (strcmp(k, "partial") == 0) {
+        need(iarg - 1, 1, "mesh_wall partial", "a sticky fraction");
+        ms.kind = 2;
+        if (!parse_double(arg[iarg], ms.sticky)) bad_arg("mesh_wall partial", "a sticky fraction in [0,1]", arg[iarg]);
+        ++iarg;
+      } else bad_arg("mesh_wall", "noslip, freeslip or partial f", k);
+      if (iarg + 1 < narg && strcmp(arg[iarg], "side") == 0) {
+        const char *sd = arg[iarg + 1];
+        if (strcmp(sd, "auto") == 0) ms.side = mpm::SIDE_AUTO;
+        else if (strcmp(sd, "normal") == 0) ms.side = mpm::SIDE_NORMAL;
+        else if (strcmp(sd, "opposite") == 0) ms.side = mpm::SIDE_OPPOSITE;
+        else if (strcmp(sd, "both") == 0) ms.side = mpm::SIDE_BOTH;
+        else bad_arg("mesh_wall side", "auto, normal, opposite or both", sd);
+        iarg += 2;
+      }
+      mesh_specs.push_back(ms);
     } else {
       std::string msg = std::string("Fix mpm/fluid: unknown keyword '") + kw +
                         "' (see docs/fix_mpm_fluid.md for the keywords)";
@@ -672,8 +697,41 @@ void FixMpmFluid::setup_grid() {
   grid_ready = true;
 }
 
+void FixMpmFluid::mesh_refresh() {
+  if (!mesh_walls) return;
+  const mpm::IndexBox &pb = grid.patch();
+  double lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = gspec.origin[d] + pb.lo[d] * gspec.dx;
+    hi[d] = gspec.origin[d] + pb.hi[d] * gspec.dx;
+  }
+  try {
+    mesh_walls->refresh(lo, hi, 2.0 * gspec.dx);
+  } catch (const std::exception &e) {
+    error->all(FLERR, e.what());
+  }
+}
+
 void FixMpmFluid::setup(int) {
   setup_grid();
+  if (!mesh_specs.empty()) {
+    try {
+      std::vector<mpm::MeshWallSpec> sp = mesh_specs;
+      if (mesh_walls) for (size_t k = 0; k < sp.size(); ++k) sp[k].side = mesh_walls->side(k);
+      mesh_walls.reset(new mpm::MeshWalls(lmp, sp));
+    } catch (const std::exception &e) {
+      error->all(FLERR, (std::string("Fix mpm/fluid: ") + e.what()).c_str());
+    }
+    mesh_refresh();
+    std::vector<const double *> pts;
+    for (int i = 0; i < atom->nlocal; ++i) if (is_point(i)) pts.push_back(atom->x[i]);
+    try {
+      std::string log = mesh_walls->infer_sides(pts.data(), (int)pts.size(), 1.0 * gspec.dx);
+      if (comm->me == 0 && !log.empty()) { if (screen) fputs(log.c_str(), screen); if (logfile) fputs(log.c_str(), logfile); }
+    } catch (const std::exception &e) {
+      error->all(FLERR, (std::string("Fix mpm/fluid: ") + e.what()).c_str());
+    }
+  }
   if (coupled && !theta_initialized) init_theta();
   check_timestep(true);
   if (out_every > 0 && update->ntimestep % out_every == 0) write_output();
@@ -758,6 +816,7 @@ void FixMpmFluid::pre_final_integrate() {
     }
   }
   check_timestep(false);
+  mesh_refresh();
   const double h = update->dt / nsub_last;
   if (coupled) grain_force.assign(3 * static_cast<std::size_t>(atom->nlocal), 0.0);
   for (int s = 0; s < nsub_last; ++s) substep(h);
@@ -1087,6 +1146,11 @@ void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k) {
     const double keep = 1.0 - face[fc].sticky;
     for (int e = 0; e < 3; ++e) vel[e] = (e == d) ? 0.0 : keep * vel[e];
   }
+  if (mesh_walls) {
+    const double xn[3] = {gspec.origin[0] + i * gspec.dx, gspec.origin[1] + j * gspec.dx,
+                          gspec.origin[2] + k * gspec.dx};
+    mesh_walls->apply(xn, vel, 1.0 * gspec.dx, 2.0 * gspec.dx);
+  }
   if (gate.active) {
     const int d = gate.dim;
     const double xn = gspec.origin[d] + idx[d] * gspec.dx;
@@ -1299,7 +1363,9 @@ void FixMpmFluid::advance_positions(double h) {
   const double eps = 1e-6 * gspec.dx;
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
+    const double xold[3] = {x[i][0], x[i][1], x[i][2]};
     for (int d = 0; d < 3; ++d) x[i][d] += h * vpic[3 * i + d];
+    if (mesh_walls && mesh_walls->push_back(x[i], v[i], 1.0 * gspec.dx, xold)) n_clamped += 1.0;
     for (int d = 0; d < 3; ++d) {
       if (gspec.periodic[d]) continue;
       const double lo = gspec.origin[d], hi = gspec.upper(d);

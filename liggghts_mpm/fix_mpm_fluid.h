@@ -25,6 +25,7 @@ FixStyle(mpm/fluid,FixMpmFluid)
 #include "mpm/fluid_laws.h"
 #include "mpm/grid.h"
 #include "mpm/shape_functions.h"
+#include "mesh_walls.h"
 
 namespace mpm { class Hdf5Series; }
 
@@ -113,6 +114,10 @@ class FixMpmFluid : public Fix {
   bool antilock = true;
   Face face[6];
   Gate gate;
+  std::vector<mpm::MeshWallSpec> mesh_specs;
+  std::unique_ptr<mpm::MeshWalls> mesh_walls;
+  bool mesh_sides_done = false;
+  void mesh_refresh();
   double damping = 0.0;
   double cfl = 0.5;
   bool subcycle = false;
