@@ -343,6 +343,9 @@ def case_ergun(r):
         err = dp_ergun / G - 1.0
         print(f"  dp/L = {G:8.1f} Pa/m: U = {Us:.5f} m/s (Ergun at this U: {dp_ergun:8.1f} Pa/m, {100 * err:+.2f} %)")
         check(steady, f"steady state reached at U = {U}")
+        th = (f["theta_min"][-1], f["theta_max"][-1])
+        check(abs(th[0] - eps) < 1e-9 and abs(th[1] - eps) < 1e-9,
+              f"fluid fraction at every point equals the porosity {eps:.6f} (got {th[0]:.9f}..{th[1]:.9f})")
         check(abs(err) < 0.05, f"pressure drop within 5 % of Ergun at U = {Us:.4f} m/s")
 
 
@@ -374,6 +377,52 @@ def case_coupled_np2_vs_np1(r):
     rel = max(abs(a - b) / max(abs(a), 1e-30) for k in ("U", "P") for a, b in zip(f1[k], f2[k]))
     print(f"  largest relative difference np2 vs np1 of U and P: {rel:.2e}")
     check(rel < 1e-9, "np=2 matches np=1 to round-off (1e-9)")
+
+
+def case_coupling_bad_input(r):
+    """Coupling keywords: unknown group or law, no viscosity, a cell smaller than a grain."""
+    tmpl = """atom_style sphere
+atom_modify map array sort 0 0
+boundary f f f
+units si
+region box block 0 0.02 0 0.02 0 0.02 units box
+create_box 2 box
+neighbor 0.001 bin
+neigh_modify binsize 0.005
+create_atoms 2 single 0.01 0.01 0.01 units box
+set atom 1 diameter {d} density 2500
+group grains type 2
+group fluid type 1
+fix f fluid mpm/fluid cell 0.005 density 1000 bulk 1e5 fill box 1 1 1 type 1 {args}
+run 0
+"""
+    cases = [
+        ("0.001", "viscosity 1e-3 couple nosuch", "keyword 'couple' expects an existing group-ID"),
+        ("0.001", "viscosity 1e-3 couple grains drag fast", "keyword 'drag' expects a drag law"),
+        ("0.001", "couple grains", "needs keyword 'viscosity' > 0"),
+        ("0.001", "viscosity 1e-3 couple grains theta_min 0", "keyword 'theta_min' expects"),
+        ("0.008", "viscosity 1e-3 couple grains", "is smaller than the largest grain"),
+    ]
+    for i, (dia, args, expect) in enumerate(cases):
+        d = os.path.join(r.work, "coupling_bad_input", str(i))
+        shutil.rmtree(d, ignore_errors=True)
+        os.makedirs(d)
+        with open(os.path.join(d, "in.bad"), "w") as f:
+            f.write(tmpl.format(d=dia, args=args))
+        p = subprocess.run([r.exe, "-in", "in.bad", "-echo", "none"], cwd=d, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True, errors="replace", timeout=60)
+        msg = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
+        check(p.returncode != 0 and expect in msg, f"'{args}' (d = {dia}) -> \"{expect}\" (got: {msg.strip()[:150]})")
+    # the override turns the grain-size error into a warning and runs
+    d = os.path.join(r.work, "coupling_bad_input", "override")
+    shutil.rmtree(d, ignore_errors=True)
+    os.makedirs(d)
+    with open(os.path.join(d, "in.ok"), "w") as f:
+        f.write(tmpl.format(d="0.008", args="viscosity 1e-3 couple grains cell_check no"))
+    p = subprocess.run([r.exe, "-in", "in.ok", "-echo", "none"], cwd=d, stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, text=True, errors="replace", timeout=60)
+    check(p.returncode == 0 and "WARNING" in p.stdout and "smaller than the largest grain" in p.stdout,
+          "'cell_check no' runs with a warning")
 
 
 def main():
