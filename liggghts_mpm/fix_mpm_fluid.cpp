@@ -162,6 +162,7 @@ bool FixMpmFluid::*FixMpmFluid::find_flag(const char *kw) {
       {"antilock", &FixMpmFluid::antilock},
       {"subcycle", &FixMpmFluid::subcycle},
       {"cell_check", &FixMpmFluid::cell_check},
+      {"wall_traction", &FixMpmFluid::wall_traction},
   };
   for (const auto &k : table)
     if (strcmp(k.name, kw) == 0) return k.flag;
@@ -367,7 +368,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
           static const char *keywords[] = {"cell", "grid", "density", "bulk", "viscosity", "eos", "shape",
                                            "transfer", "update", "antilock", "boundary", "gate", "damping",
                                            "cfl", "subcycle", "mass_threshold", "fill", "hydrostatic", "pmin",
-                                           "couple", "drag", "cell_check", "theta_min",
+                                           "couple", "drag", "cell_check", "theta_min", "wall_traction",
                                            "front", "height", "output", "mesh_wall"};
           bool is_kw = false;
           for (const char *k : keywords) is_kw = is_kw || strcmp(arg[iarg], k) == 0;
@@ -946,8 +947,44 @@ void FixMpmFluid::particles_to_grid() {
         g[4 + d] += w * f[i][d] - V * (sig[d][0] * gw[0] + sig[d][1] * gw[1] + sig[d][2] * gw[2]);
       }
     })
+    if (wall_traction && shape == mpm::ShapeKind::QuadraticBSpline) add_wall_traction(ps, xp, V, p);
   }
   grid.reverse_sum(g_p2g.data(), 7);
+}
+
+/* Wall traction, the boundary term (8-23) f_j = int_wall S_j sigma n ds, for
+   the quadratic B-spline. Its shape function of the first node inside a wall
+   is 1/8 on the wall, so that node must carry 1/8 of the wall's pressure
+   push; the internal force (8-24) alone pulls it towards the wall by exactly
+   that much (in a uniformly pressurised box the fluid would be drawn to the
+   walls). The wall and padding nodes get their share from the velocity
+   condition anyway. Quadrature: the points of the cell next to the wall,
+   each standing for the wall area V_p / dx, with their in-plane weights. */
+void FixMpmFluid::add_wall_traction(const PointShape &ps, const double *xp, double V, double p) {
+  const double inv = 1.0 / gspec.dx;
+  for (int d = 0; d < 3; ++d) {
+    if (gspec.periodic[d]) continue;
+    const double xi = (xp[d] - gspec.origin[d]) * inv;
+    int node, dir;
+    if (xi < 1.0) {
+      node = 1;
+      dir = 1;  // the low wall pushes towards +d
+    } else if (xi > gspec.ncell[d] - 1.0) {
+      node = gspec.ncell[d] - 1;
+      dir = -1;
+    } else
+      continue;
+    const int e = (d + 1) % 3, f = (d + 2) % 3;
+    const double push = dir * 0.125 * p * V * inv;
+    for (int b = 0; b < 3; ++b)
+      for (int c = 0; c < 3; ++c) {
+        int idx[3];
+        idx[d] = node;
+        idx[e] = ps.base[e] + b;
+        idx[f] = ps.base[f] + c;
+        g_p2g[7 * grid.index(idx[0], idx[1], idx[2]) + 4 + d] += push * ps.w[e][b] * ps.w[f][c];
+      }
+  }
 }
 
 /* Two-way coupling with the DEM grains (chapter 7.2, 8.1-8.2):

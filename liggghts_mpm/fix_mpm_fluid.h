@@ -112,6 +112,7 @@ class FixMpmFluid : public Fix {
   double flip_alpha = 1.0;      // FLIP fraction of a FLIP/PIC blend
   bool musl = true;
   bool antilock = true;
+  bool wall_traction = true;  // (8-23) at grid-face walls for bspline2
   Face face[6];
   Gate gate;
   std::vector<mpm::MeshWallSpec> mesh_specs;
@@ -204,6 +205,7 @@ class FixMpmFluid : public Fix {
   double node_volume(int i, int j, int k) const;
   bool is_grain(int i) const;
   void particles_to_grid();
+  void add_wall_traction(const PointShape &ps, const double *xp, double V, double p);
   void update_grid(double h);
   void apply_grid_bc(double *v, int nodeidx_i, int nodeidx_j, int nodeidx_k);
   void grid_to_particles(double h);

@@ -133,9 +133,11 @@ def case_hydrostatic_convergence(r):
         print(f"  cells {cells}: L2 all points {e_all:.4f}, interior {e_in:.4f}")
         check(s["mass"][0] == s["mass0"][0], f"cells {cells}: fluid mass exactly conserved ({s['mass'][0]!r})")
         check(s["crossings"][0] == 0, f"cells {cells}: no material point crossed a wall")
-    # measured: all 0.160 -> 0.103, interior 0.084 -> 0.051 (boundary cells carry an O(1) error)
-    check(res[8][1] < 0.10, "interior L2 error below 0.10 at 8 cells")
-    check(res[16][1] < 0.065, "interior L2 error below 0.065 at 16 cells")
+    # measured: all points 0.061 -> 0.034, interior 0.062 -> 0.034 (the cell-constant pressure of
+    # the anti-locking gives a first-order staircase, 0.43 dx/h); without the wall traction term the
+    # boundary rows carried an O(1) error (all points 0.160 -> 0.103)
+    check(res[8][0] < 0.075 and res[8][1] < 0.075, "L2 error below 0.075 at 8 cells (all and interior points)")
+    check(res[16][0] < 0.042 and res[16][1] < 0.042, "L2 error below 0.042 at 16 cells (all and interior points)")
     check(res[16][0] < res[8][0] and res[16][1] < res[8][1], "error decreases from 8 to 16 cells")
 
 
@@ -144,9 +146,9 @@ def case_dambreak_reduced(r):
     d, _ = r.dambreak("dambreak_reduced", cells=16, tend=3.0)
     ef, eh = rms_vs_martin_moyce(os.path.join(d, "front.csv"))
     print(f"  MPM16 RMS front error {ef:.4f} a, height error {eh:.4f} a")
-    # measured 0.233 / 0.101; the MPM32 acceptance figure is a benchmark (tools/dambreak_study.py)
-    check(ef < 0.30, "front RMS error below 0.30 a at MPM16")
-    check(eh < 0.15, "wall-height RMS error below 0.15 a at MPM16")
+    # measured 0.185 / 0.021; the MPM32 acceptance figure is a benchmark (tools/dambreak_study.py)
+    check(ef < 0.25, "front RMS error below 0.25 a at MPM16")
+    check(eh < 0.05, "wall-height RMS error below 0.05 a at MPM16")
     s = read_csv(os.path.join(d, "summary.csv"))
     check(s["mass"][0] == s["mass0"][0], "fluid mass exactly conserved")
     f = read_csv(os.path.join(d, "front.csv"))
@@ -315,7 +317,7 @@ def case_settling(r):
     d, _ = r.run("settling/neutral", inp, {"rhop": 10.0})
     vn = read_csv(os.path.join(d, "settling.csv"))["v_z"][-1]
     print(f"  neutrally buoyant sphere: v_z = {vn:.2e} m/s")
-    check(abs(vn) < 0.02 * vt, "a sphere of the fluid's density stays (nearly) at rest: |v| < 2 % of v_t")
+    check(abs(vn) < 1e-3 * vt, "a sphere of the fluid's density stays at rest: |v| < 0.1 % of v_t")
     d, _ = r.run("settling/light", inp, {"rhop": 1.0})
     vl = read_csv(os.path.join(d, "settling.csv"))["v_z"][-1]
     # rise speed: the same balance with the density difference reversed
@@ -323,8 +325,7 @@ def case_settling(r):
     print(f"  lighter sphere (rho 1): v_z = {vl:.2e} m/s; relative to the neutral one {vl - vn:.2e}, "
           f"isolated rise speed {vrise:.2e} m/s")
     check(vl > 0.0, "a lighter sphere rises")
-    check(abs((vl - vn) - vrise) < 0.25 * vrise,
-          "its rise relative to the neutral sphere within 25 % of the isolated value")
+    check(abs(vl - vrise) < 0.05 * vrise, "it rises at the isolated-sphere speed within 5 %")
 
 
 def case_ergun(r):
