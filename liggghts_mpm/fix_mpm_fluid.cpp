@@ -1027,20 +1027,16 @@ void FixMpmFluid::couple_fluid_grains(double h) {
   grid.reverse_sum(g_cpl.data(), 3);
 
   const double mmin = mass_threshold * point_mass_ref;
-  const mpm::IndexBox &ob = grid.owned();
-  for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
-    for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
-      for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) {
-        const std::size_t n = grid.index(i, j, k);
-        const double *c = &g_cpl[3 * n];
-        const double *g = &g_p2g[7 * n];
-        double *st = &g_st[6 * n];
-        const double Vj = node_volume(i, j, k);
-        st[3] = Vj > 0.0 ? std::min(1.0, std::max(theta_min, 1.0 - c[0] / Vj)) : 1.0;  // (8-11), (8-14)
-        st[4] = c[2] > 0.0 ? c[1] / c[2] : 0.0;
-        st[5] = g[0];
-        for (int d = 0; d < 3; ++d) st[d] = g[0] > mmin ? g[1 + d] / g[0] : 0.0;
-      }
+  grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    const double *c = &g_cpl[3 * n];
+    const double *g = &g_p2g[7 * n];
+    double *st = &g_st[6 * n];
+    const double Vj = node_volume(i, j, k);
+    st[3] = Vj > 0.0 ? std::min(1.0, std::max(theta_min, 1.0 - c[0] / Vj)) : 1.0;  // (8-11), (8-14)
+    st[4] = c[2] > 0.0 ? c[1] / c[2] : 0.0;
+    st[5] = g[0];
+    for (int d = 0; d < 3; ++d) st[d] = g[0] > mmin ? g[1 + d] / g[0] : 0.0;
+  });
   grid.forward(g_st.data(), 6);
 
   // fluid fraction at the points (8-16)
@@ -1117,27 +1113,24 @@ void FixMpmFluid::couple_fluid_grains(double h) {
 
   // node-wise exact exchange; the fluid's share of it stays on the owner
   std::fill(g_rx.begin(), g_rx.end(), 0.0);
-  for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
-    for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
-      for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) {
-        const std::size_t n = grid.index(i, j, k);
-        double *q = &g_dr[kDr * n];
-        const double *st = &g_st[6 * n];
-        double *rx = &g_rx[3 * n];
-        double J[3] = {0, 0, 0};
-        if (q[0] > 0.0 && st[5] > mmin) {
-          const double vg[3] = {q[1] / q[0], q[2] / q[0], q[3] / q[0]};
-          const double ag[3] = {q[8] / q[0], q[9] / q[0], q[10] / q[0]};
-          const double *f = &g_p2g[7 * n + 4];
-          const double af[3] = {(f[0] + q[5]) / st[5], (f[1] + q[6]) / st[5], (f[2] + q[7]) / st[5]};
-          const double mg = q[11] > 0.0 ? HUGE_VAL : q[4];
-          mpm::drag_implicit_impulse(vg, st, mg, st[5], q[0], h, J, ag, af);
-        }
-        for (int d = 0; d < 3; ++d) {
-          rx[d] = q[5 + d] - J[d] / h;                    // force on the fluid
-          q[1 + d] = q[0] > 0.0 ? J[d] / q[0] : 0.0;      // impulse per unit K, to the grains
-        }
-      }
+  grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    double *q = &g_dr[kDr * n];
+    const double *st = &g_st[6 * n];
+    double *rx = &g_rx[3 * n];
+    double J[3] = {0, 0, 0};
+    if (q[0] > 0.0 && st[5] > mmin) {
+      const double vg[3] = {q[1] / q[0], q[2] / q[0], q[3] / q[0]};
+      const double ag[3] = {q[8] / q[0], q[9] / q[0], q[10] / q[0]};
+      const double *f = &g_p2g[7 * n + 4];
+      const double af[3] = {(f[0] + q[5]) / st[5], (f[1] + q[6]) / st[5], (f[2] + q[7]) / st[5]};
+      const double mg = q[11] > 0.0 ? HUGE_VAL : q[4];
+      mpm::drag_implicit_impulse(vg, st, mg, st[5], q[0], h, J, ag, af);
+    }
+    for (int d = 0; d < 3; ++d) {
+      rx[d] = q[5 + d] - J[d] / h;                    // force on the fluid
+      q[1 + d] = q[0] > 0.0 ? J[d] / q[0] : 0.0;      // impulse per unit K, to the grains
+    }
+  });
   grid.forward(g_dr.data(), kDr);
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
@@ -1199,30 +1192,26 @@ void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k) {
 /* grid momentum update (8-35), velocity (8-36), boundary conditions */
 void FixMpmFluid::update_grid(double h) {
   const double mmin = mass_threshold * point_mass_ref;
-  const mpm::IndexBox &ob = grid.owned();
-  for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
-    for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
-      for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) {
-        const std::size_t n = grid.index(i, j, k);
-        const double *g = &g_p2g[7 * n];
-        double *gv = &g_vel[6 * n];
-        if (g[0] <= mmin || g[0] <= 0.0) {
-          // Nearly empty node at the free surface: its velocity would be a
-          // ratio of two round-off-sized numbers; it carries no information.
-          for (int c = 0; c < 6; ++c) gv[c] = 0.0;
-          continue;
-        }
-        const double inv = 1.0 / g[0];
-        double vnew[3];
-        for (int d = 0; d < 3; ++d) {
-          gv[3 + d] = g[1 + d] * inv;
-          const double f = g[4 + d] + (coupled ? g_rx[3 * n + d] : 0.0);
-          // damping is implicit in time so that any rate is stable
-          vnew[d] = (gv[3 + d] + h * f * inv) / (1.0 + h * damping);
-        }
-        apply_grid_bc(vnew, i, j, k);
-        for (int d = 0; d < 3; ++d) gv[d] = vnew[d];
-      }
+  grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    const double *g = &g_p2g[7 * n];
+    double *gv = &g_vel[6 * n];
+    if (g[0] <= mmin || g[0] <= 0.0) {
+      // Nearly empty node at the free surface: its velocity would be a
+      // ratio of two round-off-sized numbers; it carries no information.
+      for (int c = 0; c < 6; ++c) gv[c] = 0.0;
+      return;
+    }
+    const double inv = 1.0 / g[0];
+    double vnew[3];
+    for (int d = 0; d < 3; ++d) {
+      gv[3 + d] = g[1 + d] * inv;
+      const double f = g[4 + d] + (coupled ? g_rx[3 * n + d] : 0.0);
+      // damping is implicit in time so that any rate is stable
+      vnew[d] = (gv[3 + d] + h * f * inv) / (1.0 + h * damping);
+    }
+    apply_grid_bc(vnew, i, j, k);
+    for (int d = 0; d < 3; ++d) gv[d] = vnew[d];
+  });
   grid.forward(g_vel.data(), 6);
 }
 
@@ -1300,20 +1289,16 @@ void FixMpmFluid::remap_velocity_musl() {
   }
   grid.reverse_sum(g_aux.data(), 3);
   const double mmin = mass_threshold * point_mass_ref;
-  const mpm::IndexBox &ob = grid.owned();
-  for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
-    for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
-      for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) {
-        const std::size_t n = grid.index(i, j, k);
-        const double m = g_p2g[7 * n];
-        double *g = &g_aux[3 * n];
-        if (m <= mmin || m <= 0.0) {
-          g[0] = g[1] = g[2] = 0.0;
-          continue;
-        }
-        for (int d = 0; d < 3; ++d) g[d] /= m;
-        apply_grid_bc(g, i, j, k);
-      }
+  grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    const double m = g_p2g[7 * n];
+    double *g = &g_aux[3 * n];
+    if (m <= mmin || m <= 0.0) {
+      g[0] = g[1] = g[2] = 0.0;
+      return;
+    }
+    for (int d = 0; d < 3; ++d) g[d] /= m;
+    apply_grid_bc(g, i, j, k);
+  });
   grid.forward(g_aux.data(), 3);
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;

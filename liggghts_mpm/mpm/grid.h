@@ -57,6 +57,14 @@ class LocalGrid {
            k >= patch_.lo[2] && k <= patch_.hi[2];
   }
 
+  // Calls fn(i, j, k, n) for every owned node (global indices, flat patch index).
+  template <class Fn>
+  void for_owned(Fn &&fn) const {
+    for (int k = owned_.lo[2]; k <= owned_.hi[2]; ++k)
+      for (int j = owned_.lo[1]; j <= owned_.hi[1]; ++j)
+        for (int i = owned_.lo[0]; i <= owned_.hi[0]; ++i) fn(i, j, k, index(i, j, k));
+  }
+
   // Adds the halo partial sums of data (stride doubles per node) into their owners.
   void reverse_sum(double *data, int stride);
   // Copies owned values into every rank's halo images.
