@@ -17,24 +17,11 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-FAILURES = []
 
 
-def check(cond, what):
-    print(("ok    " if cond else "FAIL  ") + what)
-    if not cond:
-        FAILURES.append(what)
-
-
-def read_csv(path):
-    with open(path) as f:
-        rows = [ln.strip() for ln in f if ln.strip() and not ln.lstrip().startswith("#")]
-    names = rows[0].split(",")
-    cols = {n: [] for n in names}
-    for r in rows[1:]:
-        for n, v in zip(names, r.split(",")):
-            cols[n].append(float(v))
-    return cols
+# the same check/CSV helpers as the other whole-program cases
+sys.path.insert(0, HERE)
+from cases import FAILURES, check, read_csv  # noqa: E402
 
 
 class Runner:
