@@ -426,6 +426,17 @@ run 0
           "'cell_check no' runs with a warning")
 
 
+def case_tank_smoke(r):
+    """C3 reduced (quick mode): beads settle, fluid is created around them, the mesh gate lifts."""
+    d, p = r.run("tank_smoke", os.path.join(r.inputs, "tank", "in.tank"), {"quick": 1})
+    f = read_csv(os.path.join(d, "fronts.csv"))
+    check(len(f["t"]) > 2, f"fronts.csv has rows ({len(f['t'])})")
+    check(all(math.isfinite(v) for k in ("x_water", "x_beads") for v in f[k]), "fronts finite")
+    check(max(f["mass"]) == min(f["mass"]), "fluid mass constant after the grains displaced it")
+    check(f["gate_z"][-1] > f["gate_z"][0], "the gate mesh has risen")
+    check(all(0.0 < v <= 0.2 for v in f["x_water"] + f["x_beads"]), "fronts inside the tank")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("case")
