@@ -237,18 +237,32 @@ def main():
 
     fig, ax = plt.subplots(figsize=(6, 4.5))
     others = [rw for rw in rows if rw["dir"] != ref["dir"] and math.isfinite(rw["wall"])]
-    if others:
-        w = [rw["wall"] for rw in others]
-        ax.loglog(w, [max(rw["rms_water"], 1e-6) for rw in others], "o-", label="water front, RMS")
-        ax.loglog(w, [max(rw["rms_beads"], 1e-6) for rw in others], "s--", label="bead front, RMS")
-        for rw in others:
+    # one line per series: the grid series (points per cell of the reference) and the
+    # points-per-cell series (cells of the reference); any other run as single markers
+    series = [("grid series, %d points/cell" % int(ref["npc"]), [rw for rw in others if rw["ppc"] == int(ref["npc"])]),
+              ("points/cell series, Grid%d" % int(ref["cells"]), [rw for rw in others if rw["cells"] == int(ref["cells"])
+                                                                 and rw["ppc"] != int(ref["npc"])])]
+    rest = [rw for rw in others if all(rw not in grp for _, grp in series)]
+    if rest:
+        series.append(("other runs", rest))
+    for k, (name, grp) in enumerate(series):
+        if not grp:
+            continue
+        grp = sorted(grp, key=lambda rw: (rw["cells"], rw["ppc"]))  # in order of resolution
+        w = [rw["wall"] for rw in grp]
+        ls = "" if name == "other runs" else "-"
+        ax.loglog(w, [max(rw["rms_water"], 1e-6) for rw in grp], "o" + ls, color="C%d" % k,
+                  label=name + ": water")
+        ax.loglog(w, [max(rw["rms_beads"], 1e-6) for rw in grp], "s" + (ls and "-") + "-", color="C%d" % k,
+                  mfc="none", label=name + ": beads")
+        for rw in grp:
             ax.annotate(rw["run"], (rw["wall"], max(rw["rms_water"], 1e-6)), fontsize=7,
                         textcoords="offset points", xytext=(4, 4))
     ax.set_xlabel("wall time (s)")
-    ax.set_ylabel("difference from %s (m)" % ref["label"])
+    ax.set_ylabel("RMS difference from %s (m)" % ref["label"])
     ax.set_title("C3 tank: convergence against cost")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(a.out + "_convergence.png", dpi=150)
     print("wrote", a.out + "_convergence.png")
