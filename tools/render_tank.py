@@ -23,24 +23,11 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from tank_fronts import read_info  # noqa: E402  (tank_run.txt reader shared with the fronts tool)
+
 WATER = "#8ecae6"   # light blue
 BEADS = "#08306b"   # dark blue
-
-
-def read_run(rundir):
-    """key = value lines of tank_run.txt -> dict (numbers converted)."""
-    info = {}
-    path = os.path.join(rundir, "tank_run.txt")
-    with open(path) as f:
-        for line in f:
-            if "=" not in line:
-                continue
-            k, v = (s.strip() for s in line.split("=", 1))
-            try:
-                info[k] = float(v)
-            except ValueError:
-                info[k] = v
-    return info
 
 
 def read_dump(path):
@@ -93,7 +80,9 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    info = read_run(a.rundir)
+    info = read_info(a.rundir)
+    if not info:
+        sys.exit(f"render_tank: no tank_run.txt in {a.rundir} (not a run of inputs/tank/in.tank?)")
     dt, n0 = info["dt"], int(info["gate_start_step"])
     prefix = str(info.get("prefix", "tank"))
     L, W, H = info.get("L", 0.2), info.get("W", 0.1), info.get("H", 0.15)
