@@ -71,30 +71,49 @@ def rms_vs_martin_moyce(front_csv, width=4.0, g=9.81):
 
 class Runner:
     def __init__(self, a):
-        self.exe = os.path.abspath(a.exe)
-        self.inputs = os.path.abspath(a.inputs)
+        self.exe = os.path.abspath(a.exe) if a.exe else None
+        self.inputs = os.path.abspath(a.inputs) if getattr(a, "inputs", None) else None
         self.work = os.path.abspath(a.work)
         self.mpirun = shlex.split(a.mpirun)
 
-    def run(self, case, infile, variables, np=1, expect_ok=True, extra_files=()):
+    def fresh(self, case):
+        """An empty work folder for a case."""
         d = os.path.join(self.work, case)
         shutil.rmtree(d, ignore_errors=True)
         os.makedirs(d)
-        shutil.copy(infile, d)
-        for f in extra_files:
-            shutil.copy(f, d)
-        cmd = [self.exe, "-in", os.path.basename(infile), "-echo", "none"]
-        for k, v in variables.items():
-            cmd += ["-var", k, str(v)]
+        return d
+
+    def execute(self, d, infile, variables=None, np=1, expect_ok=True, timeout=900):
+        """Runs liggghts_mpm on the input file 'infile' (a name in folder d) with -var pairs."""
+        if not self.exe:
+            raise RuntimeError("--exe is required for this case")
+        cmd = [self.exe, "-in", infile, "-echo", "none"]
+        for k, v in (variables or {}).items():
+            cmd += ["-var", k, str(v)]  # one word: "partial 0.5" stays one value
         if np > 1:
             cmd = self.mpirun + ["-np", str(np)] + cmd
-        p = subprocess.run(cmd, cwd=d, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", timeout=900)
+        p = subprocess.run(cmd, cwd=d, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                           errors="replace", timeout=timeout)
         with open(os.path.join(d, "output.txt"), "w") as f:
             f.write(p.stdout)
         if expect_ok and p.returncode != 0:
             tail = "\n".join(p.stdout.splitlines()[-15:])
-            raise RuntimeError(f"{case}: liggghts_mpm exited with {p.returncode}:\n{tail}")
-        return d, p
+            raise RuntimeError(f"{os.path.basename(d)}: liggghts_mpm exited with {p.returncode}:\n{tail}")
+        return p
+
+    def run(self, case, infile, variables, np=1, expect_ok=True, extra_files=()):
+        d = self.fresh(case)
+        for f in (infile,) + tuple(extra_files):
+            shutil.copy(f, d)
+        return d, self.execute(d, os.path.basename(infile), variables, np, expect_ok)
+
+    def run_script(self, case, text):
+        """Runs an input given as text (no -var); returns the process and its first ERROR line."""
+        d = self.fresh(case)
+        with open(os.path.join(d, "in.script"), "w") as f:
+            f.write(text)
+        p = self.execute(d, "in.script", expect_ok=False, timeout=60)
+        return p, next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
 
     def dambreak(self, case, np=1, **v):
         return self.run(case, os.path.join(self.inputs, "dambreak", "in.dambreak"), v, np=np)
@@ -176,8 +195,7 @@ def case_restart_roundtrip(r):
     d0, _ = r.run("restart/full", inp, {"mode": 0})
     d1, _ = r.run("restart/split", inp, {"mode": 1})
     # the second half runs in the same folder, from restart.mpm
-    cmd = [r.exe, "-in", "in.restart", "-echo", "none", "-var", "mode", "2"]
-    p = subprocess.run(cmd, cwd=d1, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace", timeout=300)
+    p = r.execute(d1, "in.restart", {"mode": 2}, expect_ok=False, timeout=300)
     check(p.returncode == 0, "restarted run finished")
     a = read_csv(os.path.join(d0, "state.csv"))
     b = read_csv(os.path.join(d1, "state.csv"))
@@ -222,14 +240,7 @@ fix f all mpm/fluid {args}
 run 0
 """
     for i, (args, expect) in enumerate(cases):
-        d = os.path.join(r.work, "bad_input", str(i))
-        shutil.rmtree(d, ignore_errors=True)
-        os.makedirs(d)
-        with open(os.path.join(d, "in.bad"), "w") as f:
-            f.write(tmpl.format(args=args))
-        p = subprocess.run([r.exe, "-in", "in.bad", "-echo", "none"], cwd=d, stdout=subprocess.PIPE,
-                           stderr=subprocess.STDOUT, text=True, errors="replace", timeout=60)
-        msg = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
+        p, msg = r.run_script(f"bad_input/{i}", tmpl.format(args=args))
         check(p.returncode != 0 and "mpm/fluid" in msg and expect in msg,
               f"'{args[-40:]}' -> error containing \"{expect}\" (got: {msg.strip()[:160]})")
 
@@ -405,23 +416,11 @@ run 0
         ("0.008", "viscosity 1e-3 couple grains", "is smaller than the largest grain"),
     ]
     for i, (dia, args, expect) in enumerate(cases):
-        d = os.path.join(r.work, "coupling_bad_input", str(i))
-        shutil.rmtree(d, ignore_errors=True)
-        os.makedirs(d)
-        with open(os.path.join(d, "in.bad"), "w") as f:
-            f.write(tmpl.format(d=dia, args=args))
-        p = subprocess.run([r.exe, "-in", "in.bad", "-echo", "none"], cwd=d, stdout=subprocess.PIPE,
-                           stderr=subprocess.STDOUT, text=True, errors="replace", timeout=60)
-        msg = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
+        p, msg = r.run_script(f"coupling_bad_input/{i}", tmpl.format(d=dia, args=args))
         check(p.returncode != 0 and expect in msg, f"'{args}' (d = {dia}) -> \"{expect}\" (got: {msg.strip()[:150]})")
     # the override turns the grain-size error into a warning and runs
-    d = os.path.join(r.work, "coupling_bad_input", "override")
-    shutil.rmtree(d, ignore_errors=True)
-    os.makedirs(d)
-    with open(os.path.join(d, "in.ok"), "w") as f:
-        f.write(tmpl.format(d="0.008", args="viscosity 1e-3 couple grains cell_check no"))
-    p = subprocess.run([r.exe, "-in", "in.ok", "-echo", "none"], cwd=d, stdout=subprocess.PIPE,
-                       stderr=subprocess.STDOUT, text=True, errors="replace", timeout=60)
+    p, _ = r.run_script("coupling_bad_input/override",
+                        tmpl.format(d="0.008", args="viscosity 1e-3 couple grains cell_check no"))
     check(p.returncode == 0 and "WARNING" in p.stdout and "smaller than the largest grain" in p.stdout,
           "'cell_check no' runs with a warning")
 

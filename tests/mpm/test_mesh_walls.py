@@ -11,8 +11,6 @@ STL files tests/mpm/box.stl, gate.stl and drum.stl. Exit status 0 when every che
 """
 import argparse
 import os
-import shlex
-import shutil
 import subprocess
 import sys
 
@@ -21,37 +19,20 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 # the same check/CSV helpers as the other whole-program cases
 sys.path.insert(0, HERE)
+import cases  # noqa: E402
 from cases import FAILURES, check, read_csv  # noqa: E402
 
 
-class Runner:
+class Runner(cases.Runner):
+    """cases.Runner with the inputs and STL files of this folder."""
+
     def __init__(self, a):
-        self.exe = os.path.abspath(a.exe) if a.exe else None
-        self.work = os.path.abspath(a.work)
-        self.mpirun = shlex.split(a.mpirun)
+        super().__init__(a)
         self.unit = os.path.abspath(a.unit) if a.unit else None
 
     def run(self, case, infile, stl, variables, np=1, expect_ok=True):
-        if not self.exe:
-            raise RuntimeError("--exe is required for this case")
-        d = os.path.join(self.work, case)
-        shutil.rmtree(d, ignore_errors=True)
-        os.makedirs(d)
-        shutil.copy(os.path.join(HERE, infile), d)
-        shutil.copy(os.path.join(HERE, stl), d)
-        cmd = [self.exe, "-in", infile, "-echo", "none"]
-        for k, v in variables.items():
-            cmd += ["-var", k, str(v)]  # one word: "partial 0.5" stays one value
-        if np > 1:
-            cmd = self.mpirun + ["-np", str(np)] + cmd
-        p = subprocess.run(cmd, cwd=d, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                           errors="replace", timeout=900)
-        with open(os.path.join(d, "output.txt"), "w") as f:
-            f.write(p.stdout)
-        if expect_ok and p.returncode != 0:
-            tail = "\n".join(p.stdout.splitlines()[-15:])
-            raise RuntimeError(f"{case}: liggghts_mpm exited with {p.returncode}:\n{tail}")
-        return d, p
+        return super().run(case, os.path.join(HERE, infile), variables, np, expect_ok,
+                           extra_files=(os.path.join(HERE, stl),))
 
 
 # ---------------------------------------------------------------- cases
