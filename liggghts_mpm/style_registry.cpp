@@ -7,6 +7,7 @@
 #include "lammps.h"
 #include "modify.h"
 
+#include "fix_balance_mpm.h"
 #include "fix_mpm_fluid.h"
 
 using namespace LAMMPS_NS;
@@ -38,4 +39,5 @@ Fix *create_fix(LAMMPS *lmp, int narg, char **arg) {
 void mpm::register_styles(LAMMPS *lmp) {
   std::map<std::string, FixCreatorFn> &fixes = *(lmp->modify->*modify_fix_map());
   fixes["mpm/fluid"] = &create_fix<FixMpmFluid>;
+  fixes["balance/mpm"] = &create_fix<FixBalanceMpm>;
 }

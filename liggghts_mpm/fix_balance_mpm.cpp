@@ -1,0 +1,279 @@
+#include "fix_balance_mpm.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <sstream>
+#include <utility>
+
+#include "atom.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "group.h"
+#include "irregular.h"
+#include "modify.h"
+#include "neighbor.h"
+#include "update.h"
+
+using namespace LAMMPS_NS;
+
+namespace {
+
+bool parse_double(const char *s, double &v) {
+  char *end = nullptr;
+  v = std::strtod(s, &end);
+  return end != s && *end == '\0' && std::isfinite(v);
+}
+
+bool parse_int(const char *s, int &v) {
+  char *end = nullptr;
+  const long l = std::strtol(s, &end, 10);
+  if (end == s || *end != '\0' || l < 0 || l > std::numeric_limits<int>::max()) return false;
+  v = static_cast<int>(l);
+  return true;
+}
+
+}  // namespace
+
+/* ----------------------------------------------------------------------
+   fix ID group-ID balance/mpm dim x|y|z [every N] [weight group-ID w]... [thresh t]
+------------------------------------------------------------------------- */
+
+FixBalanceMpm::FixBalanceMpm(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
+  int iarg = 3;
+  while (iarg < narg) {
+    const char *kw = arg[iarg];
+    const char *v = iarg + 1 < narg ? arg[iarg + 1] : nullptr;
+    if (strcmp(kw, "dim") == 0) {
+      if (!v || strlen(v) != 1 || !strchr("xyz", v[0])) bad_arg(kw, "x, y or z", v);
+      dim_ = v[0] - 'x';
+      iarg += 2;
+    } else if (strcmp(kw, "every") == 0) {
+      if (!v || !parse_int(v, every_)) bad_arg(kw, "a number of steps >= 0", v);
+      iarg += 2;
+    } else if (strcmp(kw, "thresh") == 0) {
+      if (!v || !parse_double(v, thresh_) || thresh_ < 1.0) bad_arg(kw, "an imbalance factor >= 1", v);
+      iarg += 2;
+    } else if (strcmp(kw, "weight") == 0) {
+      if (!v) bad_arg(kw, "a group ID and a weight", v);
+      const int ig = group->find(v);
+      if (ig < 0) bad_arg(kw, "an existing group ID", v);
+      const char *w = iarg + 2 < narg ? arg[iarg + 2] : nullptr;
+      double wv = 0.0;
+      if (!w || !parse_double(w, wv) || wv < 0.0) bad_arg("weight", "a weight >= 0 after the group ID", w);
+      wgroup_bits_.push_back(group->bitmask[ig]);
+      wvalues_.push_back(wv);
+      iarg += 3;
+    } else {
+      error->all(FLERR, (std::string("Fix balance/mpm: unknown keyword '") + kw +
+                         "' (expected dim, every, weight or thresh)").c_str());
+    }
+  }
+  if (dim_ < 0) error->all(FLERR, "Fix balance/mpm: keyword 'dim' (x, y or z) is required");
+  if (domain->triclinic) error->all(FLERR, "Fix balance/mpm: needs an orthogonal box");
+  if (dim_ == 2 && domain->dimension == 2) error->all(FLERR, "Fix balance/mpm: keyword 'dim' is z in a 2d run");
+
+  box_change_domain = 1;
+  if (every_ > 0) force_reneighbor = 1;
+  next_reneighbor = -1;
+
+  const int P = comm->procgrid[dim_];
+  cut_.resize(P + 1);
+  const double *split = dim_ == 0 ? comm->xsplit : dim_ == 1 ? comm->ysplit : comm->zsplit;
+  for (int k = 0; k <= P; ++k) cut_[k] = domain->boxlo[dim_] + domain->prd[dim_] * split[k];
+
+  vector_flag = 1;
+  size_vector = 3 + P + 1;
+  global_freq = 1;
+  extvector = 0;
+}
+
+void FixBalanceMpm::bad_arg(const char *keyword, const char *expected, const char *given) {
+  std::string msg = std::string("Fix balance/mpm: keyword '") + keyword + "' expects " + expected +
+                    ", got " + (given ? std::string("'") + given + "'" : std::string("nothing"));
+  error->all(FLERR, msg.c_str());
+}
+
+int FixBalanceMpm::setmask() { return FixConst::PRE_EXCHANGE; }
+
+void FixBalanceMpm::init() {
+  // fix mpm/fluid builds its grid patch from the subdomain at the setup of a
+  // run; moving the cuts inside a run would leave it with the old patch.
+  if (every_ > 0)
+    for (int m = 0; m < modify->nfix; ++m)
+      if (strcmp(modify->fix[m]->style, "mpm/fluid") == 0)
+        error->all(FLERR, "Fix balance/mpm: keyword 'every' > 0 cannot be used with fix mpm/fluid, which builds "
+                          "its grid patch at the setup of a run; use 'every 0' (balance at the setup of every "
+                          "run) and split the run into several runs");
+}
+
+double FixBalanceMpm::weight(int i) const {
+  const int mask = atom->mask[i];
+  double w = (mask & groupbit) ? 1.0 : 0.0;
+  for (std::size_t g = 0; g < wgroup_bits_.size(); ++g)
+    if (mask & wgroup_bits_[g]) w = wvalues_[g];
+  return w;
+}
+
+double FixBalanceMpm::imbalance() const {
+  double mine = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i) mine += weight(i);
+  double mx = 0.0, sum = 0.0;
+  MPI_Allreduce(&mine, &mx, 1, MPI_DOUBLE, MPI_MAX, world);
+  MPI_Allreduce(&mine, &sum, 1, MPI_DOUBLE, MPI_SUM, world);
+  return sum > 0.0 ? mx / (sum / comm->nprocs) : 1.0;
+}
+
+/* ----------------------------------------------------------------------
+   Cut k (1..P-1) goes where the weight below it is k/P of the total. The
+   weight below a coordinate is a step function (atoms sit on planes, e.g. the
+   lattice of material points), so the target is bracketed by bisection on
+   the coordinate (one vector MPI_Allreduce per step, all cuts at once), then
+   the cut is put halfway between the plane that crosses the target and its
+   neighbour on the side that comes closer to the target.
+------------------------------------------------------------------------- */
+
+void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
+  const int P = comm->procgrid[dim_], nc = P - 1;
+  const double lo = domain->boxlo[dim_], hi = domain->boxhi[dim_], len = hi - lo;
+  const double inf = std::numeric_limits<double>::infinity();
+
+  std::vector<std::pair<double, double>> cw;
+  for (int i = 0; i < atom->nlocal; ++i) {
+    const double w = weight(i);
+    if (w > 0.0) cw.emplace_back(atom->x[i][dim_], w);
+  }
+  std::sort(cw.begin(), cw.end());
+  std::vector<double> xs(cw.size()), pre(cw.size() + 1, 0.0);
+  for (std::size_t n = 0; n < cw.size(); ++n) {
+    xs[n] = cw[n].first;
+    pre[n + 1] = pre[n] + cw[n].second;
+  }
+  auto below = [&](double c) { return pre[std::lower_bound(xs.begin(), xs.end(), c) - xs.begin()]; };
+  auto last_below = [&](double c) {  // largest local coordinate < c, or -inf
+    auto it = std::lower_bound(xs.begin(), xs.end(), c);
+    return it == xs.begin() ? -inf : *(it - 1);
+  };
+  auto first_at = [&](double c) {  // smallest local coordinate >= c, or +inf
+    auto it = std::lower_bound(xs.begin(), xs.end(), c);
+    return it == xs.end() ? inf : *it;
+  };
+
+  double total = 0.0;
+  MPI_Allreduce(&pre.back(), &total, 1, MPI_DOUBLE, MPI_SUM, world);
+  cut.assign(P + 1, 0.0);
+  cut[0] = lo;
+  cut[P] = hi;
+  if (total <= 0.0) {  // nothing to balance: uniform slabs
+    for (int k = 1; k < P; ++k) cut[k] = lo + len * k / P;
+    return;
+  }
+
+  // bisection: W(< a_k) < T_k <= W(< b_k)
+  std::vector<double> a(nc, lo), b(nc, hi + 1e-9 * len), loc(nc), glob(nc);
+  for (int it = 0; it < 64; ++it) {
+    for (int k = 0; k < nc; ++k) loc[k] = below(0.5 * (a[k] + b[k]));
+    MPI_Allreduce(loc.data(), glob.data(), nc, MPI_DOUBLE, MPI_SUM, world);
+    for (int k = 0; k < nc; ++k) {
+      const double mid = 0.5 * (a[k] + b[k]), target = total * (k + 1) / P;
+      (glob[k] < target ? a[k] : b[k]) = mid;
+    }
+  }
+  // c_k: the plane that crosses the target (largest coordinate < b_k)
+  std::vector<double> c(nc);
+  for (int k = 0; k < nc; ++k) loc[k] = last_below(b[k]);
+  MPI_Allreduce(loc.data(), c.data(), nc, MPI_DOUBLE, MPI_MAX, world);
+  // weights below and including the plane, the planes before and after it
+  std::vector<double> w2(2 * nc), w2g(2 * nc), prev(nc), next(nc);
+  for (int k = 0; k < nc; ++k) {
+    w2[2 * k] = std::isfinite(c[k]) ? below(c[k]) : 0.0;
+    w2[2 * k + 1] = below(b[k]);
+    loc[k] = std::isfinite(c[k]) ? last_below(c[k]) : -inf;
+  }
+  MPI_Allreduce(w2.data(), w2g.data(), 2 * nc, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(loc.data(), prev.data(), nc, MPI_DOUBLE, MPI_MAX, world);
+  for (int k = 0; k < nc; ++k) loc[k] = first_at(b[k]);
+  MPI_Allreduce(loc.data(), next.data(), nc, MPI_DOUBLE, MPI_MIN, world);
+
+  for (int k = 0; k < nc; ++k) {
+    const double target = total * (k + 1) / P;
+    double x;
+    if (!std::isfinite(c[k])) {
+      x = b[k];
+    } else if (std::fabs(w2g[2 * k] - target) <= std::fabs(w2g[2 * k + 1] - target)) {
+      x = 0.5 * ((std::isfinite(prev[k]) ? prev[k] : lo) + c[k]);  // plane goes to the upper slab
+    } else {
+      x = 0.5 * (c[k] + (std::isfinite(next[k]) ? next[k] : hi));  // plane stays in the lower slab
+    }
+    cut[k + 1] = x;
+  }
+  // strictly increasing, inside the box
+  const double minw = 1e-6 * len;
+  for (int k = 1; k < P; ++k) cut[k] = std::min(std::max(cut[k], cut[k - 1] + minw), hi - (P - k) * minw);
+}
+
+void FixBalanceMpm::balance() {
+  const int P = comm->procgrid[dim_];
+  if (P < 2) return;
+  imb_before_ = imbalance();
+  if (thresh_ > 1.0 && imb_before_ <= thresh_) {
+    imb_after_ = imb_before_;
+    return;
+  }
+  std::vector<double> cut;
+  find_cuts(cut);
+
+  double *split = dim_ == 0 ? comm->xsplit : dim_ == 1 ? comm->ysplit : comm->zsplit;
+  const double lo = domain->boxlo[dim_], len = domain->prd[dim_];
+  split[0] = 0.0;
+  split[P] = 1.0;
+  for (int k = 1; k < P; ++k) split[k] = (cut[k] - lo) / len;
+  for (int k = 0; k <= P; ++k) cut_[k] = lo + len * split[k];
+  comm->uniform = 0;
+  domain->set_local_box();
+
+  // atoms to their new owners (possibly several ranks away), then the
+  // communication pattern and the neighbour bins of the new subdomains
+  domain->pbc();
+  Irregular irregular(lmp);
+  irregular.migrate_atoms();
+  comm->setup();
+  if (neighbor->style) neighbor->setup_bins();
+
+  imb_after_ = imbalance();
+  ++nbalance_;
+  if (comm->me == 0) {
+    std::ostringstream os;
+    os.precision(6);
+    os << "fix balance/mpm: step " << update->ntimestep << ", cuts in " << char('x' + dim_) << ":";
+    for (double x : cut_) os << " " << x;
+    os.precision(4);
+    os << " (imbalance " << imb_before_ << " -> " << imb_after_ << ")\n";
+    if (screen) fputs(os.str().c_str(), screen);
+    if (logfile) fputs(os.str().c_str(), logfile);
+  }
+}
+
+void FixBalanceMpm::setup_pre_exchange() {
+  balance();
+  if (every_ > 0) next_reneighbor = (update->ntimestep / every_ + 1) * every_;
+}
+
+void FixBalanceMpm::pre_exchange() {
+  if (every_ <= 0 || update->ntimestep < next_reneighbor) return;
+  balance();
+  next_reneighbor = (update->ntimestep / every_ + 1) * every_;
+}
+
+double FixBalanceMpm::compute_vector(int n) {
+  if (n == 0) return imb_after_;
+  if (n == 1) return imb_before_;
+  if (n == 2) return nbalance_;
+  return cut_[n - 3];
+}

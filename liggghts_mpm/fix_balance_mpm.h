@@ -1,0 +1,50 @@
+// fix balance/mpm: static load balance along one dimension for LIGGGHTS 3.8,
+// which has no 'balance' command. Places the cuts between the subdomains of
+// one processor-grid dimension so that every slab holds the same weight of
+// atoms (material points of fix mpm/fluid, grains, ...), moves the atoms to
+// their new owners and lets LIGGGHTS rebuild its communication and bins.
+// User page: docs/fix_balance_mpm.md.
+#ifdef FIX_CLASS
+FixStyle(balance/mpm,FixBalanceMpm)
+#else
+
+#ifndef LMP_FIX_BALANCE_MPM_H
+#define LMP_FIX_BALANCE_MPM_H
+
+#include <string>
+#include <vector>
+
+#include "fix.h"
+
+namespace LAMMPS_NS {
+
+class FixBalanceMpm : public Fix {
+ public:
+  FixBalanceMpm(class LAMMPS *, int, char **);
+  int setmask() override;
+  void init() override;
+  void setup_pre_exchange() override;
+  void pre_exchange() override;
+  double compute_vector(int) override;
+
+ private:
+  void bad_arg(const char *keyword, const char *expected, const char *given);
+  double weight(int i) const;
+  double imbalance() const;                 // max rank weight / mean rank weight (collective)
+  void find_cuts(std::vector<double> &cut);  // new cut coordinates along dim_ (collective)
+  void balance();
+
+  int dim_ = -1;         // 0, 1, 2
+  int every_ = 0;        // 0: only at the setup of each run
+  double thresh_ = 1.0;  // balance only if the imbalance exceeds this
+  std::vector<int> wgroup_bits_;
+  std::vector<double> wvalues_;
+  std::vector<double> cut_;  // current cuts (absolute), procgrid[dim]+1 values
+  double imb_before_ = 1.0, imb_after_ = 1.0;
+  int nbalance_ = 0;
+};
+
+}  // namespace LAMMPS_NS
+
+#endif
+#endif

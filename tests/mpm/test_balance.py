@@ -1,0 +1,147 @@
+#!/usr/bin/env python3
+"""Whole-program tests of fix balance/mpm (liggghts_mpm/fix_balance_mpm.h; docs/fix_balance_mpm.md).
+Standard library only.
+
+    test_balance.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR [--mpirun "mpirun ..."]
+
+CASE: np2 (3-D dam break of inputs/bench on 2 ranks with the balance fix against 1 rank),
+every_dem (re-balancing inside a run, no fluid), bad_input, all. Exit status 0 when every check passes.
+"""
+import argparse
+import os
+import re
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+import cases  # noqa: E402
+from cases import FAILURES, check, read_csv  # noqa: E402
+
+
+def cut_lines(text):
+    """[(step, [cuts], imbalance before, after)] from the fix's log lines."""
+    out = []
+    for m in re.finditer(r"fix balance/mpm: step (\d+), cuts in \w:([-\d.eE+ ]+)\(imbalance (\S+) -> (\S+)\)", text):
+        out.append((int(m.group(1)), [float(v) for v in m.group(2).split()], float(m.group(3)),
+                    float(m.group(4))))
+    return out
+
+
+def case_np2(r):
+    """2 ranks with balance/mpm (re-balanced at the setup of each of 3 runs) = 1 rank to 1e-10."""
+    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
+    v = dict(cells=8, warm=10, nsteps=90, segments=3)
+    d1, _ = r.run("balance_np2/np1", inp, v)
+    d2, p2 = r.run("balance_np2/np2", inp, dict(v, balance=1), np=2)
+    f1 = read_csv(os.path.join(d1, "bench3d.csv"))
+    f2 = read_csv(os.path.join(d2, "bench3d.csv"))
+    for k in ("front_x", "front_y", "points", "steps"):
+        diff = abs(f1[k][0] - f2[k][0])
+        check(diff < 1e-10, f"{k}: np2 (balanced) = np1 to 1e-10 (|diff| = {diff:.1e})")
+    check(f1["front_x"][0] > 0.5 + 1e-3, "the column has started to spread")
+    lines = cut_lines(p2.stdout)
+    print("  " + "\n  ".join(str(ln) for ln in lines))
+    check(len(lines) == 4, f"balanced at the setup of every run ({len(lines)} of 4)")
+    if lines:
+        step, cuts, before, after = lines[0]
+        # uniform cut of the 3 m box would be 1.5 m; the column occupies x < 1
+        check(abs(cuts[1] - 1.5) > 0.5 and 0.0 < cuts[1] < 1.0, f"the cut moved into the column ({cuts[1]:.4f} m)")
+        check(before > 1.9 and after < 1.05, f"imbalance {before:.3f} -> {after:.3f} (max rank / mean)")
+
+
+def case_bad_input(r):
+    """Bad arguments stop with an error naming the command and the keyword."""
+    tmpl = """atom_style sphere
+atom_modify map array sort 0 0
+boundary f f f
+units si
+region box block 0 2 0 1 0 1 units box
+create_box 1 box
+region col block 0 1 0 1 0 1 units box
+neighbor 0.1 bin
+fix b all balance/mpm {args}
+fix f all mpm/fluid cell 0.25 density 1000 bulk 2e6 fill col 2 2 2 type 1
+run 0
+"""
+    bad = [
+        ("dim x colour red", "Fix balance/mpm: unknown keyword 'colour'"),
+        ("dim", "Fix balance/mpm: keyword 'dim' expects x, y or z, got nothing"),
+        ("dim w", "Fix balance/mpm: keyword 'dim' expects x, y or z, got 'w'"),
+        ("every 10", "Fix balance/mpm: keyword 'dim' (x, y or z) is required"),
+        ("dim x every", "Fix balance/mpm: keyword 'every' expects"),
+        ("dim x every -3", "Fix balance/mpm: keyword 'every' expects"),
+        ("dim x thresh 0.5", "Fix balance/mpm: keyword 'thresh' expects an imbalance factor >= 1"),
+        ("dim x weight nogroup 2", "Fix balance/mpm: keyword 'weight' expects an existing group ID"),
+        ("dim x weight all", "Fix balance/mpm: keyword 'weight' expects a weight >= 0"),
+        ("dim x every 100", "Fix balance/mpm: keyword 'every' > 0 cannot be used with fix mpm/fluid"),
+    ]
+    for i, (args, expect) in enumerate(bad):
+        p, msg = r.run_script(f"balance_bad_input/{i}", tmpl.format(args=args))
+        check(p.returncode != 0 and expect in msg, f"'{args}' -> \"{expect}\" (got: {msg.strip()[:150]})")
+    p, msg = r.run_script("balance_bad_input/ok", tmpl.format(args="dim x every 0 weight all 1.0 thresh 1.1"))
+    check(p.returncode == 0, f"valid arguments run ({msg.strip()[:120]})")
+
+
+DEM = """atom_style sphere
+atom_modify map array sort 0 0
+boundary f f f
+units si
+processors * 1 1
+region box block 0 4 0 1 0 1 units box
+create_box 1 box
+region left block 0 1 0 1 0 1 units box
+lattice sc 0.1
+create_atoms 1 region left
+set group all diameter 0.01 density 1000
+neighbor 0.05 bin
+neigh_modify delay 0 every 1 check yes
+velocity all set 1.0 0 0 units box
+fix bal all balance/mpm dim x every 50
+fix nve all nve/sphere
+thermo_style custom step atoms f_bal[1] f_bal[3] f_bal[5]
+thermo 50
+timestep 0.005
+run 400
+"""
+
+
+def case_every_dem(r):
+    """Without fix mpm/fluid, 'every 50' re-balances inside a run: a slab of atoms drifting in +x."""
+    d = r.fresh("balance_every_dem")
+    with open(os.path.join(d, "in.dem"), "w") as f:
+        f.write(DEM)
+    p = r.execute(d, "in.dem", np=2)
+    lines = cut_lines(p.stdout)
+    check(len(lines) == 9, f"balanced at setup and every 50 steps ({len(lines)} of 9)")
+    cuts = [ln[1][1] for ln in lines]
+    # 11 planes of 100 atoms (x = 0, 0.1, ..1.0) move at 1 m/s: the cut follows them
+    check(all(b > a for a, b in zip(cuts, cuts[1:])), f"the cut follows the atoms ({cuts[0]:.3f} -> {cuts[-1]:.3f})")
+    check(abs(cuts[-1] - (0.45 + 2.0)) < 1e-6, "cut between the 5th and 6th plane after 2 s")
+    check(all(ln[3] < 1.1 for ln in lines), "imbalance after each balance at most 6/5.5")
+    check(re.search(r"^\s*400\s+1100\s", p.stdout, re.M) is not None, "no atom lost (1100 at step 400)")
+
+
+CASES = {"np2": case_np2, "bad_input": case_bad_input, "every_dem": case_every_dem}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("case", choices=sorted(CASES) + ["all"])
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--inputs", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--mpirun", default="mpirun --allow-run-as-root --oversubscribe")
+    a = ap.parse_args()
+    r = cases.Runner(a)
+    for n in (sorted(CASES) if a.case == "all" else [a.case]):
+        print(f"== {n}: {CASES[n].__doc__}")
+        try:
+            CASES[n](r)
+        except (RuntimeError, FileNotFoundError, IndexError, KeyError, ValueError) as e:
+            check(False, f"{n}: {e}")
+    print(f"{len(FAILURES)} failure(s)")
+    return 1 if FAILURES else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
