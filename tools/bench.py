@@ -1,0 +1,447 @@
+#!/usr/bin/env python3
+"""Benchmark harness of issue 5 (docs/performance.md).
+
+  tools/python tools/bench.py [--quick] [--out DIR] [--np 2] [--only SECTION ...]
+
+Sections (all by default):
+  mpm       3-D pure-fluid dam break (inputs/bench/in.dambreak3d, quadratic B-splines, double
+            precision): material-point-steps per second serially and on --np ranks (uniform cuts and
+            with fix balance/mpm), parallel efficiency t1 / (np t_np), memory per point (peak RSS
+            minus a run with 512 points). Quick: 100k points; full: 30k, 100k, 250k.
+  coupling  C3 tank (inputs/tank/in.tank) at Grid40 x 8 (32000 points, 7762 beads), a short segment
+            (dry phase 20 steps, 10 coupled settling + 10 lift steps) under valgrind --tool=callgrind,
+            collected inside Verlet::run only: instructions in FixMpmFluid::couple_fluid_grains
+            (coupling), in FixMpmFluid::pre_final_integrate (fluid step, coupling included) and the
+            rest (LIGGGHTS). coupling_overhead_fraction = coupling / (fluid step - coupling). The
+            same for a pure-fluid dam break (the coupling code must not run) with the hot spots.
+            Full mode adds the wall time of the whole tank case (about 30 min on one core).
+  laser     one Table 5.1 case (inputs/laser/table51.toml), wall time of the process; full mode:
+            the sweep of tools/laser_sweep.py --full (every model x 7 intensities) on 1 and 2 cores.
+  sph       2-D square-column dam break against Martin & Moyce: LIGGGHTS SPH
+            (inputs/bench/in.sph_dambreak) and fix mpm/fluid (inputs/dambreak/in.dambreak, K = 2e7)
+            at several resolutions, one rank each; RMS front error (units of a) and wall time;
+            sph_over_mpm_walltime_same_error = SPH wall time / MPM wall time at the same error,
+            interpolated log-log on each method's error-vs-wall-time front.
+
+Writes DIR/results.csv (metric,value,unit,note), DIR/results.md, DIR/runs.csv (every run),
+plots DIR/*.png, DIR/hotspots.md, and bench-results.csv (metric,value,unit) in the current
+folder. Quick mode takes about 5-10 minutes on 2 cores. Timings depend on the load of the machine.
+"""
+import argparse
+import concurrent.futures as cf
+import csv
+import math
+import os
+import platform
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+TOP = os.path.normpath(os.path.join(HERE, ".."))
+sys.path.insert(0, HERE)
+import dambreak_error  # noqa: E402
+import laser_sweep  # noqa: E402
+from laser_common import run_case  # noqa: E402
+
+MPIRUN = ["mpirun", "--allow-run-as-root", "--oversubscribe"]
+RESULTS = []  # (metric, value, unit, note)
+RUNS = []     # dicts
+
+
+def say(*a):
+    print(*a, flush=True)
+
+
+def add(metric, value, unit, note=""):
+    RESULTS.append((metric, value, unit, note))
+    say("  %-44s %12s %-22s %s" % (metric, fmt(value), unit, note))
+
+
+def fmt(v):
+    if isinstance(v, float):
+        return "%.4g" % v
+    return str(v)
+
+
+def run(cmd, cwd, timeout=3600, rss=False):
+    """Runs cmd in cwd; returns (wall s, stdout text, peak RSS kB or None)."""
+    os.makedirs(cwd, exist_ok=True)
+    if rss:
+        cmd = ["/usr/bin/time", "-v", "-o", os.path.join(cwd, "time.txt")] + cmd
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                       errors="replace", timeout=timeout)
+    wall = time.perf_counter() - t0
+    with open(os.path.join(cwd, "output.txt"), "w") as f:
+        f.write(p.stdout)
+    if p.returncode != 0:
+        tail = "\n".join(p.stdout.splitlines()[-12:])
+        raise RuntimeError("%s failed (%d) in %s:\n%s" % (" ".join(cmd[:6]), p.returncode, cwd, tail))
+    peak = None
+    if rss:
+        with open(os.path.join(cwd, "time.txt")) as f:
+            m = re.search(r"Maximum resident set size \(kbytes\): (\d+)", f.read())
+            peak = int(m.group(1)) if m else None
+    return wall, p.stdout, peak
+
+
+def loop_times(text):
+    return [(float(m.group(1)), int(m.group(2)), int(m.group(3))) for m in
+            re.finditer(r"Loop time of (\S+) on (\d+) procs for (\d+) steps", text)]
+
+
+def lig(a, np_):
+    return (MPIRUN + ["-np", str(np_)] if np_ > 1 else []) + [a.exe]
+
+
+# ---------------------------------------------------------------- 3-D pure-fluid dam break
+
+def mpm_run(a, cells, np_, balance, nsteps, tag, rss=False):
+    d = os.path.join(a.out, "mpm3d", tag)
+    shutil.rmtree(d, ignore_errors=True)
+    cmd = lig(a, np_) + ["-in", os.path.join(TOP, "inputs", "bench", "in.dambreak3d"), "-echo", "none",
+                         "-var", "cells", str(cells), "-var", "nsteps", str(nsteps), "-var", "warm", "10",
+                         "-var", "balance", str(balance)]
+    wall, out, peak = run(cmd, d, rss=rss)
+    lt = loop_times(out)
+    points = int(re.search(r"created (\d+) material points", out).group(1))
+    loop = lt[1][0]  # the timed run (the first is the warm-up)
+    r = dict(section="mpm3d", case=tag, cells=cells, np=np_, balance=balance, points=points, steps=nsteps,
+             loop_s=loop, wall_s=wall, point_steps_per_s=points * nsteps / loop, peak_rss_kB=peak)
+    m = re.search(r"imbalance (\S+) -> (\S+)\)", out)
+    if m:
+        r["imbalance"] = "%s -> %s" % (m.group(1), m.group(2))
+    RUNS.append(r)
+    say("    %-22s %8d points, %4d steps: loop %.3f s, %.3g point-steps/s%s" %
+        (tag, points, nsteps, loop, r["point_steps_per_s"], ", imbalance " + r["imbalance"] if m else ""))
+    return r
+
+
+def section_mpm(a):
+    say("== mpm: 3-D dam break")
+    sizes = [23] if a.quick else [16, 23, 32]
+    nsteps = 60 if a.quick else 100
+    base = mpm_run(a, 4, 1, 0, 10, "baseline_c4", rss=True)
+    table = []
+    for c in sizes:
+        s1 = mpm_run(a, c, 1, 0, nsteps, "c%d_np1" % c, rss=True)
+        su = mpm_run(a, c, a.np, 0, nsteps, "c%d_np%d_uniform" % (c, a.np))
+        sb = mpm_run(a, c, a.np, 1, nsteps, "c%d_np%d_balance" % (c, a.np))
+        eff_u = s1["loop_s"] / (a.np * su["loop_s"])
+        eff_b = s1["loop_s"] / (a.np * sb["loop_s"])
+        mem = (s1["peak_rss_kB"] - base["peak_rss_kB"]) * 1024.0 / (s1["points"] - base["points"])
+        table.append((c, s1, su, sb, eff_u, eff_b, mem))
+        sfx = "" if c == 23 else "_%dk" % round(s1["points"] / 1000.0)
+        note = "%d points, %d steps after 10 warm-up steps" % (s1["points"], nsteps)
+        add("mpm_point_steps_per_s_per_core" + sfx, s1["point_steps_per_s"], "point-steps/s", note + ", serial")
+        add("mpm_parallel_efficiency_%dranks%s" % (a.np, sfx), eff_b, "0..1",
+            note + ", fix balance/mpm (cuts by point counts at setup)")
+        add("mpm_parallel_efficiency_%dranks_uniform%s" % (a.np, sfx), eff_u, "0..1",
+            note + ", uniform LIGGGHTS cuts (all points on one rank)")
+        add("mpm_memory_per_point" + sfx, mem, "bytes/point",
+            "peak RSS minus the 512-point run, divided by the extra points (grid included)")
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(5.5, 4))
+        pts = [t[1]["points"] for t in table]
+        ax.plot(pts, [t[1]["point_steps_per_s"] / 1e6 for t in table], "o-", label="1 rank")
+        ax.plot(pts, [t[2]["point_steps_per_s"] / 1e6 / a.np for t in table], "s--",
+                label="%d ranks, uniform cuts (per rank)" % a.np)
+        ax.plot(pts, [t[3]["point_steps_per_s"] / 1e6 / a.np for t in table], "^-",
+                label="%d ranks, balance/mpm (per rank)" % a.np)
+        ax.axhline(3.0, color="k", lw=0.8, ls=":", label="target 3 M/s/core")
+        ax.set_xscale("log")
+        ax.set_xlabel("material points")
+        ax.set_ylabel("M point-steps / s / core")
+        ax.set_title("3-D dam break, bspline2, double")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(a.out, "mpm_throughput.png"), dpi=120)
+        plt.close(fig)
+    except ImportError:
+        pass
+
+
+# ---------------------------------------------------------------- coupling (callgrind)
+
+def callgrind_costs(path):
+    """({function: inclusive Ir}, {function: self Ir}, total Ir) from callgrind_annotate."""
+    line = re.compile(r"^\s*([\d,]+)\s+\(\s*[\d.]+%\)\s+(.*?)(?:\s+\[[^\]]*\])?\s*$")
+
+    def table(extra):
+        p = subprocess.run(["callgrind_annotate", "--threshold=100"] + extra + [path], stdout=subprocess.PIPE,
+                           text=True, errors="replace")
+        out, total = {}, 0
+        for ln in p.stdout.splitlines():
+            m = line.match(ln)
+            if not m:
+                continue
+            ir, name = int(m.group(1).replace(",", "")), m.group(2)
+            if name == "PROGRAM TOTALS":
+                total = ir
+                continue
+            i = name.find(":")
+            if 0 <= i < len(name) - 1 and name[i + 1] != ":":
+                name = name[i + 1:]  # drop the "file:" / "???:" prefix
+            out[name] = out.get(name, 0) + ir
+        return out, total
+
+    incl, total = table(["--inclusive=yes"])
+    self_, _ = table([])
+    return incl, self_, total
+
+
+def find_cost(table, name):
+    """Inclusive cost of a function (its .cold clone included)."""
+    return sum(v for k, v in table.items() if k.startswith("LAMMPS_NS::" + name) or k.startswith(name))
+
+
+def callgrind_run(a, tag, cmd):
+    d = os.path.join(a.out, "callgrind", tag)
+    shutil.rmtree(d, ignore_errors=True)
+    out = os.path.join(d, "callgrind.out")
+    os.makedirs(d)
+    wall, _, _ = run(["valgrind", "--tool=callgrind", "--callgrind-out-file=" + out,
+                      "--toggle-collect=LAMMPS_NS::Verlet::run(int)"] + cmd, d, timeout=7200)
+    incl, self_, total = callgrind_costs(out)
+    return d, wall, incl, self_, total
+
+
+def section_coupling(a):
+    say("== coupling: C3 tank at Grid40 x 8 under callgrind (Verlet::run only)")
+    tank = os.path.join(TOP, "inputs", "tank", "in.tank")
+    short = ["-var", "tdry", "0.0004", "-var", "tsnap", "0.0001", "-var", "tsettle", "0.0001",
+             "-var", "tend", "0.0001", "-var", "tfront", "0.0001"]
+    cmd = [a.exe, "-in", tank, "-echo", "none"] + short
+    # native timing of the same segment (coupled steps only)
+    wall, out, _ = run(cmd, os.path.join(a.out, "coupling", "native"))
+    lt = [t for t in loop_times(out)]
+    coupled = lt[1:]
+    ms_step = 1e3 * sum(t[0] for t in coupled) / max(1, sum(t[2] for t in coupled))
+    d, wall, incl, self_, total = callgrind_run(a, "tank", cmd)
+    pfi = find_cost(incl, "FixMpmFluid::pre_final_integrate()")
+    cpl = find_cost(incl, "FixMpmFluid::couple_fluid_grains(double)")
+    eos = find_cost(incl, "FixMpmFluid::end_of_step()")
+    fluid = pfi - cpl
+    lig_ = total - pfi - eos
+    say("    Ir in Verlet::run: total %.4g, fluid step %.4g (coupling %.4g), output %.4g, LIGGGHTS %.4g"
+        % (total, pfi, cpl, eos, lig_))
+    note = ("C3 Grid40x8 (32000 points, 7762 beads, not settled: 20 dry steps), 20 coupled steps, "
+            "callgrind Ir in Verlet::run; coupling / (fluid step without coupling)")
+    add("coupling_overhead_fraction", cpl / fluid if fluid else float("nan"), "ratio", note)
+    add("c3_share_liggghts", lig_ / total, "fraction of step", "DEM, neighbour lists, exchange, other fixes")
+    add("c3_share_mpm_fluid", fluid / total, "fraction of step", "pre_final_integrate minus coupling")
+    add("c3_share_coupling", cpl / total, "fraction of step", "couple_fluid_grains (4 halo exchanges incl.)")
+    add("c3_share_mpm_output", eos / total, "fraction of step", "HDF5 output every 10 steps (end_of_step)")
+    add("c3_ms_per_coupled_step", ms_step, "ms/step", "native, same segment, 1 rank")
+    RUNS.append(dict(section="coupling", case="tank_callgrind", wall_s=wall, ir_total=total, ir_fluid_step=pfi,
+                     ir_coupling=cpl, ir_output=eos, ms_per_step=ms_step))
+
+    say("== coupling: pure-fluid 3-D dam break under callgrind (hot spots)")
+    cmd = [a.exe, "-in", os.path.join(TOP, "inputs", "bench", "in.dambreak3d"), "-echo", "none",
+           "-var", "cells", "10", "-var", "warm", "2", "-var", "nsteps", "10"]
+    d, wall, incl, self_, total = callgrind_run(a, "dambreak3d", cmd)
+    cpl0 = find_cost(incl, "couple_fluid_grains")
+    add("coupling_cost_without_grains", cpl0, "instructions",
+        "pure-fluid run (8000 points, 12 steps): couple_fluid_grains never runs")
+    pfi0 = find_cost(incl, "FixMpmFluid::pre_final_integrate()")
+    steps_pts = 8000 * 12
+    add("mpm_instructions_per_point_step", pfi0 / steps_pts, "Ir/(point step)",
+        "callgrind, fluid step (pre_final_integrate), 8000 points, bspline2; compare code versions with it")
+    rows = sorted(((v, k) for k, v in self_.items()), reverse=True)[:15]
+    with open(os.path.join(a.out, "hotspots.md"), "w") as f:
+        f.write("| function | self Ir | share of Verlet::run | Ir per point-step |\n| --- | --- | --- | --- |\n")
+        for v, k in rows:
+            f.write("| `%s` | %.4g | %.1f %% | %.0f |\n" % (k[:90], v, 100.0 * v / total, v / steps_pts))
+    say("    hot spots -> %s" % os.path.join(a.out, "hotspots.md"))
+
+    if not a.quick:
+        say("== coupling: whole C3 tank at Grid40 x 8 (default input, long)")
+        wall, out, _ = run([a.exe, "-in", tank, "-echo", "none"], os.path.join(a.out, "coupling", "full_tank"),
+                           timeout=6 * 3600)
+        add("c3_whole_case_walltime", wall, "s", "in.tank defaults (0.25 s dry, 0.05 s settling, 0.2 s lift), 1 rank")
+
+
+# ---------------------------------------------------------------- laser
+
+def section_laser(a):
+    say("== laser")
+    d = os.path.join(a.out, "laser")
+    os.makedirs(d, exist_ok=True)
+    best = None
+    for k in range(3):  # the best of three: the process wall time, start-up included
+        t0 = time.perf_counter()
+        code, s, err = run_case(a.laser_exe, os.path.join(d, "table51_%d" % k),
+                                ["--config", os.path.join(TOP, "inputs", "laser", "table51.toml")])
+        w = time.perf_counter() - t0
+        if code != 0:
+            raise RuntimeError("laser_drill failed: " + err)
+        best = w if best is None else min(best, w)
+    add("laser_case_s", best, "s", "Table 5.1 (inputs/laser/table51.toml), process wall time, best of 3")
+    if a.quick:
+        return
+    cases = [(I, m, p, args) for I in laser_sweep.INTENSITIES for m, p, args in laser_sweep.cases(True)]
+
+    def one(c):
+        I, m, p, args = c
+        name = "I%.3g_%s%s" % (I, m, "" if p is None else "_%g" % p)
+        code, s, err = run_case(a.laser_exe, os.path.join(d, "sweep", name), ["--intensity", I, "--model", m] + args)
+        return code
+    for workers in (1, 2):
+        t0 = time.perf_counter()
+        with cf.ThreadPoolExecutor(max_workers=workers) as ex:
+            codes = list(ex.map(one, cases))
+        w = time.perf_counter() - t0
+        add("laser_sweep_s_%dcore%s" % (workers, "s" if workers > 1 else ""), w, "s",
+            "%d cases (every model of laser_sweep.py --full x 7 intensities), %d failed" %
+            (len(cases), sum(1 for c in codes if c != 0)))
+
+
+# ---------------------------------------------------------------- SPH against MPM
+
+def pareto(points):
+    """(wall, err) sorted by wall, keeping only runs more accurate than every cheaper one."""
+    out = []
+    for w, e in sorted(points):
+        if not out or e < out[-1][1]:
+            out.append((w, e))
+    return out
+
+
+def time_at_error(front, e):
+    """Wall time to reach error e on a front (log-log interpolation); (time, exact?)."""
+    if e >= front[0][1]:
+        return front[0][0], e == front[0][1]   # even the cheapest run is as accurate: an upper bound
+    for (w0, e0), (w1, e1) in zip(front, front[1:]):
+        if e1 <= e <= e0:
+            t = (math.log(e) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(w0) + t * (math.log(w1) - math.log(w0))), True
+    return float("nan"), False
+
+
+def section_sph(a):
+    say("== sph: 2-D square-column dam break, LIGGGHTS SPH against fix mpm/fluid (1 rank each)")
+    tend = 3.0
+    sph_n = [25, 35] if a.quick else [25, 35, 50, 70]
+    mpm_c = [12, 16] if a.quick else [12, 16, 24, 32]
+    pts = {"sph": [], "mpm": []}
+    for n in sph_n:
+        d = os.path.join(a.out, "sph", "sph_n%d" % n)
+        shutil.rmtree(d, ignore_errors=True)
+        wall, out, _ = run([a.exe, "-in", os.path.join(TOP, "inputs", "bench", "in.sph_dambreak"), "-echo", "none",
+                            "-var", "n", str(n), "-var", "tend", str(tend)], d)
+        ef, eh, _ = dambreak_error.errors(os.path.join(d, "front.csv"), tmax=tend)
+        s = dambreak_error.read_csv(os.path.join(d, "summary.csv"))
+        pts["sph"].append((wall, ef))
+        RUNS.append(dict(section="sph", case="SPH n=%d" % n, points=n * n, wall_s=wall, front_rms_a=ef,
+                         height_rms_a=eh, lost=int(s["lost"][0])))
+        say("    SPH %3d x %-3d particles: wall %6.1f s, front RMS %.4f a, height RMS %.4f a, lost %d" %
+            (n, n, wall, ef, eh, int(s["lost"][0])))
+    for c in mpm_c:
+        d = os.path.join(a.out, "sph", "mpm_c%d" % c)
+        shutil.rmtree(d, ignore_errors=True)
+        wall, out, _ = run([a.exe, "-in", os.path.join(TOP, "inputs", "dambreak", "in.dambreak"), "-echo", "none",
+                            "-var", "cells", str(c), "-var", "tend", str(tend)], d)
+        ef, eh, _ = dambreak_error.errors(os.path.join(d, "front.csv"), tmax=tend)
+        pts["mpm"].append((wall, ef))
+        RUNS.append(dict(section="sph", case="MPM%d" % c, points=4 * c * c, wall_s=wall, front_rms_a=ef,
+                         height_rms_a=eh))
+        say("    MPM%-3d (%5d points): wall %6.1f s, front RMS %.4f a, height RMS %.4f a" %
+            (c, 4 * c * c, wall, ef, eh))
+    fs, fm = pareto(pts["sph"]), pareto(pts["mpm"])
+    target = max(fs[-1][1], fm[-1][1])  # the smallest error both methods reach
+    ts, exs = time_at_error(fs, target)
+    tm, exm = time_at_error(fm, target)
+    bound = "" if exs and exm else " (%s cheapest run is already more accurate: its time is an upper bound)" % (
+        "SPH's" if not exs else "MPM's")
+    add("sph_over_mpm_walltime_same_error", ts / tm, "ratio",
+        "at front RMS error %.3f a: SPH %.1f s, MPM %.1f s; T <= %g, 1 rank each%s" % (target, ts, tm, tend, bound))
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(5.5, 4))
+        for k, lab, mk in (("sph", "LIGGGHTS SPH (n x n)", "s-"), ("mpm", "fix mpm/fluid (MPMn)", "o-")):
+            w, e = zip(*sorted(pts[k]))
+            ax.plot(w, e, mk, label=lab)
+        ax.axhline(target, color="k", lw=0.8, ls=":")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("wall time (s, 1 rank)")
+        ax.set_ylabel("front RMS error / a")
+        ax.set_title("2-D dam break vs Martin & Moyce")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(a.out, "sph_vs_mpm.png"), dpi=120)
+        plt.close(fig)
+    except ImportError:
+        pass
+
+
+# ---------------------------------------------------------------- main
+
+SECTIONS = {"mpm": section_mpm, "coupling": section_coupling, "laser": section_laser, "sph": section_sph}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--out", default="bench-out")
+    ap.add_argument("--np", type=int, default=2)
+    ap.add_argument("--exe", default=os.path.join(TOP, "build", "liggghts_mpm"))
+    ap.add_argument("--laser-exe", default=None)
+    ap.add_argument("--only", nargs="*", choices=sorted(SECTIONS))
+    a = ap.parse_args()
+    a.out = os.path.abspath(a.out)
+    a.exe = os.path.abspath(a.exe)
+    if a.laser_exe is None:
+        for c in (os.path.join(TOP, "build", "laser_drill"), os.path.join(TOP, "build", "laser", "laser_drill"),
+                  os.path.join(TOP, "build-laser", "laser_drill")):
+            if os.path.exists(c):
+                a.laser_exe = c
+                break
+    os.makedirs(a.out, exist_ok=True)
+    t0 = time.perf_counter()
+    failed = []
+    for name in (a.only or ["mpm", "coupling", "laser", "sph"]):
+        try:
+            SECTIONS[name](a)
+        except (RuntimeError, subprocess.TimeoutExpired, OSError, ValueError, IndexError, KeyError) as e:
+            failed.append(name)
+            say("!! section %s failed: %s" % (name, e))
+    total = time.perf_counter() - t0
+    load = os.getloadavg()
+    machine = "%s, %d cores, %s; load average at the end %.2f (other jobs share the cores)" % (
+        platform.processor() or platform.machine(), os.cpu_count(), platform.node(), load[0])
+    add("bench_total_s", total, "s", ("quick" if a.quick else "full") + " mode; " + machine)
+
+    with open(os.path.join(a.out, "results.csv"), "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["metric", "value", "unit", "note"])
+        w.writerows(RESULTS)
+    with open("bench-results.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["metric", "value", "unit"])
+        w.writerows([r[:3] for r in RESULTS])
+    with open(os.path.join(a.out, "results.md"), "w") as f:
+        f.write("| metric | value | unit | note |\n| --- | --- | --- | --- |\n")
+        for m, v, u, n in RESULTS:
+            f.write("| %s | %s | %s | %s |\n" % (m, fmt(v), u, n))
+    keys = []
+    for r in RUNS:
+        keys += [k for k in r if k not in keys]
+    with open(os.path.join(a.out, "runs.csv"), "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys)
+        w.writeheader()
+        w.writerows(RUNS)
+    say("wrote bench-results.csv, %s/results.csv, results.md, runs.csv (%.0f s)" % (a.out, total))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
