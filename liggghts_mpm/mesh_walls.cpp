@@ -244,15 +244,15 @@ void MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
 }
 
 void MeshWalls::bins_build(const double box[6]) {
-  // Bins of edge >= 2 margin (at most ~1e6 of them); a triangle goes into every bin that its
+  // Bins of edge >= margin (at most ~1e6 of them); a triangle goes into every bin that its
   // bounding box widened by the margin overlaps and whose centre is within (half diagonal +
-  // margin) of its plane. Any triangle within 'margin' of a point of a bin is then in that bin.
+  // margin) of the triangle. Any triangle within 'margin' of a point of a bin is then in that bin.
   double ext[3], vol = 1.0;
   for (int d = 0; d < 3; ++d) {
     ext[d] = std::max(box[3 + d] - box[d], 1e-300);
     vol *= ext[d];
   }
-  bsize_ = std::max({2.0 * margin_, std::cbrt(vol / 1.0e6), 1e-12 * std::max({ext[0], ext[1], ext[2]})});
+  bsize_ = std::max({margin_, std::cbrt(vol / 1.0e6), 1e-12 * std::max({ext[0], ext[1], ext[2]})});
   size_t nbin = 1;
   for (int d = 0; d < 3; ++d) {
     blo_[d] = box[d];
@@ -273,6 +273,9 @@ void MeshWalls::bins_build(const double box[6]) {
       if (lo[d] > hi[d]) out = true;
     }
     if (out) continue;
+    int nwide = 0;
+    for (int d = 0; d < 3; ++d) nwide += hi[d] - lo[d] >= 3;
+    const bool wide = nwide >= 2;
     for (int k = lo[2]; k <= hi[2]; ++k)
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int ii = lo[0]; ii <= hi[0]; ++ii) {
@@ -281,6 +284,14 @@ void MeshWalls::bins_build(const double box[6]) {
           double d[3];
           sub3(c, t.p[0], d);
           if (std::fabs(dot3(d, t.n)) > half_diag + margin_) continue;
+          // a triangle whose bounding box spans many bins in two directions (the fans of a
+          // jar's end caps) is far from most of them: keep a bin only if the triangle comes
+          // near the bin's ball
+          if (wide) {
+            Hit hit;
+            closest_point(t, c, hit);
+            if (hit.dist2 > (half_diag + margin_) * (half_diag + margin_)) continue;
+          }
           bins_[(static_cast<size_t>(k) * nb_[1] + j) * nb_[0] + ii].push_back(static_cast<int>(i));
         }
   }
@@ -384,26 +395,95 @@ bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, doub
   const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
   const double r2 = reach * reach, rf2 = reach_fluid * reach_fluid, rb2 = reach_behind * reach_behind;
 
-  constexpr int kMax = 64;
-  int idx[kMax];
-  Hit hits[kMax];
-  double dd[kMax][3];   // x - closest point
-  bool back[kMax];      // behind the triangle's plane (one-sided meshes)
-  int nh = 0;
-  for (int c = 0; c < ncand && nh < kMax; ++c) {
+  // Candidates by a lower bound of their distance (plane, bounding box), nearest first. One wall direction is one
+  // constraint: of the hits of a mesh whose directions (face normal, or the direction from an
+  // edge/vertex) lie within 30 degrees of each other only the nearest is kept. A finely
+  // tessellated curved wall (a jar) thus constrains a node once, along its nearest facet, and not
+  // dozens of times along normals up to tens of degrees off (which would also take away the
+  // tangential velocity that a free-slip or partial wall keeps); distinct walls meeting at an
+  // edge or corner (a box) still act together. A candidate whose plane is farther than a kept
+  // hit of a similar direction cannot be nearer, so its closest point is not computed.
+  constexpr int kCand = 512, kMax = 16;
+  constexpr double kCos = 0.8660;  // 30 degrees
+  std::pair<double, int> cl[kCand];
+  int ncl = 0;
+  for (int c = 0; c < ncand && ncl < kCand; ++c) {
     const int i = cand ? (*cand)[c] : c;
     const Tri &t = tris_[i];
     if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
         x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
       continue;
-    Hit &h = hits[nh];
-    closest_point(t, x, h);
-    if (h.dist2 > r2) continue;
-    sub3(x, h.p, dd[nh]);
+    // lower bound of the distance: to the plane and to the bounding box
+    double a[3], bd2 = 0.0;
+    sub3(x, t.p[0], a);
+    const double pd = std::fabs(dot3(a, t.n));
+    for (int q = 0; q < 3; ++q) {
+      const double e = std::max({t.lo[q] - x[q], 0.0, x[q] - t.hi[q]});
+      bd2 += e * e;
+    }
+    const double lb = std::max(pd, std::sqrt(bd2));
+    if (lb > reach) continue;
+    cl[ncl++] = {lb, i};
+  }
+  if (ncl == 0) return false;
+  std::sort(cl, cl + ncl);
+  int idx[kMax];
+  Hit hits[kMax];
+  double dd[kMax][3];   // x - closest point
+  double dir[kMax][3];  // direction of the hit (unsigned for faces)
+  bool back[kMax];      // behind the triangle's plane (one-sided meshes)
+  int nh = 0;
+  for (int c = 0; c < ncl; ++c) {
+    const int i = cl[c].second;
+    const Tri &t = tris_[i];
+    // a kept hit of a similar direction that is nearer than this triangle can be makes it
+    // redundant (a face hit also when equally near: a coplanar neighbour adds nothing)
+    bool skip = false;
+    const double lb2 = cl[c].first * cl[c].first;
+    for (int h = 0; h < nh && !skip; ++h)
+      skip = tris_[idx[h]].mesh == t.mesh && std::fabs(dot3(dir[h], t.n)) > kCos &&
+             (hits[h].face ? hits[h].dist2 <= lb2 + 1e-12 * r2 : hits[h].dist2 + 1e-12 * r2 < lb2);
+    if (skip) continue;
+    Hit hit;
+    closest_point(t, x, hit);
+    if (hit.dist2 > r2) continue;
+    double dv[3], dn[3];
+    sub3(x, hit.p, dv);
+    const double dl = std::sqrt(hit.dist2);
+    if (hit.face || dl <= 1e-12 * reach) {
+      for (int q = 0; q < 3; ++q) dn[q] = t.n[q];
+    } else {
+      for (int q = 0; q < 3; ++q) dn[q] = dv[q] / dl;
+    }
     const int side = specs_[t.mesh].side;
     const bool one_sided = side == SIDE_NORMAL || side == SIDE_OPPOSITE;
-    back[nh] = one_sided && side * dot3(dd[nh], t.n) < 0.0;
-    idx[nh++] = i;
+    const bool is_back = one_sided && side * dot3(dv, t.n) < 0.0;
+    int slot = nh;
+    for (int h = 0; h < nh; ++h)
+      if (tris_[idx[h]].mesh == t.mesh && std::fabs(dot3(dir[h], dn)) > kCos) {
+        if (std::fabs(hit.dist2 - hits[h].dist2) <= 1e-12 * r2) {
+          // the same nearest point seen from another triangle: a face hit takes precedence
+          // over edge/vertex hits; of those, the node is behind only if behind all of them
+          if (hit.face && !hits[h].face) {
+            slot = h;
+          } else {
+            if (hit.face == hits[h].face) back[h] = back[h] && is_back;
+            slot = -1;
+          }
+        } else {
+          slot = hit.dist2 < hits[h].dist2 ? h : -1;  // nearer: replaces it; else redundant
+        }
+        break;
+      }
+    if (slot < 0 || slot >= kMax) continue;
+    hits[slot] = hit;
+    for (int q = 0; q < 3; ++q) {
+      dd[slot][q] = dv[q];
+      dir[slot][q] = dn[q];
+    }
+    back[slot] = is_back;
+    idx[slot] = i;
+    if (slot == nh) ++nh;
   }
   if (nh == 0) return false;
 
@@ -546,6 +626,10 @@ bool MeshWalls::push_back(double x[3], double v[3], double reach, const double *
       if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
           x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
         continue;
+      double a[3];
+      sub3(x, t.p[0], a);
+      const double pd = dot3(a, t.n);
+      if (pd * pd > dmin + 1e-12 * r2) continue;  // its plane is farther than the nearest hit
       closest_point(t, x, hits[nh]);
       if (hits[nh].dist2 >= r2) continue;
       dmin = std::min(dmin, hits[nh].dist2);
