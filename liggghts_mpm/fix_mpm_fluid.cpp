@@ -150,6 +150,8 @@ const FixMpmFluid::ScalarKeyword *FixMpmFluid::find_scalar(const char *kw) {
       {"mass_threshold", &FixMpmFluid::mass_threshold, 0.0, 1.0, false, true,
        "a fraction of the point mass in [0,1)"},
       {"theta_min", &FixMpmFluid::theta_min, 0.0, 1.0, true, true, "a lowest fluid fraction in (0,1)"},
+      {"theta_smooth", &FixMpmFluid::theta_smooth, 0.0, HUGE_VAL, false, true,
+       "a smoothing length >= 0 for the grains' volume fraction"},
   };
   for (const ScalarKeyword &k : table)
     if (strcmp(k.name, kw) == 0) return &k;
@@ -336,6 +338,11 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       if (!parse_double(arg[iarg + 3], wall_pos)) bad_arg(kw, "a wall position", arg[iarg + 3]);
       wall_pos_given = true;
       iarg += 4;
+    } else if (strcmp(kw, "every") == 0) {
+      need(iarg, 1, kw, "an integer N >= 1 (the fluid advances every N-th time step)");
+      if (!parse_int(arg[iarg + 1], fluid_every) || fluid_every < 1)
+        bad_arg(kw, "an integer N >= 1 (the fluid advances every N-th time step)", arg[iarg + 1]);
+      iarg += 2;
     } else if (strcmp(kw, "output") == 0) {
       need(iarg, 3, kw, "'N prefix points f1 ... [grid g1 ...]'");
       if (!parse_int(arg[iarg + 1], out_every) || out_every < 0)
@@ -367,8 +374,8 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
           // The first word that is no field name ends the list only if it is a keyword.
           static const char *keywords[] = {"cell", "grid", "density", "bulk", "viscosity", "eos", "shape",
                                            "transfer", "update", "antilock", "boundary", "gate", "damping",
-                                           "cfl", "subcycle", "mass_threshold", "fill", "hydrostatic", "pmin",
-                                           "couple", "drag", "cell_check", "theta_min", "wall_traction",
+                                           "cfl", "subcycle", "every", "mass_threshold", "fill", "hydrostatic", "pmin",
+                                           "couple", "drag", "cell_check", "theta_min", "theta_smooth", "wall_traction",
                                            "front", "height", "output", "mesh_wall"};
           bool is_kw = false;
           for (const char *k : keywords) is_kw = is_kw || strcmp(arg[iarg], k) == 0;
@@ -765,7 +772,7 @@ double FixMpmFluid::stable_dt() {
 
 void FixMpmFluid::check_timestep(bool at_setup) {
   dt_stable_last = stable_dt();
-  const double dt = update->dt;
+  const double dt = fluid_every * update->dt;
   if (!std::isfinite(dt_stable_last) || dt_stable_last <= 0.0)
     error->all(FLERR, "Fix mpm/fluid: the fluid state is not finite (NaN velocity or density); "
                       "the run was unstable before this check");
@@ -776,10 +783,11 @@ void FixMpmFluid::check_timestep(bool at_setup) {
   if (!subcycle) {
     std::ostringstream os;
     os.precision(4);
-    os << "Fix mpm/fluid: timestep " << dt << " exceeds the largest stable time step " << dt_stable_last
+    os << "Fix mpm/fluid: " << (fluid_every > 1 ? "fluid step (every x timestep) " : "timestep ") << dt
+       << " exceeds the largest stable time step " << dt_stable_last
        << " (acoustic limit cfl*dx/(c+|v|max) with cfl = " << cfl << ", dx = " << gspec.dx
        << ", c = " << c_max
-       << ", or viscous limit dx^2 rho/(2 dim eta)); reduce the timestep to " << dt_stable_last
+       << ", or viscous limit dx^2 rho/(2 dim eta)); reduce the timestep to " << dt_stable_last / fluid_every
        << " or use keyword 'subcycle yes'" << (at_setup ? "" : " (limit reached during the run)");
     error->all(FLERR, os.str().c_str());
   }
@@ -816,9 +824,17 @@ void FixMpmFluid::pre_final_integrate() {
       if (logfile) fputs(os.str().c_str(), logfile);
     }
   }
+  if (fluid_every > 1 && update->ntimestep % fluid_every != 0) {
+    // between two fluid steps the grains keep the fluid force of the last one
+    if (coupled)
+      for (int k = 0; k < atom->nlocal; ++k)
+        if (is_grain(k))
+          for (int d = 0; d < 3; ++d) atom->f[k][d] += pdata[k][C_FGRAIN + d];
+    return;
+  }
   check_timestep(false);
   mesh_refresh();
-  const double h = update->dt / nsub_last;
+  const double h = fluid_every * update->dt / nsub_last;
   if (coupled) grain_force.assign(3 * static_cast<std::size_t>(atom->nlocal), 0.0);
   for (int s = 0; s < nsub_last; ++s) substep(h);
   if (coupled) {
@@ -1025,6 +1041,7 @@ void FixMpmFluid::couple_fluid_grains(double h) {
     })
   }
   grid.reverse_sum(g_cpl.data(), 3);
+  if (theta_smooth > 0.0) smooth_solid_volume();
 
   const double mmin = mass_threshold * point_mass_ref;
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -1142,6 +1159,47 @@ void FixMpmFluid::couple_fluid_grains(double h) {
     })
     for (int d = 0; d < 3; ++d) grain_force[3 * static_cast<std::size_t>(k) + d] += J[d] / h / nsub_last;
   }
+}
+
+/* Smoothing of the grains' volume at the owned nodes (g_cpl[3n]) by a
+   discrete diffusion of the solid fraction phi_j = S_j / V_j: passes of the
+   filter [1/4 1/2 1/4] along each direction; the flux between neighbours
+   j, n is (phi_n - phi_j) min(V_j, V_n) / 4, so the total solid volume is
+   kept exactly, a uniform fraction stays uniform, nodes outside a wall
+   (V = 0) take no part and each pass is stable. A pass adds dx^2/2 to the
+   variance of the kernel, so ceil(2 L^2 / dx^2) passes give a Gaussian of
+   standard deviation L (docs/drag.md, "Smoothing the fluid fraction"). */
+void FixMpmFluid::smooth_solid_volume() {
+  const double dx = gspec.dx;
+  const int passes = static_cast<int>(std::ceil(2.0 * theta_smooth * theta_smooth / (dx * dx) - 1e-9));
+  if (passes <= 0) return;
+  g_phi.assign(2 * grid.size(), 0.0);  // phi, node volume
+  grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    const double V = node_volume(i, j, k);
+    g_phi[2 * n] = V > 0.0 ? g_cpl[3 * n] / V : 0.0;
+    g_phi[2 * n + 1] = V;
+  });
+  grid.forward(g_phi.data(), 2);
+  g_phi_new.resize(grid.size());
+  for (int pass = 0; pass < passes; ++pass)
+    for (int d = 0; d < 3; ++d) {
+      if (!gspec.periodic[d] && gspec.ncell[d] < 2) continue;
+      grid.for_owned([&](int i, int j, int k, std::size_t n) {
+        const double V = g_phi[2 * n + 1], phi = g_phi[2 * n];
+        double S = phi * V;
+        for (int side = -1; side <= 1; side += 2) {
+          int idx[3] = {i, j, k};
+          idx[d] += side;
+          if (!grid.in_patch(idx[0], idx[1], idx[2])) continue;
+          const std::size_t m = grid.index(idx[0], idx[1], idx[2]);
+          S += 0.25 * std::min(V, g_phi[2 * m + 1]) * (g_phi[2 * m] - phi);
+        }
+        g_phi_new[n] = V > 0.0 ? S / V : 0.0;
+      });
+      grid.for_owned([&](int, int, int, std::size_t n) { g_phi[2 * n] = g_phi_new[n]; });
+      grid.forward(g_phi.data(), 2);
+    }
+  grid.for_owned([&](int, int, int, std::size_t n) { g_cpl[3 * n] = g_phi[2 * n] * g_phi[2 * n + 1]; });
 }
 
 // At the first run with grains: the fluid present in a point's volume is

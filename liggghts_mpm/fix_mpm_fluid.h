@@ -123,6 +123,7 @@ class FixMpmFluid : public Fix {
   double cfl = 0.5;
   bool subcycle = false;
   int max_subcycle = 1000;
+  int fluid_every = 1;          // the fluid advances every N-th time step, by N dt (keyword every)
   double mass_threshold = 1e-5;
   int front_axis = 0;
   int height_axis = 2, wall_axis = 0;
@@ -144,6 +145,8 @@ class FixMpmFluid : public Fix {
   mpm::DragLaw drag_law = mpm::DragLaw::ErgunWenYu;
   mpm::DragForm drag_form = mpm::DragForm::Consistent;
   double theta_min = mpm::kDragThetaMin;
+  double theta_smooth = 0.0;    // standard deviation of the smoothing of the solid fraction (0: none)
+  std::vector<double> g_phi, g_phi_new;  // smoothing work arrays (per node)
   bool cell_check = true;
   bool theta_initialized = false;  // fluid mass reduced by the grains' volume once (restart)
   std::vector<PointShape> grain_shapes;
@@ -201,6 +204,7 @@ class FixMpmFluid : public Fix {
   void compute_shapes();
   bool shape_of(const double *x, PointShape &ps);
   void couple_fluid_grains(double h);
+  void smooth_solid_volume();
   void init_theta();
   double node_volume(int i, int j, int k) const;
   bool is_grain(int i) const;

@@ -361,6 +361,37 @@ def case_ergun(r):
         check(abs(err) < 0.05, f"pressure drop within 5 % of Ergun at U = {Us:.4f} m/s")
 
 
+def case_theta_smooth(r):
+    """theta_smooth keeps the solid volume: a uniform bed stays uniform (C2 unchanged), and with
+    free grains the total momentum is still kept (the smoothing only changes theta)."""
+    inp = os.path.join(r.inputs, "ergun", "in.ergun")
+    eps = 1.0 - math.pi / 6.0
+    dd, _ = r.run("theta_smooth/ergun", inp, {"G": 1000.0, "smooth": 2.0e-3})
+    f = read_csv(os.path.join(dd, "ergun.csv"))
+    th = (f["theta_min"][-1], f["theta_max"][-1])
+    check(abs(th[0] - eps) < 1e-9 and abs(th[1] - eps) < 1e-9,
+          f"smoothed fluid fraction of a uniform periodic bed is still the porosity (got {th[0]:.9f}..{th[1]:.9f})")
+    dd, _ = r.run("theta_smooth/momentum", inp, {"G": 0.0, "mobile": 1, "v0": 0.05, "tend": 0.02,
+                                                  "outdt": 0.001, "smooth": 2.0e-3})
+    f = read_csv(os.path.join(dd, "ergun.csv"))
+    P0 = 0.05 * eps * 10.0 * (4 * 2.0e-3) ** 3
+    drift = abs(f["P"][-1] - P0) / P0
+    print(f"  with theta_smooth: momentum drift {drift:.1e}, theta {f['theta_min'][-1]:.6f}..{f['theta_max'][-1]:.6f}")
+    check(drift < 1e-9, "total momentum of fluid + grains conserved with theta_smooth")
+
+
+def case_every(r):
+    """'every N': the fluid advances every N-th step by N dt and the grain keeps its fluid force in
+    between; C1 terminal velocity still within 2 % (DEM step N times smaller than the fluid's)."""
+    inp = os.path.join(r.inputs, "settling", "in.settling")
+    d, _ = r.run("every/heavy", inp, {"every": 4})
+    sim = read_csv(os.path.join(d, "settling.csv"))
+    _, vt = schiller_naumann_settling(1e-4, 3000.0, 10.0, 1e-5, 9.81, sim["t"][-1])
+    v = -sim["v_z"][-1]
+    print(f"  every 4: terminal velocity {v:.5f} m/s, Schiller-Naumann {vt:.5f} m/s ({100 * abs(v - vt) / vt:.2f} %)")
+    check(abs(v - vt) < 0.02 * vt, "terminal velocity within 2 % with the fluid advanced every 4th step")
+
+
 def case_momentum_balance(r):
     """Drag and pressure forces between free grains and fluid conserve total momentum (periodic, no gravity)."""
     inp = os.path.join(r.inputs, "ergun", "in.ergun")
@@ -413,6 +444,9 @@ run 0
         ("0.001", "viscosity 1e-3 couple grains drag fast", "keyword 'drag' expects a drag law"),
         ("0.001", "couple grains", "needs keyword 'viscosity' > 0"),
         ("0.001", "viscosity 1e-3 couple grains theta_min 0", "keyword 'theta_min' expects"),
+        ("0.001", "viscosity 1e-3 couple grains theta_smooth -1", "keyword 'theta_smooth' expects"),
+        ("0.001", "viscosity 1e-3 couple grains every 0", "keyword 'every' expects an integer N >= 1"),
+        ("0.001", "viscosity 1e-3 couple grains every", "keyword 'every' expects an integer N >= 1"),
         ("0.008", "viscosity 1e-3 couple grains", "is smaller than the largest grain"),
     ]
     for i, (dia, args, expect) in enumerate(cases):
