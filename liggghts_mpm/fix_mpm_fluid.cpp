@@ -681,7 +681,9 @@ void FixMpmFluid::setup_grid() {
   g_cell.assign(grid.size() * 4, 0.0);
   if (musl) g_aux.assign(grid.size() * 3, 0.0);
   if (coupled) {
-    g_cpl.assign(grid.size() * 3, 0.0);
+    g_cpl.assign(grid.size() * 2, 0.0);
+    g_sol.assign(grid.size(), 0.0);
+    g_th.assign(grid.size(), 1.0);
     g_st.assign(grid.size() * 6, 0.0);
     g_rx.assign(grid.size() * 3, 0.0);
     g_dr.assign(grid.size() * kDr, 0.0);
@@ -853,6 +855,7 @@ void FixMpmFluid::pre_final_integrate() {
 
 void FixMpmFluid::substep(double h) {
   compute_shapes();
+  if (coupled) fluid_fraction();
   particles_to_grid();
   if (coupled) couple_fluid_grains(h);
   update_grid(h);
@@ -1003,6 +1006,52 @@ void FixMpmFluid::add_wall_traction(const PointShape &ps, const double *xp, doub
   }
 }
 
+/* Fluid fraction (8-11)-(8-14) at the nodes from the grains' volumes (with
+   the optional smoothing) and at the points (8-16), then the points'
+   density and pressure for it. Done at the start of each sub-step, before
+   the particles-to-grid map and the forces on the grains, so that the
+   pressure with which the fluid and the grains push each other belongs to
+   the grains' present positions: with the pressure of the previous
+   sub-step (theta of the grains' old positions) the restoring force of
+   the fluid on a grain lags one step behind its displacement, which feeds
+   energy into the grain-fluid oscillation (stiff: K / theta per unit
+   volume change) and made the moving dense bed of C3 blow up. */
+void FixMpmFluid::fluid_fraction() {
+  const int nlocal = atom->nlocal;
+  double **x = atom->x;
+  double *radius = atom->radius;
+  if (static_cast<int>(grain_shapes.size()) < nlocal) grain_shapes.resize(nlocal);
+  const int ns = mpm::support(shape);
+  std::fill(g_sol.begin(), g_sol.end(), 0.0);
+  for (int k = 0; k < nlocal; ++k) {
+    if (!is_grain(k)) continue;
+    PointShape &ps = grain_shapes[k];
+    if (!shape_of(x[k], ps)) {
+      ps.base[0] = INT_MIN;  // outside the grid: no fluid there
+      continue;
+    }
+    const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
+    const double *xp = x[k];
+    MPM_FOR_NODES(ps, xp, { g_sol[n] += w * Vk; })
+  }
+  grid.reverse_sum(g_sol.data(), 1);
+  if (theta_smooth > 0.0) smooth_solid_volume();
+  grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    const double Vj = node_volume(i, j, k);
+    g_th[n] = Vj > 0.0 ? std::min(1.0, std::max(theta_min, 1.0 - g_sol[n] / Vj)) : 1.0;  // (8-11), (8-14)
+  });
+  grid.forward(g_th.data(), 1);
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const PointShape &ps = shapes[i];
+    const double *xp = x[i];
+    double th = 0.0;
+    MPM_FOR_NODES(ps, xp, { th += w * g_th[n]; })
+    pdata[i][C_THETA] = th;
+  }
+  if (theta_initialized) update_stress(0.0, true);
+}
+
 /* Two-way coupling with the DEM grains (chapter 7.2, 8.1-8.2):
    fluid fraction at the nodes from the grains' volumes (8-11)-(8-14) and at
    the points (8-16); fluid velocity, fraction and pressure gradient at each
@@ -1017,54 +1066,31 @@ void FixMpmFluid::couple_fluid_grains(double h) {
   double *radius = atom->radius, *rmass = atom->rmass;
   if (static_cast<int>(grain_shapes.size()) < nlocal) grain_shapes.resize(nlocal);
 
-  // solid volume of the grains, pressure and volume of the points, at the nodes
+  // pressure and volume of the points at the nodes; the fluid fraction is already there
   std::fill(g_cpl.begin(), g_cpl.end(), 0.0);
-  for (int k = 0; k < nlocal; ++k) {
-    if (!is_grain(k)) continue;
-    PointShape &ps = grain_shapes[k];
-    if (!shape_of(x[k], ps)) {
-      ps.base[0] = INT_MIN;  // outside the grid: no fluid there
-      continue;
-    }
-    const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
-    const double *xp = x[k];
-    MPM_FOR_NODES(ps, xp, { g_cpl[3 * n] += w * Vk; })
-  }
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
     const PointShape &ps = shapes[i];
     const double V = pdata[i][C_VOL], p = pdata[i][C_P];
     const double *xp = x[i];
     MPM_FOR_NODES(ps, xp, {
-      g_cpl[3 * n + 1] += w * V * p;
-      g_cpl[3 * n + 2] += w * V;
+      g_cpl[2 * n] += w * V * p;
+      g_cpl[2 * n + 1] += w * V;
     })
   }
-  grid.reverse_sum(g_cpl.data(), 3);
-  if (theta_smooth > 0.0) smooth_solid_volume();
+  grid.reverse_sum(g_cpl.data(), 2);
 
   const double mmin = mass_threshold * point_mass_ref;
-  grid.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double *c = &g_cpl[3 * n];
+  grid.for_owned([&](int, int, int, std::size_t n) {
+    const double *c = &g_cpl[2 * n];
     const double *g = &g_p2g[7 * n];
     double *st = &g_st[6 * n];
-    const double Vj = node_volume(i, j, k);
-    st[3] = Vj > 0.0 ? std::min(1.0, std::max(theta_min, 1.0 - c[0] / Vj)) : 1.0;  // (8-11), (8-14)
-    st[4] = c[2] > 0.0 ? c[1] / c[2] : 0.0;
+    st[3] = g_th[n];
+    st[4] = c[1] > 0.0 ? c[0] / c[1] : 0.0;
     st[5] = g[0];
     for (int d = 0; d < 3; ++d) st[d] = g[0] > mmin ? g[1 + d] / g[0] : 0.0;
   });
   grid.forward(g_st.data(), 6);
-
-  // fluid fraction at the points (8-16)
-  for (int i = 0; i < nlocal; ++i) {
-    if (!is_point(i)) continue;
-    const PointShape &ps = shapes[i];
-    const double *xp = x[i];
-    double th = 0.0;
-    MPM_FOR_NODES(ps, xp, { th += w * g_st[6 * n + 3]; })
-    pdata[i][C_THETA] = th;
-  }
 
   // Drag, exchanged node by node. Each grain k has the coefficient K_k
   // (frozen over the sub-step) and touches node j with weight S_jk. At every
@@ -1161,7 +1187,7 @@ void FixMpmFluid::couple_fluid_grains(double h) {
   }
 }
 
-/* Smoothing of the grains' volume at the owned nodes (g_cpl[3n]) by a
+/* Smoothing of the grains' volume at the owned nodes (g_sol) by a
    discrete diffusion of the solid fraction phi_j = S_j / V_j: passes of the
    filter [1/4 1/2 1/4] along each direction; the flux between neighbours
    j, n is (phi_n - phi_j) min(V_j, V_n) / 4, so the total solid volume is
@@ -1176,7 +1202,7 @@ void FixMpmFluid::smooth_solid_volume() {
   g_phi.assign(2 * grid.size(), 0.0);  // phi, node volume
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
     const double V = node_volume(i, j, k);
-    g_phi[2 * n] = V > 0.0 ? g_cpl[3 * n] / V : 0.0;
+    g_phi[2 * n] = V > 0.0 ? g_sol[n] / V : 0.0;
     g_phi[2 * n + 1] = V;
   });
   grid.forward(g_phi.data(), 2);
@@ -1199,7 +1225,7 @@ void FixMpmFluid::smooth_solid_volume() {
       grid.for_owned([&](int, int, int, std::size_t n) { g_phi[2 * n] = g_phi_new[n]; });
       grid.forward(g_phi.data(), 2);
     }
-  grid.for_owned([&](int, int, int, std::size_t n) { g_cpl[3 * n] = g_phi[2 * n] * g_phi[2 * n + 1]; });
+  grid.for_owned([&](int, int, int, std::size_t n) { g_sol[n] = g_phi[2 * n] * g_phi[2 * n + 1]; });
 }
 
 // At the first run with grains: the fluid present in a point's volume is
@@ -1207,15 +1233,12 @@ void FixMpmFluid::smooth_solid_volume() {
 // the grains' volume would be counted as compressed fluid.
 void FixMpmFluid::init_theta() {
   compute_shapes();
-  particles_to_grid();
-  grain_force.assign(3 * static_cast<std::size_t>(atom->nmax), 0.0);
-  couple_fluid_grains(update->dt);
+  fluid_fraction();
   for (int i = 0; i < atom->nlocal; ++i) {
     if (!is_point(i)) continue;
     atom->rmass[i] *= pdata[i][C_THETA];
     pdata[i][C_RHO] = atom->rmass[i] / (pdata[i][C_THETA] * pdata[i][C_VOL]);
   }
-  std::fill(grain_force.begin(), grain_force.end(), 0.0);
   theta_initialized = true;
 }
 
@@ -1376,7 +1399,7 @@ void FixMpmFluid::remap_velocity_musl() {
    Navier-Poisson (7-24). Anti-locking: the dilatation rate is averaged over
    each grid cell and the cell's pressure follows from the cell's mean
    density, so all points of a cell carry one pressure (Mast et al. 2012). */
-void FixMpmFluid::update_stress(double h) {
+void FixMpmFluid::update_stress(double h, bool theta_only) {
   const int nlocal = atom->nlocal;
   double **x = atom->x;
   double *rmass = atom->rmass;
@@ -1393,11 +1416,13 @@ void FixMpmFluid::update_stress(double h) {
     for (int i = 0; i < nlocal; ++i) {
       if (!is_point(i)) continue;
       const double *s = pdata[i];
-      const double *L = &velgrad[9 * static_cast<std::size_t>(i)];
       double *c = &g_cell[4 * cell_node(i)];
       const double V = s[C_VOL];
       c[0] += V;
-      c[1] += V * (L[0] + L[4] + L[8]);
+      if (!theta_only) {
+        const double *L = &velgrad[9 * static_cast<std::size_t>(i)];
+        c[1] += V * (L[0] + L[4] + L[8]);
+      }
       c[2] += s[C_THETA] * V;
       c[3] += rmass[i];
     }
@@ -1407,8 +1432,10 @@ void FixMpmFluid::update_stress(double h) {
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
     double *s = pdata[i];
-    const double *L = &velgrad[9 * static_cast<std::size_t>(i)];
-    double div = L[0] + L[4] + L[8];
+    // theta_only: the fluid fraction changed, the volume did not (velgrad
+    // belongs to the last step's atom order then and is not read)
+    const double *L = theta_only ? nullptr : &velgrad[9 * static_cast<std::size_t>(i)];
+    double div = theta_only ? 0.0 : L[0] + L[4] + L[8];
     double p;
     if (antilock) {
       const double *c = &g_cell[4 * cell_node(i)];
@@ -1430,6 +1457,7 @@ void FixMpmFluid::update_stress(double h) {
       fail_one(os.str());
     }
     s[C_P] = p;
+    if (theta_only) continue;
     const double Lm[3][3] = {{L[0], L[1], L[2]}, {L[3], L[4], L[5]}, {L[6], L[7], L[8]}};
     mpm::newtonian_deviatoric_stress(viscosity, Lm, s + C_TAU);
   }

@@ -150,7 +150,9 @@ class FixMpmFluid : public Fix {
   bool cell_check = true;
   bool theta_initialized = false;  // fluid mass reduced by the grains' volume once (restart)
   std::vector<PointShape> grain_shapes;
-  std::vector<double> g_cpl;    // per node: solid volume, V p, V of the points (P2G)
+  std::vector<double> g_cpl;    // per node: V p, V of the points (P2G)
+  std::vector<double> g_sol;    // per node: solid volume of the grains (reverse-summed, smoothed)
+  std::vector<double> g_th;     // per node: fluid fraction (forwarded)
   std::vector<double> g_st;     // per node: u(3), theta, p, m (forwarded)
   std::vector<double> g_rx;     // per node: force of the grains on the fluid (3), owned nodes
   static constexpr int kDr = 12;
@@ -205,6 +207,7 @@ class FixMpmFluid : public Fix {
   bool shape_of(const double *x, PointShape &ps);
   void couple_fluid_grains(double h);
   void smooth_solid_volume();
+  void fluid_fraction();
   void init_theta();
   double node_volume(int i, int j, int k) const;
   bool is_grain(int i) const;
@@ -214,7 +217,7 @@ class FixMpmFluid : public Fix {
   void apply_grid_bc(double *v, int nodeidx_i, int nodeidx_j, int nodeidx_k);
   void grid_to_particles(double h);
   void remap_velocity_musl();
-  void update_stress(double h);
+  void update_stress(double h, bool theta_only = false);
   void advance_positions(double h);
   void write_output();
   void compute_outputs();
