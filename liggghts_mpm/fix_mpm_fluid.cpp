@@ -966,7 +966,10 @@ void FixMpmFluid::particles_to_grid() {
         g[4 + d] += w * f[i][d] - V * (sig[d][0] * gw[0] + sig[d][1] * gw[1] + sig[d][2] * gw[2]);
       }
     })
-    if (wall_traction && shape == mpm::ShapeKind::QuadraticBSpline) add_wall_traction(ps, xp, V, p);
+    if (wall_traction && shape == mpm::ShapeKind::QuadraticBSpline) {
+      add_wall_traction(ps, xp, V, p);
+      if (mesh_walls) add_mesh_wall_traction(xp, V, p);
+    }
   }
   grid.reverse_sum(g_p2g.data(), 7);
 }
@@ -1050,6 +1053,41 @@ void FixMpmFluid::fluid_fraction() {
     pdata[i][C_THETA] = th;
   }
   if (theta_initialized) update_stress(0.0, true);
+}
+
+/* The same boundary term (8-23) at mesh walls: a point closer than one
+   cell to a triangle face stands for the wall area V_p / dx at its nearest
+   point q on the face (the points of the layer next to the wall tile it),
+   and the wall pushes the fluid with p V_p / dx along the face normal
+   towards the fluid, shared among the nodes by their weights at q. Nodes
+   behind the wall take their share out again through the velocity
+   condition; the nodes in front get the push that the internal force
+   (8-24) alone lacks there (without it a curved mesh wall draws the fluid
+   in: docs/mesh_walls.md). */
+void FixMpmFluid::add_mesh_wall_traction(const double *xp, double V, double p) {
+  double q[3], nrm[3];
+  if (p == 0.0 || !mesh_walls->nearest_face(xp, gspec.dx, q, nrm)) return;
+  const double inv = 1.0 / gspec.dx;
+  const mpm::IndexBox &pb = grid.patch();
+  int base[3];
+  double w[3][3];
+  for (int d = 0; d < 3; ++d) {
+    double xi = (q[d] - gspec.origin[d]) * inv;
+    if (!gspec.periodic[d]) xi = std::min(std::max(xi, 0.0), static_cast<double>(gspec.ncell[d]));
+    mpm::Shape1D sh;
+    mpm::shape_eval(shape, xi, sh);
+    if (sh.base < pb.lo[d] || sh.base + 2 > pb.hi[d]) return;
+    base[d] = sh.base;
+    for (int a = 0; a < 3; ++a) w[d][a] = sh.w[a];
+  }
+  const double push = p * V * inv;
+  for (int c = 0; c < 3; ++c)
+    for (int b = 0; b < 3; ++b)
+      for (int a = 0; a < 3; ++a) {
+        const double wt = push * w[0][a] * w[1][b] * w[2][c];
+        double *g = &g_p2g[7 * grid.index(base[0] + a, base[1] + b, base[2] + c) + 4];
+        for (int d = 0; d < 3; ++d) g[d] += wt * nrm[d];
+      }
 }
 
 /* Two-way coupling with the DEM grains (chapter 7.2, 8.1-8.2):

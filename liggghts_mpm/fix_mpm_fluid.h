@@ -207,6 +207,7 @@ class FixMpmFluid : public Fix {
   bool shape_of(const double *x, PointShape &ps);
   void couple_fluid_grains(double h);
   void smooth_solid_volume();
+  void add_mesh_wall_traction(const double *xp, double V, double p);
   void fluid_fraction();
   void init_theta();
   double node_volume(int i, int j, int k) const;

@@ -538,6 +538,50 @@ bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, doub
   return touched;
 }
 
+bool MeshWalls::nearest_face(const double x[3], double reach, double q[3], double n[3]) const {
+  if (tris_.empty()) return false;
+  const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
+  const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+  double best = reach * reach;
+  int bi = -1;
+  Hit bh;
+  for (int c = 0; c < ncand; ++c) {
+    const int i = cand ? (*cand)[c] : c;
+    const Tri &t = tris_[i];
+    if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
+        x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
+      continue;
+    double a[3];
+    sub3(x, t.p[0], a);
+    const double pd = dot3(a, t.n);
+    if (pd * pd >= best) continue;  // its plane is farther than the best hit
+    Hit h;
+    closest_point(t, x, h);
+    if (h.dist2 >= best) continue;
+    best = h.dist2;
+    bi = i;
+    bh = h;
+  }
+  if (bi < 0 || !bh.face) return false;
+  const Tri &t = tris_[bi];
+  double d[3];
+  sub3(x, bh.p, d);
+  const double s = dot3(d, t.n);
+  const int side = specs_[t.mesh].side;
+  double sg;
+  if (side == SIDE_NORMAL || side == SIDE_OPPOSITE) {
+    sg = side;
+    if (sg * s < 0.0) return false;  // behind a one-sided wall
+  } else {
+    sg = s >= 0.0 ? 1.0 : -1.0;
+  }
+  for (int k = 0; k < 3; ++k) {
+    q[k] = bh.p[k];
+    n[k] = sg * t.n[k];
+  }
+  return true;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Material points
 

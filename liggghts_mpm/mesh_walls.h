@@ -54,6 +54,11 @@ class MeshWalls {
   // scans all gathered triangles. Returns true if touched.
   bool apply(const double x[3], double vel[3], double reach, double reach_behind = -1.0) const;
 
+  // Nearest triangle face to x within 'reach' (the closest point inside a triangle, not on an edge
+  // or vertex only): q = that point, n = unit normal towards x's side (the fluid side of a
+  // one-sided mesh; false if x is behind it). For the wall traction of the fix. reach <= margin.
+  bool nearest_face(const double x[3], double reach, double q[3], double n[3]) const;
+
   // Material points. Undoes a crossing: (a) if x_old is given and the segment x_old -> x crosses a
   // triangle, x goes back to x_old's side of it; (b) for one-sided meshes, a point behind a
   // triangle (closest point inside the face, depth < reach) is put back on the fluid side. The
