@@ -6,6 +6,8 @@
 
 #include "fix_mpm_fluid.h"
 
+#include <Eigen/Dense>
+
 #include <mpi.h>
 
 #include <algorithm>
@@ -656,17 +658,17 @@ void FixMpmFluid::init() {
 
 bool FixMpmFluid::is_grain(int i) const { return coupled && (atom->mask[i] & couple_groupbit) != 0; }
 
-// Integral of node i's shape function over the grid, in cell volumes per
-// dimension: 1 inside, less for nodes whose support crosses a wall (8-13).
-double FixMpmFluid::node_volume(int i, int j, int k) const {
+// Node volume for the grains' volume fraction (8-13) with shape functions
+// reflected at the grid faces: half a cell on a wall, a full cell inside,
+// none outside (the text's (8-13) integrates the unreflected shape function
+// over the inside, which leaves the padding node 1/48 of a cell).
+double FixMpmFluid::solid_node_volume(int i, int j, int k) const {
   const int idx[3] = {i, j, k};
   double v = gspec.dx * gspec.dx * gspec.dx;
   for (int d = 0; d < 3; ++d) {
     if (gspec.periodic[d]) continue;
-    const int lo = idx[d], hi = gspec.ncell[d] - idx[d];  // distance in nodes to each wall
-    if (lo >= -1 && lo <= 2) v *= node_frac[d][0][lo + 1];
-    else if (hi >= -1 && hi <= 2) v *= node_frac[d][1][hi + 1];
-    else if (lo < -1 || hi < -1) v *= 0.0;
+    if (idx[d] < 0 || idx[d] > gspec.ncell[d]) return 0.0;
+    if (idx[d] == 0 || idx[d] == gspec.ncell[d]) v *= 0.5;
   }
   return v;
 }
@@ -681,28 +683,12 @@ void FixMpmFluid::setup_grid() {
   g_cell.assign(grid.size() * 4, 0.0);
   if (musl) g_aux.assign(grid.size() * 3, 0.0);
   if (coupled) {
-    g_cpl.assign(grid.size() * 2, 0.0);
+    g_cpl.assign(grid.size() * kPfit, 0.0);
     g_sol.assign(grid.size(), 0.0);
     g_th.assign(grid.size(), 1.0);
-    g_st.assign(grid.size() * 6, 0.0);
+    g_st.assign(grid.size() * kSt, 0.0);
     g_rx.assign(grid.size() * 3, 0.0);
     g_dr.assign(grid.size() * kDr, 0.0);
-    // node at distance n (in nodes) from a wall: integral of its shape function
-    // over the inside, by the midpoint rule on 4000 intervals of the support
-    for (int d = 0; d < 3; ++d)
-      for (int n = -1; n <= 2; ++n) {
-        double sum = 0.0;
-        const int nq = 4000;
-        for (int q = 0; q < nq; ++q) {
-          const double xi = -2.0 + 4.0 * (q + 0.5) / nq;  // offset from the node, cells
-          if (n + xi < 0.0) continue;                     // outside the wall
-          mpm::Shape1D sh;
-          mpm::shape_eval(shape, n + xi, sh);
-          const int a = n - sh.base;
-          if (a >= 0 && a < mpm::support(shape)) sum += sh.w[a] * 4.0 / nq;
-        }
-        node_frac[d][0][n + 1] = node_frac[d][1][n + 1] = sum;
-      }
   }
   grid_ready = true;
 }
@@ -1037,11 +1023,44 @@ void FixMpmFluid::fluid_fraction() {
     const double *xp = x[k];
     MPM_FOR_NODES(ps, xp, { g_sol[n] += w * Vk; })
   }
+  // Walls: the solid volume mapped to a node outside a grid face is folded
+  // onto its mirror node inside (reflected shape functions), so that no node
+  // has the sliver volume that (8-13) gives the padding nodes (1/48 of a
+  // cell for the B-spline: one grain near the wall would swing its theta by
+  // tens of per cent, and the pressure of the points next to the wall with
+  // it, by K dtheta/theta). Node volumes: half a cell on the wall, full
+  // inside; a padding node takes the fraction of its mirror.
+  for (int d = 0; d < 3; ++d) {
+    if (gspec.periodic[d]) continue;
+    const mpm::IndexBox &pb = grid.patch();
+    for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
+      for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+        for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
+          int idx[3] = {i, j, k};
+          const int c = idx[d];
+          int m;
+          if (c < 0) m = -c;
+          else if (c > gspec.ncell[d]) m = 2 * gspec.ncell[d] - c;
+          else continue;
+          const std::size_t n = grid.index(i, j, k);
+          idx[d] = m;
+          if (g_sol[n] != 0.0 && grid.in_patch(idx[0], idx[1], idx[2])) {
+            g_sol[grid.index(idx[0], idx[1], idx[2])] += g_sol[n];
+            g_sol[n] = 0.0;
+          }
+        }
+  }
   grid.reverse_sum(g_sol.data(), 1);
   if (theta_smooth > 0.0) smooth_solid_volume();
+  auto mirror = [&](int c, int d) {
+    if (gspec.periodic[d]) return c;
+    return c < 0 ? -c : (c > gspec.ncell[d] ? 2 * gspec.ncell[d] - c : c);
+  };
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double Vj = node_volume(i, j, k);
-    g_th[n] = Vj > 0.0 ? std::min(1.0, std::max(theta_min, 1.0 - g_sol[n] / Vj)) : 1.0;  // (8-11), (8-14)
+    const int mi[3] = {mirror(i, 0), mirror(j, 1), mirror(k, 2)};
+    const double Vj = solid_node_volume(mi[0], mi[1], mi[2]);
+    const std::size_t m = grid.in_patch(mi[0], mi[1], mi[2]) ? grid.index(mi[0], mi[1], mi[2]) : n;
+    g_th[n] = std::min(1.0, std::max(theta_min, 1.0 - g_sol[m] / Vj));  // (8-11), (8-14)
   });
   grid.forward(g_th.data(), 1);
   for (int i = 0; i < nlocal; ++i) {
@@ -1104,31 +1123,84 @@ void FixMpmFluid::couple_fluid_grains(double h) {
   double *radius = atom->radius, *rmass = atom->rmass;
   if (static_cast<int>(grain_shapes.size()) < nlocal) grain_shapes.resize(nlocal);
 
-  // pressure and volume of the points at the nodes; the fluid fraction is already there
+  // Pressure at the nodes for the force on the grains: a linear least-squares
+  // fit p_j + b.(x - x_j) to the pressures of the points around node j,
+  // weighted by S_j V_p. A plain weighted mean would be the pressure of the
+  // points' centre, which next to a wall or the bed's floor lies up to a cell
+  // off the node: the gradient at a grain resting on the floor was then a
+  // fraction of the hydrostatic one (39 % of Archimedes at z = r, cell = 3 d;
+  // docs/drag.md). The fit reproduces any linear pressure field exactly.
   std::fill(g_cpl.begin(), g_cpl.end(), 0.0);
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
     const PointShape &ps = shapes[i];
     const double V = pdata[i][C_VOL], p = pdata[i][C_P];
     const double *xp = x[i];
+    // With anti-locking the pressure is the cell's (its mean density): it
+    // belongs to the cell's centre, not to the point (a fit to the points'
+    // own positions sees a staircase and, near a wall, a flat one).
+    double xs[3];
+    for (int a = 0; a < 3; ++a) {
+      if (!antilock) {
+        xs[a] = xp[a];
+        continue;
+      }
+      int c = static_cast<int>(std::floor((xp[a] - gspec.origin[a]) / gspec.dx));
+      if (!gspec.periodic[a]) c = std::min(std::max(c, 0), gspec.ncell[a] - 1);
+      xs[a] = gspec.origin[a] + (c + 0.5) * gspec.dx;
+    }
     MPM_FOR_NODES(ps, xp, {
-      g_cpl[2 * n] += w * V * p;
-      g_cpl[2 * n + 1] += w * V;
+      double *c = &g_cpl[kPfit * n];
+      const double wv = w * V;
+      double d[3];
+      for (int a = 0; a < 3; ++a) d[a] = xs[a] - xp[a] - off[a];
+      c[0] += wv * p;
+      c[1] += wv;
+      for (int a = 0; a < 3; ++a) {
+        c[2 + a] += wv * d[a];
+        c[5 + a] += wv * p * d[a];
+      }
+      c[8] += wv * d[0] * d[0];
+      c[9] += wv * d[1] * d[1];
+      c[10] += wv * d[2] * d[2];
+      c[11] += wv * d[1] * d[2];
+      c[12] += wv * d[0] * d[2];
+      c[13] += wv * d[0] * d[1];
     })
   }
-  grid.reverse_sum(g_cpl.data(), 2);
+  grid.reverse_sum(g_cpl.data(), kPfit);
 
   const double mmin = mass_threshold * point_mass_ref;
   grid.for_owned([&](int, int, int, std::size_t n) {
-    const double *c = &g_cpl[2 * n];
+    const double *c = &g_cpl[kPfit * n];
     const double *g = &g_p2g[7 * n];
-    double *st = &g_st[6 * n];
+    double *st = &g_st[kSt * n];
     st[3] = g_th[n];
+    st[6] = st[7] = st[8] = st[9] = 0.0;
     st[4] = c[1] > 0.0 ? c[0] / c[1] : 0.0;
+    if (c[1] > 0.0) {
+      Eigen::Matrix4d M;
+      M << c[1], c[2], c[3], c[4], c[2], c[8], c[13], c[12], c[3], c[13], c[9], c[11], c[4], c[12], c[11],
+          c[10];
+      const Eigen::Vector4d r(c[0], c[5], c[6], c[7]);
+      // scale the offsets by the cell so that the system is well conditioned
+      const double s = 1.0 / gspec.dx;
+      const Eigen::Vector4d D(1.0, s, s, s);
+      const Eigen::Matrix4d Ms = D.asDiagonal() * M * D.asDiagonal();
+      Eigen::LDLT<Eigen::Matrix4d> ldlt(Ms);
+      if (ldlt.info() == Eigen::Success && ldlt.rcond() > 1e-6) {
+        const Eigen::Vector4d sol = D.asDiagonal() * ldlt.solve(D.asDiagonal() * r);
+        if (std::isfinite(sol[0]) && std::isfinite(sol[1]) && std::isfinite(sol[2]) && std::isfinite(sol[3])) {
+          st[4] = sol[0];
+          for (int a = 0; a < 3; ++a) st[6 + a] = sol[1 + a];
+          st[9] = 1.0;  // the fit (value and gradient) is determined
+        }
+      }
+    }
     st[5] = g[0];
     for (int d = 0; d < 3; ++d) st[d] = g[0] > mmin ? g[1 + d] / g[0] : 0.0;
   });
-  grid.forward(g_st.data(), 6);
+  grid.forward(g_st.data(), kSt);
 
   // Drag, exchanged node by node. Each grain k has the coefficient K_k
   // (frozen over the sub-step) and touches node j with weight S_jk. At every
@@ -1149,16 +1221,26 @@ void FixMpmFluid::couple_fluid_grains(double h) {
     if (!is_grain(k) || grain_shapes[k].base[0] == INT_MIN) continue;
     const PointShape &ps = grain_shapes[k];
     const double *xp = x[k];
-    double u[3] = {0, 0, 0}, gradp[3] = {0, 0, 0}, th = 0.0, wet = 0.0;
+    double u[3] = {0, 0, 0}, gradp[3] = {0, 0, 0}, fitgrad[3] = {0, 0, 0}, th = 0.0, wet = 0.0, wfit = 0.0;
     MPM_FOR_NODES(ps, xp, {
-      const double *st = &g_st[6 * n];
+      const double *st = &g_st[kSt * n];
       th += w * st[3];
       for (int d = 0; d < 3; ++d) gradp[d] += st[4] * gw[d];
+      if (st[9] > 0.0) {  // the fitted gradients of the nodes whose fit is determined
+        wfit += w;
+        for (int d = 0; d < 3; ++d) fitgrad[d] += w * st[6 + d];
+      }
       if (st[5] > mmin) {  // only nodes that hold fluid carry its velocity
         wet += w;
         for (int d = 0; d < 3; ++d) u[d] += w * st[d];
       }
     })
+    // Pressure gradient at the grain: the fitted nodal gradients interpolated
+    // (exact for a linear pressure field, also next to walls where a node's
+    // own fit is undetermined: all its points in one layer); the gradient of
+    // the interpolated nodal pressures where no fit is determined.
+    if (wfit > 0.5)
+      for (int d = 0; d < 3; ++d) gradp[d] = fitgrad[d] / wfit;
     const double d_k = 2.0 * radius[k];
     const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
     double K = 0.0;
@@ -1196,7 +1278,7 @@ void FixMpmFluid::couple_fluid_grains(double h) {
   std::fill(g_rx.begin(), g_rx.end(), 0.0);
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
     double *q = &g_dr[kDr * n];
-    const double *st = &g_st[6 * n];
+    const double *st = &g_st[kSt * n];
     double *rx = &g_rx[3 * n];
     double J[3] = {0, 0, 0};
     if (q[0] > 0.0 && st[5] > mmin) {
@@ -1239,7 +1321,7 @@ void FixMpmFluid::smooth_solid_volume() {
   if (passes <= 0) return;
   g_phi.assign(2 * grid.size(), 0.0);  // phi, node volume
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double V = node_volume(i, j, k);
+    const double V = solid_node_volume(i, j, k);
     g_phi[2 * n] = V > 0.0 ? g_sol[n] / V : 0.0;
     g_phi[2 * n + 1] = V;
   });

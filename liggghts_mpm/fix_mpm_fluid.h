@@ -150,17 +150,18 @@ class FixMpmFluid : public Fix {
   bool cell_check = true;
   bool theta_initialized = false;  // fluid mass reduced by the grains' volume once (restart)
   std::vector<PointShape> grain_shapes;
-  std::vector<double> g_cpl;    // per node: V p, V of the points (P2G)
+  static constexpr int kPfit = 14;
+  std::vector<double> g_cpl;    // per node: moments of the points' pressure for its linear fit (kPfit)
   std::vector<double> g_sol;    // per node: solid volume of the grains (reverse-summed, smoothed)
   std::vector<double> g_th;     // per node: fluid fraction (forwarded)
-  std::vector<double> g_st;     // per node: u(3), theta, p, m (forwarded)
+  static constexpr int kSt = 10;
+  std::vector<double> g_st;     // per node: u(3), theta, p, m, fitted grad p (3), fit determined (forwarded)
   std::vector<double> g_rx;     // per node: force of the grains on the fluid (3), owned nodes
   static constexpr int kDr = 12;
   int integrated_groupbits = 0;   // groups moved by some integrator: other grains are fixed
   std::vector<double> g_dr;     // per node: sum S K, sum S K v (3), sum S m, pressure reaction (3), sum S K a (3), sum S K of fixed grains
   std::vector<double> grain_force;  // per local grain: fluid force averaged over sub-steps (3)
   class FixPropertyAtom *fix_dragforce = nullptr;  // per-atom vector 'dragforce' (LIGGGHTS convention)
-  double node_frac[3][2][4];    // integral inside the grid of the shape function of a node -1..2 nodes from a wall
 
   // output
   int out_every = 0;
@@ -210,7 +211,7 @@ class FixMpmFluid : public Fix {
   void add_mesh_wall_traction(const double *xp, double V, double p);
   void fluid_fraction();
   void init_theta();
-  double node_volume(int i, int j, int k) const;
+  double solid_node_volume(int i, int j, int k) const;
   bool is_grain(int i) const;
   void particles_to_grid();
   void add_wall_traction(const PointShape &ps, const double *xp, double V, double p);
