@@ -10,6 +10,7 @@ only, so that CTest needs no virtual environment.
 import argparse
 import math
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -390,6 +391,19 @@ def case_every(r):
     v = -sim["v_z"][-1]
     print(f"  every 4: terminal velocity {v:.5f} m/s, Schiller-Naumann {vt:.5f} m/s ({100 * abs(v - vt) / vt:.2f} %)")
     check(abs(v - vt) < 0.02 * vt, "terminal velocity within 2 % with the fluid advanced every 4th step")
+
+
+def case_buoyancy_floor(r):
+    """A grain at rest in a fluid at rest gets Archimedes' force, also next to the floor: the
+    pressure gradient at the grain comes from linear fits of the cell pressures (cell = 3 d)."""
+    inp = os.path.join(os.path.dirname(os.path.abspath(__file__)), "in.buoyancy")
+    for zg, tol in ((0.0005, 0.2), (0.0015, 0.2), (0.006, 0.03), (0.012, 0.01)):
+        _, p = r.run(f"buoyancy_floor/z{zg}", inp, {"zg": zg})
+        m = re.search(r"RESULT zg \S+ ratio (\S+)", p.stdout)
+        check(m is not None, f"z = {zg}: result printed")
+        ratio = float(m.group(1))
+        print(f"  grain centre {1e3 * zg:.1f} mm above the floor: fluid force / Archimedes = {ratio:.4f}")
+        check(abs(ratio - 1.0) < tol, f"z = {zg}: within {100 * tol:.0f} % of Archimedes")
 
 
 def case_momentum_balance(r):
