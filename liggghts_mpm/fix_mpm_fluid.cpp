@@ -391,7 +391,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
         ++iarg;
       }
     } else if (strcmp(kw, "mesh_wall") == 0) {
-      need(iarg, 2, kw, "a fix ID and noslip | freeslip | partial f");
+      need(iarg, 2, kw, "a fix ID and noslip | freeslip | partial f | sticky f");
       mpm::MeshWallSpec ms;
       ms.fix_id = arg[iarg + 1];
       ms.side = mpm::SIDE_AUTO;
@@ -399,12 +399,14 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       iarg += 3;
       if (strcmp(k, "noslip") == 0) ms.kind = 0;
       else if (strcmp(k, "freeslip") == 0) ms.kind = 1;
-      else if (strcmp(k, "partial") == 0) {
-        need(iarg - 1, 1, "mesh_wall partial", "a sticky fraction");
-        ms.kind = 2;
-        if (!parse_double(arg[iarg], ms.sticky)) bad_arg("mesh_wall partial", "a sticky fraction in [0,1]", arg[iarg]);
+      else if (strcmp(k, "partial") == 0 || strcmp(k, "sticky") == 0) {
+        const bool sticky_kind = strcmp(k, "sticky") == 0;
+        const char *kwname = sticky_kind ? "mesh_wall sticky" : "mesh_wall partial";
+        need(iarg - 1, 1, kwname, "a sticky fraction");
+        ms.kind = sticky_kind ? 3 : 2;
+        if (!parse_double(arg[iarg], ms.sticky)) bad_arg(kwname, "a sticky fraction in [0,1]", arg[iarg]);
         ++iarg;
-      } else bad_arg("mesh_wall", "noslip, freeslip or partial f", k);
+      } else bad_arg("mesh_wall", "noslip, freeslip, partial f or sticky f", k);
       if (iarg + 1 < narg && strcmp(arg[iarg], "side") == 0) {
         const char *sd = arg[iarg + 1];
         if (strcmp(sd, "auto") == 0) ms.side = mpm::SIDE_AUTO;

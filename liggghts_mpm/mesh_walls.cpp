@@ -46,13 +46,21 @@ inline void wall_velocity(const MeshWalls::Tri &t, const double b[3], double w[3
 
 // Relative velocity r = v - w: normal part along unit n -> max(0, r.n) (fluid side) or 0 (behind),
 // tangential part scaled by (1 - sticky).
-inline void constrain(double v[3], const double w[3], const double n[3], bool behind, double sticky) {
+// imposed (kind 'sticky f'): the tangential velocity becomes f times the wall's tangential
+// velocity (the text's "50 % sticky wall" of C4), whatever it was.
+inline void constrain(double v[3], const double w[3], const double n[3], bool behind, double sticky,
+                      bool imposed = false) {
   double r[3];
   sub3(v, w, r);
   const double rn = dot3(r, n);
   const double rn_new = behind ? 0.0 : std::max(0.0, rn);
   const double keep = 1.0 - sticky;
+  const double wn = dot3(w, n);
   for (int d = 0; d < 3; ++d) {
+    if (imposed) {
+      v[d] = (wn + rn_new) * n[d] + sticky * (w[d] - wn * n[d]);
+      continue;
+    }
     const double rt = r[d] - rn * n[d];
     v[d] = w[d] + rn_new * n[d] + keep * rt;
   }
@@ -73,6 +81,7 @@ MeshWalls::MeshWalls(LAMMPS_NS::LAMMPS *lmp, std::vector<MeshWallSpec> specs)
       case 0: s.sticky = 1.0; break;
       case 1: s.sticky = 0.0; break;
       case 2:
+      case 3:
         if (!(s.sticky >= 0.0 && s.sticky <= 1.0)) {
           std::ostringstream m;
           m << "sticky fraction " << s.sticky << " of a partial-slip wall must lie in [0,1]";
@@ -81,7 +90,7 @@ MeshWalls::MeshWalls(LAMMPS_NS::LAMMPS *lmp, std::vector<MeshWallSpec> specs)
         break;
       default:
         throw std::runtime_error(fix_msg(s.fix_id, "unknown wall kind " + std::to_string(s.kind) +
-                                                       " (0 noslip, 1 freeslip, 2 partial)"));
+                                                       " (0 noslip, 1 freeslip, 2 partial, 3 sticky)"));
     }
     if (s.side != SIDE_NORMAL && s.side != SIDE_OPPOSITE && s.side != SIDE_AUTO && s.side != SIDE_BOTH)
       throw std::runtime_error(fix_msg(s.fix_id, "unknown fluid side " + std::to_string(s.side)));
@@ -531,7 +540,7 @@ bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, doub
       if (hits[h].dist2 > (behind ? rb2 : rf2)) continue;
       double w[3];
       wall_velocity(t, hits[h].b, w);
-      constrain(vel, w, n, behind, sticky);
+      constrain(vel, w, n, behind, sticky, specs_[k].kind == 3);
       touched = true;
     }
   }

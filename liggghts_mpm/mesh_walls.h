@@ -30,7 +30,7 @@ enum MeshSide : int {
 
 struct MeshWallSpec {
   std::string fix_id;  // ID of a fix mesh/surface (or a style derived from it)
-  int kind = 0;        // 0 noslip, 1 freeslip, 2 partial
+  int kind = 0;        // 0 noslip, 1 freeslip, 2 partial, 3 sticky (imposed fraction of the wall's tangential velocity)
   double sticky = 1.0; // tangential damping in [0,1]; forced to 1 (noslip) or 0 (freeslip)
   int side = SIDE_NORMAL;  // MeshSide
 };
