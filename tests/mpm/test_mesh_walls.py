@@ -142,6 +142,11 @@ def case_drum(r):
                                       f"< -0.2 x wall speed {vw:.2f} m/s")
     check(abs(fs["vcm_x"][1]) < 0.3 * abs(ns["vcm_x"][1]),
           f"freeslip drags much less: |vcm_x| {abs(fs['vcm_x'][1]):.3f} < 0.3 x {abs(ns['vcm_x'][1]):.3f}")
+    # sticky 0.5: the nodes at the wall move with half the wall's tangential velocity
+    st = drum_run(r, "drum_sticky", "sticky 0.5")
+    ratio = st["vcm_x"][1] / ns["vcm_x"][1]
+    print(f"  sticky 0.5: vcm_x {st['vcm_x'][1]:.3f} m/s = {ratio:.2f} x noslip")
+    check(0.3 < ratio < 0.75, f"sticky 0.5 drags about half as much as noslip (ratio {ratio:.2f} in 0.3..0.75)")
 
 
 def case_drum_np2(r):
@@ -158,6 +163,7 @@ def case_bad_input(r):
     bad = [({"wallfix": "nosuch"}, "nosuch"),
            ({"wallfix": "grav"}, "mesh/surface"),
            ({"kind": "partial 1.5"}, "[0,1]"),
+           ({"kind": "sticky -0.5"}, "[0,1]"),
            ({"fside": "sideways"}, "sideways")]
     for i, (v, needle) in enumerate(bad):
         d, p = r.run(f"bad_input/{i}", "in.mesh_walls_box", "box.stl", dict(v, steps=10), expect_ok=False)
