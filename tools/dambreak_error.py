@@ -17,7 +17,7 @@ DATA = os.path.normpath(os.path.join(HERE, "..", "..", "shared", "data"))
 
 
 def find_data(name):
-    for d in (os.environ.get("MPM_SHARED_DATA", ""), DATA,
+    for d in (os.environ.get("MPM_SHARED_DATA", ""), os.path.join(HERE, "..", "inputs", "dambreak"), DATA,
               os.path.join(HERE, "..", "shared", "data")):
         p = os.path.join(d, name)
         if d and os.path.exists(p):

@@ -38,8 +38,9 @@ def read_csv(path):
 
 
 def shared_data(name):
-    for d in (os.environ.get("MPM_SHARED_DATA", ""), os.path.join(HERE, "..", "..", "..", "shared", "data"),
-              os.path.join(HERE, "..", "..", "shared", "data")):
+    # the reference data travel with the repository (inputs/dambreak); ../shared/data as before
+    for d in (os.environ.get("MPM_SHARED_DATA", ""), os.path.join(HERE, "..", "..", "inputs", "dambreak"),
+              os.path.join(HERE, "..", "..", "..", "shared", "data"), os.path.join(HERE, "..", "..", "shared", "data")):
         p = os.path.join(d, name)
         if d and os.path.exists(p):
             return p
