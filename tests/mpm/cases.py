@@ -485,6 +485,19 @@ def case_tank_smoke(r):
     check(all(0.0 < v <= 0.2 for v in f["x_water"] + f["x_beads"]), "fronts inside the tank")
 
 
+def run_cases(table, name, runner):
+    """Runs the case 'name' of table (or all of them, sorted, for 'all'), each error a failed
+    check; prints the count and returns the exit status. For the other drivers' main()."""
+    for n in (sorted(table) if name == "all" else [name]):
+        print(f"== {n}: {table[n].__doc__}")
+        try:
+            table[n](runner)
+        except (RuntimeError, FileNotFoundError, IndexError, KeyError, ValueError) as e:
+            check(False, f"{n}: {e}")
+    print(f"{len(FAILURES)} failure(s)")
+    return 1 if FAILURES else 0
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("case")

@@ -15,7 +15,7 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import cases  # noqa: E402
-from cases import FAILURES, check, read_csv  # noqa: E402
+from cases import check, read_csv  # noqa: E402
 
 
 def cut_lines(text):
@@ -132,15 +132,7 @@ def main():
     ap.add_argument("--work", required=True)
     ap.add_argument("--mpirun", default="mpirun --allow-run-as-root --oversubscribe")
     a = ap.parse_args()
-    r = cases.Runner(a)
-    for n in (sorted(CASES) if a.case == "all" else [a.case]):
-        print(f"== {n}: {CASES[n].__doc__}")
-        try:
-            CASES[n](r)
-        except (RuntimeError, FileNotFoundError, IndexError, KeyError, ValueError) as e:
-            check(False, f"{n}: {e}")
-    print(f"{len(FAILURES)} failure(s)")
-    return 1 if FAILURES else 0
+    return cases.run_cases(CASES, a.case, cases.Runner(a))
 
 
 if __name__ == "__main__":

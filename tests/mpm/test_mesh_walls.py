@@ -20,7 +20,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 # the same check/CSV helpers as the other whole-program cases
 sys.path.insert(0, HERE)
 import cases  # noqa: E402
-from cases import FAILURES, check, read_csv  # noqa: E402
+from cases import check, read_csv  # noqa: E402
 
 
 class Runner(cases.Runner):
@@ -205,16 +205,7 @@ def main():
     ap.add_argument("--work", default="mesh_walls_work")
     ap.add_argument("--mpirun", default="mpirun --allow-run-as-root --oversubscribe")
     a = ap.parse_args()
-    r = Runner(a)
-    names = sorted(CASES) if a.case == "all" else [a.case]
-    for n in names:
-        print(f"== {n}: {CASES[n].__doc__}")
-        try:
-            CASES[n](r)
-        except (RuntimeError, FileNotFoundError, IndexError, KeyError, ValueError) as e:
-            check(False, f"{n}: {e}")
-    print(f"{len(FAILURES)} failure(s)")
-    return 1 if FAILURES else 0
+    return cases.run_cases(CASES, a.case, Runner(a))
 
 
 if __name__ == "__main__":
