@@ -1032,32 +1032,35 @@ void FixMpmFluid::fluid_fraction() {
   // tens of per cent, and the pressure of the points next to the wall with
   // it, by K dtheta/theta). Node volumes: half a cell on the wall, full
   // inside; a padding node takes the fraction of its mirror.
-  for (int d = 0; d < 3; ++d) {
-    if (gspec.periodic[d]) continue;
-    const mpm::IndexBox &pb = grid.patch();
-    for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
-      for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
-        for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-          int idx[3] = {i, j, k};
-          const int c = idx[d];
-          int m;
-          if (c < 0) m = -c;
-          else if (c > gspec.ncell[d]) m = 2 * gspec.ncell[d] - c;
-          else continue;
-          const std::size_t n = grid.index(i, j, k);
-          idx[d] = m;
-          if (g_sol[n] != 0.0 && grid.in_patch(idx[0], idx[1], idx[2])) {
-            g_sol[grid.index(idx[0], idx[1], idx[2])] += g_sol[n];
-            g_sol[n] = 0.0;
-          }
-        }
-  }
-  grid.reverse_sum(g_sol.data(), 1);
-  if (theta_smooth > 0.0) smooth_solid_volume();
   auto mirror = [&](int c, int d) {
     if (gspec.periodic[d]) return c;
     return c < 0 ? -c : (c > gspec.ncell[d] ? 2 * gspec.ncell[d] - c : c);
   };
+  const mpm::IndexBox &pb = grid.patch();
+  for (int d = 0; d < 3; ++d) {
+    if (gspec.periodic[d]) continue;
+    // only the patch's padding layers outside the low and the high face
+    const int layers[2][2] = {{pb.lo[d], std::min(pb.hi[d], -1)},
+                              {std::max(pb.lo[d], gspec.ncell[d] + 1), pb.hi[d]}};
+    for (const auto &L : layers) {
+      mpm::IndexBox b = pb;
+      b.lo[d] = L[0];
+      b.hi[d] = L[1];
+      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+          for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
+            const std::size_t n = grid.index(i, j, k);
+            int idx[3] = {i, j, k};
+            idx[d] = mirror(idx[d], d);
+            if (g_sol[n] != 0.0 && grid.in_patch(idx[0], idx[1], idx[2])) {
+              g_sol[grid.index(idx[0], idx[1], idx[2])] += g_sol[n];
+              g_sol[n] = 0.0;
+            }
+          }
+    }
+  }
+  grid.reverse_sum(g_sol.data(), 1);
+  if (theta_smooth > 0.0) smooth_solid_volume();
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
     const int mi[3] = {mirror(i, 0), mirror(j, 1), mirror(k, 2)};
     const double Vj = solid_node_volume(mi[0], mi[1], mi[2]);
