@@ -109,6 +109,11 @@ class Runner:
             shutil.copy(f, d)
         return d, self.execute(d, os.path.basename(infile), variables, np, expect_ok)
 
+    def expect_error(self, case, text, needles, label):
+        """Runs an input text that must stop with an error whose message contains every needle."""
+        p, msg = self.run_script(case, text)
+        check(p.returncode != 0 and all(n in msg for n in needles), f"{label} (got: {msg.strip()[:160]})")
+
     def run_script(self, case, text):
         """Runs an input given as text (no -var); returns the process and its first ERROR line."""
         d = self.fresh(case)
@@ -242,9 +247,8 @@ fix f all mpm/fluid {args}
 run 0
 """
     for i, (args, expect) in enumerate(cases):
-        p, msg = r.run_script(f"bad_input/{i}", tmpl.format(args=args))
-        check(p.returncode != 0 and "mpm/fluid" in msg and expect in msg,
-              f"'{args[-40:]}' -> error containing \"{expect}\" (got: {msg.strip()[:160]})")
+        r.expect_error(f"bad_input/{i}", tmpl.format(args=args), ("mpm/fluid", expect),
+                       f"'{args[-40:]}' -> error containing \"{expect}\"")
 
 
 def case_dt_error(r):
@@ -465,8 +469,8 @@ run 0
         ("0.008", "viscosity 1e-3 couple grains", "is smaller than the largest grain"),
     ]
     for i, (dia, args, expect) in enumerate(cases):
-        p, msg = r.run_script(f"coupling_bad_input/{i}", tmpl.format(d=dia, args=args))
-        check(p.returncode != 0 and expect in msg, f"'{args}' (d = {dia}) -> \"{expect}\" (got: {msg.strip()[:150]})")
+        r.expect_error(f"coupling_bad_input/{i}", tmpl.format(d=dia, args=args), (expect,),
+                       f"'{args}' (d = {dia}) -> \"{expect}\"")
     # the override turns the grain-size error into a warning and runs
     p, _ = r.run_script("coupling_bad_input/override",
                         tmpl.format(d="0.008", args="viscosity 1e-3 couple grains cell_check no"))

@@ -76,8 +76,7 @@ run 0
         ("dim x every 100", "Fix balance/mpm: keyword 'every' > 0 cannot be used with fix mpm/fluid"),
     ]
     for i, (args, expect) in enumerate(bad):
-        p, msg = r.run_script(f"balance_bad_input/{i}", tmpl.format(args=args))
-        check(p.returncode != 0 and expect in msg, f"'{args}' -> \"{expect}\" (got: {msg.strip()[:150]})")
+        r.expect_error(f"balance_bad_input/{i}", tmpl.format(args=args), (expect,), f"'{args}' -> \"{expect}\"")
     p, msg = r.run_script("balance_bad_input/ok", tmpl.format(args="dim x every 0 weight all 1.0 thresh 1.1"))
     check(p.returncode == 0, f"valid arguments run ({msg.strip()[:120]})")
 
