@@ -680,10 +680,10 @@ void FixMpmFluid::setup_grid() {
   // before LIGGGHTS re-neighbours and migrates it (half the skin), rounded up.
   const int halo = mpm::support(shape) + static_cast<int>(std::ceil(neighbor->skin / gspec.dx)) + 1;
   grid.setup(gspec, world, domain->sublo, domain->subhi, halo);
-  g_p2g.assign(grid.size() * 7, 0.0);
-  g_vel.assign(grid.size() * 6, 0.0);
+  g_p2g.assign(grid.size() * kP2g, 0.0);
+  g_vel.assign(grid.size() * kVel, 0.0);
   g_cell.assign(grid.size() * 4, 0.0);
-  if (musl) g_aux.assign(grid.size() * 3, 0.0);
+  if (musl) g_aux.assign(grid.size() * kAux, 0.0);
   if (coupled) {
     g_cpl.assign(grid.size() * kPfit, 0.0);
     g_sol.assign(grid.size(), 0.0);
@@ -860,9 +860,11 @@ void FixMpmFluid::compute_shapes() {
     vpic.resize(3 * static_cast<std::size_t>(nlocal));
     velgrad.resize(9 * static_cast<std::size_t>(nlocal));
   }
+  plist.clear();
   double **x = atom->x;
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
+    plist.push_back(i);
     if (!shape_of(x[i], shapes[i])) {
       std::ostringstream os;
       os << "Fix mpm/fluid: material point " << atom->tag[i] << " at (" << x[i][0] << ", " << x[i][1] << ", "
@@ -897,6 +899,7 @@ bool FixMpmFluid::shape_of(const double *x, PointShape &ps) {
       fail_one(os.str());
     }
   }
+  ps.n0 = grid.index(ps.base[0], ps.base[1], ps.base[2]);
   return true;
 }
 
@@ -928,38 +931,64 @@ bool FixMpmFluid::shape_of(const double *x, PointShape &ps) {
    external forces (gravity (8-18) and whatever LIGGGHTS fixes add) */
 void FixMpmFluid::particles_to_grid() {
   std::fill(g_p2g.begin(), g_p2g.end(), 0.0);
-  const int ns = mpm::support(shape);
-  const int nlocal = atom->nlocal;
-  double **x = atom->x, **v = atom->v, **f = atom->f;
-  double *rmass = atom->rmass;
   const bool affine = transfer == TR_APIC;
-  for (int i = 0; i < nlocal; ++i) {
-    if (!is_point(i)) continue;
+  if (shape == mpm::ShapeKind::QuadraticBSpline)
+    affine ? p2g_kernel<3, true>() : p2g_kernel<3, false>();
+  else
+    affine ? p2g_kernel<2, true>() : p2g_kernel<2, false>();
+  grid.reverse_sum(g_p2g.data(), kP2g);
+}
+
+// Offsets x_i - x_p of the stencil's node planes from the point, per direction.
+static inline void stencil_offsets(const mpm::GridSpec &gs, const mpm::Stencil &ps, const double *xp,
+                                   double o[3][3]) {
+  for (int d = 0; d < 3; ++d)
+    for (int a = 0; a < 3; ++a) o[d][a] = gs.origin[d] + (ps.base[d] + a) * gs.dx - xp[d];
+}
+
+template <int NS, bool AFFINE>
+void FixMpmFluid::p2g_kernel() {
+  double **x = atom->x, **v = atom->v, **f = atom->f;
+  const double *rmass = atom->rmass;
+  double *const g = g_p2g.data();
+  const std::size_t sy = grid.stride_y(), sz = grid.stride_z();
+  const bool traction = wall_traction && shape == mpm::ShapeKind::QuadraticBSpline;
+  for (const int i : plist) {
     const PointShape &ps = shapes[i];
     const double *s = pdata[i];
     const double m = rmass[i], V = s[C_VOL], p = s[C_P];
     const double *t = s + C_TAU;
-    // sigma = -p I + tau (symmetric), Voigt xx yy zz yz xz xy
-    const double sig[3][3] = {{t[0] - p, t[5], t[4]}, {t[5], t[1] - p, t[3]}, {t[4], t[3], t[2] - p}};
-    const double *C = s + C_AFF;
-    const double *xp = x[i];
-    MPM_FOR_NODES(ps, xp, {
-      double *g = &g_p2g[7 * n];
-      const double wm = w * m;
-      g[0] += wm;
-      for (int d = 0; d < 3; ++d) {
-        double vd = v[i][d];
-        if (affine) vd += C[3 * d] * off[0] + C[3 * d + 1] * off[1] + C[3 * d + 2] * off[2];
-        g[1 + d] += wm * vd;
-        g[4 + d] += w * f[i][d] - V * (sig[d][0] * gw[0] + sig[d][1] * gw[1] + sig[d][2] * gw[2]);
+    // -V sigma with sigma = -p I + tau (tau in Voigt order xx yy zz yz xz xy)
+    const double sxx = -V * (t[0] - p), syy = -V * (t[1] - p), szz = -V * (t[2] - p);
+    const double syz = -V * t[3], sxz = -V * t[4], sxy = -V * t[5];
+    // Node record m, m v (3), f (3), pad: each update is two 4-wide rows
+    // (mass and momentum; force) that the compiler vectorizes.
+    const mpm::Row4 mv = {m, m * v[i][0], m * v[i][1], m * v[i][2]};
+    const mpm::Row4 fe = {f[i][0], f[i][1], f[i][2], 0.0};
+    const mpm::Row4 sx = {sxx, sxy, sxz, 0.0}, sy_ = {sxy, syy, syz, 0.0}, sz_ = {sxz, syz, szz, 0.0};
+    double mC[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, o[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    if (AFFINE) {
+      for (int c = 0; c < 9; ++c) mC[c] = m * s[C_AFF + c];
+      stencil_offsets(gspec, ps, x[i], o);
+    }
+    mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double gx, double gy,
+                                         double gz) {
+      mpm::Row4 u = mv;
+      if (AFFINE) {
+        const double ox = o[0][a], oy = o[1][b], oz = o[2][c];
+        u[1] += mC[0] * ox + mC[1] * oy + mC[2] * oz;
+        u[2] += mC[3] * ox + mC[4] * oy + mC[5] * oz;
+        u[3] += mC[6] * ox + mC[7] * oy + mC[8] * oz;
       }
-    })
-    if (wall_traction && shape == mpm::ShapeKind::QuadraticBSpline) {
-      add_wall_traction(ps, xp, V, p);
-      if (mesh_walls) add_mesh_wall_traction(xp, V, p);
+      double *gn = g + kP2g * n;
+      mpm::row4(gn) += w * u;
+      mpm::row4(gn + 4) += w * fe + gx * sx + gy * sy_ + gz * sz_;
+    });
+    if (traction) {
+      add_wall_traction(ps, x[i], V, p);
+      if (mesh_walls) add_mesh_wall_traction(x[i], V, p);
     }
   }
-  grid.reverse_sum(g_p2g.data(), 7);
 }
 
 /* Wall traction, the boundary term (8-23) f_j = int_wall S_j sigma n ds, for
@@ -992,7 +1021,7 @@ void FixMpmFluid::add_wall_traction(const PointShape &ps, const double *xp, doub
         idx[d] = node;
         idx[e] = ps.base[e] + b;
         idx[f] = ps.base[f] + c;
-        g_p2g[7 * grid.index(idx[0], idx[1], idx[2]) + 4 + d] += push * ps.w[e][b] * ps.w[f][c];
+        g_p2g[kP2g * grid.index(idx[0], idx[1], idx[2]) + 4 + d] += push * ps.w[e][b] * ps.w[f][c];
       }
   }
 }
@@ -1109,7 +1138,7 @@ void FixMpmFluid::add_mesh_wall_traction(const double *xp, double V, double p) {
     for (int b = 0; b < 3; ++b)
       for (int a = 0; a < 3; ++a) {
         const double wt = push * w[0][a] * w[1][b] * w[2][c];
-        double *g = &g_p2g[7 * grid.index(base[0] + a, base[1] + b, base[2] + c) + 4];
+        double *g = &g_p2g[kP2g * grid.index(base[0] + a, base[1] + b, base[2] + c) + 4];
         for (int d = 0; d < 3; ++d) g[d] += wt * nrm[d];
       }
 }
@@ -1178,7 +1207,7 @@ void FixMpmFluid::couple_fluid_grains(double h) {
   const double mmin = mass_threshold * point_mass_ref;
   grid.for_owned([&](int, int, int, std::size_t n) {
     const double *c = &g_cpl[kPfit * n];
-    const double *g = &g_p2g[7 * n];
+    const double *g = &g_p2g[kP2g * n];
     double *st = &g_st[kSt * n];
     st[3] = g_th[n];
     st[6] = st[7] = st[8] = st[9] = 0.0;
@@ -1289,7 +1318,7 @@ void FixMpmFluid::couple_fluid_grains(double h) {
     if (q[0] > 0.0 && st[5] > mmin) {
       const double vg[3] = {q[1] / q[0], q[2] / q[0], q[3] / q[0]};
       const double ag[3] = {q[8] / q[0], q[9] / q[0], q[10] / q[0]};
-      const double *f = &g_p2g[7 * n + 4];
+      const double *f = &g_p2g[kP2g * n + 4];
       const double af[3] = {(f[0] + q[5]) / st[5], (f[1] + q[6]) / st[5], (f[2] + q[7]) / st[5]};
       const double mg = q[11] > 0.0 ? HUGE_VAL : q[4];
       mpm::drag_implicit_impulse(vg, st, mg, st[5], q[0], h, J, ag, af);
@@ -1399,63 +1428,102 @@ void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k) {
 void FixMpmFluid::update_grid(double h) {
   const double mmin = mass_threshold * point_mass_ref;
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double *g = &g_p2g[7 * n];
-    double *gv = &g_vel[6 * n];
-    if (g[0] <= mmin || g[0] <= 0.0) {
-      // Nearly empty node at the free surface: its velocity would be a
-      // ratio of two round-off-sized numbers; it carries no information.
-      for (int c = 0; c < 6; ++c) gv[c] = 0.0;
-      return;
-    }
+    const double *g = &g_p2g[kP2g * n];
+    double *gv = &g_vel[kVel * n];
+    for (int c = 0; c < kVel; ++c) gv[c] = 0.0;
+    // Nearly empty node at the free surface: its velocity would be a ratio
+    // of two round-off-sized numbers; it carries no information.
+    if (g[0] <= mmin || g[0] <= 0.0) return;
     const double inv = 1.0 / g[0];
     double vnew[3];
     for (int d = 0; d < 3; ++d) {
-      gv[3 + d] = g[1 + d] * inv;
+      gv[4 + d] = g[1 + d] * inv;
       const double f = g[4 + d] + (coupled ? g_rx[3 * n + d] : 0.0);
       // damping is implicit in time so that any rate is stable
-      vnew[d] = (gv[3 + d] + h * f * inv) / (1.0 + h * damping);
+      vnew[d] = (gv[4 + d] + h * f * inv) / (1.0 + h * damping);
     }
     apply_grid_bc(vnew, i, j, k);
     for (int d = 0; d < 3; ++d) gv[d] = vnew[d];
   });
-  grid.forward(g_vel.data(), 6);
+  grid.forward(g_vel.data(), kVel);
 }
 
-/* grid to particles: velocity (8-37)/(8-40), affine velocity, velocity gradient */
+/* grid to particles: velocity (8-37)/(8-40), affine velocity, velocity
+   gradient; with MUSL also the first half of the remap (the updated point
+   momentum back to the nodes), in the same pass over the points */
 void FixMpmFluid::grid_to_particles(double) {
-  const int ns = mpm::support(shape);
-  const int nlocal = atom->nlocal;
+  const bool quad = shape == mpm::ShapeKind::QuadraticBSpline;
+  const bool apic = transfer == TR_APIC;
+  if (musl) std::fill(g_aux.begin(), g_aux.end(), 0.0);
+  // The velocity gradient of the new grid velocity is the USL stress
+  // update's (MUSL takes it from the remapped velocity instead) and the
+  // affine field of APIC with linear shapes; B (APIC) needs the node offsets.
+  if (quad) {
+    if (apic)
+      musl ? g2p_kernel<3, false, true, true, true>() : g2p_kernel<3, true, true, false, false>();
+    else
+      musl ? g2p_kernel<3, false, false, true, false>() : g2p_kernel<3, true, false, false, false>();
+  } else {
+    if (apic)
+      musl ? g2p_kernel<2, true, false, true, true>() : g2p_kernel<2, true, false, false, false>();
+    else
+      musl ? g2p_kernel<2, false, false, true, false>() : g2p_kernel<2, true, false, false, false>();
+  }
+}
+
+template <int NS, bool NEED_L, bool NEED_B, bool SCATTER, bool SCATTER_AFFINE>
+void FixMpmFluid::g2p_kernel() {
   double **x = atom->x, **v = atom->v;
+  const double *rmass = atom->rmass;
+  const double *const gvel = g_vel.data();
+  double *const ga = g_aux.data();
+  const std::size_t sy = grid.stride_y(), sz = grid.stride_z();
   const double dinv = mpm::apic_dinv_bspline2() / (gspec.dx * gspec.dx);
-  for (int i = 0; i < nlocal; ++i) {
-    if (!is_point(i)) continue;
+  const bool flip = transfer == TR_FLIP;
+  for (const int i : plist) {
     const PointShape &ps = shapes[i];
     double *s = pdata[i];
-    const double *xp = x[i];
-    double vp[3] = {0, 0, 0}, dv[3] = {0, 0, 0}, L[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0},
-           B[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    MPM_FOR_NODES(ps, xp, {
-      const double *gv = &g_vel[6 * n];
-      for (int d = 0; d < 3; ++d) {
-        vp[d] += w * gv[d];
-        dv[d] += w * (gv[d] - gv[3 + d]);
-        for (int e = 0; e < 3; ++e) {
-          L[3 * d + e] += gv[d] * gw[e];
-          B[3 * d + e] += w * gv[d] * off[e];
-        }
+    // 4-wide accumulators (the node record is v_new (3), pad, v_old (3), pad);
+    // L and B by columns: Lc[e][d] = sum v_d dS/dx_e
+    mpm::Row4 vp = {0, 0, 0, 0}, dv = {0, 0, 0, 0};
+    mpm::Row4 Lc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}, Bc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
+    double o[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    if (NEED_B) stencil_offsets(gspec, ps, x[i], o);
+    mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double gx, double gy,
+                                         double gz) {
+      const mpm::Row4 un = mpm::row4(gvel + kVel * n), uo = mpm::row4(gvel + kVel * n + 4);
+      vp += w * un;
+      dv += w * (un - uo);
+      if (NEED_L) {
+        Lc[0] += gx * un;
+        Lc[1] += gy * un;
+        Lc[2] += gz * un;
       }
-    })
+      if (NEED_B) {
+        const double ox = w * o[0][a], oy = w * o[1][b], oz = w * o[2][c];
+        Bc[0] += ox * un;
+        Bc[1] += oy * un;
+        Bc[2] += oz * un;
+      }
+    });
+    double L[9], B[9];
+    for (int d = 0; d < 3; ++d)
+      for (int e = 0; e < 3; ++e) {
+        L[3 * d + e] = Lc[e][d];
+        B[3 * d + e] = Bc[e][d];
+      }
     for (int d = 0; d < 3; ++d) vpic[3 * i + d] = vp[d];
-    if (transfer == TR_FLIP) {
+    if (flip) {
       for (int d = 0; d < 3; ++d) v[i][d] = flip_alpha * (v[i][d] + dv[d]) + (1.0 - flip_alpha) * vp[d];
     } else {
       for (int d = 0; d < 3; ++d) v[i][d] = vp[d];
     }
     // Affine field: B D^-1 for the quadratic B-spline (exact inertia), the
-    // velocity gradient for linear shape functions.
-    if (transfer == TR_APIC && shape == mpm::ShapeKind::QuadraticBSpline)
+    // velocity gradient for linear shape functions and for FLIP/PIC without
+    // MUSL; with MUSL, FLIP/PIC store the remapped gradient there.
+    if (NEED_B)
       for (int c = 0; c < 9; ++c) s[C_AFF + c] = B[c] * dinv;
-    else
+    else if (NEED_L)
       for (int c = 0; c < 9; ++c) s[C_AFF + c] = L[c];
     if (!(std::isfinite(v[i][0]) && std::isfinite(v[i][1]) && std::isfinite(v[i][2]))) {
       std::ostringstream os;
@@ -1464,59 +1532,74 @@ void FixMpmFluid::grid_to_particles(double) {
       fail_one(os.str());
     }
     // velocity gradient for the stress update (USL; MUSL recomputes it)
-    std::copy(L, L + 9, &velgrad[9 * static_cast<std::size_t>(i)]);
+    if (NEED_L) std::copy(L, L + 9, &velgrad[9 * static_cast<std::size_t>(i)]);
+    if (SCATTER) {
+      // MUSL remap, first half: the point's new momentum (with its new affine
+      // field for APIC) to the same nodes
+      const double m = rmass[i];
+      const mpm::Row4 mv = {m * v[i][0], m * v[i][1], m * v[i][2], 0.0};
+      double mC[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+      if (SCATTER_AFFINE) {
+        for (int c = 0; c < 9; ++c) mC[c] = m * s[C_AFF + c];
+        if (!NEED_B) stencil_offsets(gspec, ps, x[i], o);
+      }
+      mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
+        mpm::Row4 u = mv;
+        if (SCATTER_AFFINE) {
+          const double ox = o[0][a], oy = o[1][b], oz = o[2][c];
+          u[0] += mC[0] * ox + mC[1] * oy + mC[2] * oz;
+          u[1] += mC[3] * ox + mC[4] * oy + mC[5] * oz;
+          u[2] += mC[6] * ox + mC[7] * oy + mC[8] * oz;
+        }
+        mpm::row4(ga + kAux * n) += w * u;
+      });
+    }
   }
 }
 
-/* MUSL (Buzzi et al. 2008, text after (8-41)): map the updated point
-   momentum back to the grid and take the velocity gradient for the stress
-   update from it, still at the positions of the start of the step. */
+/* MUSL (Buzzi et al. 2008, text after (8-41)): the updated point momentum,
+   mapped back to the grid by grid_to_particles, gives the velocity gradient
+   for the stress update, still at the positions of the start of the step. */
 void FixMpmFluid::remap_velocity_musl() {
-  std::fill(g_aux.begin(), g_aux.end(), 0.0);
-  const int ns = mpm::support(shape);
-  const int nlocal = atom->nlocal;
-  double **x = atom->x, **v = atom->v;
-  double *rmass = atom->rmass;
-  const bool affine = transfer == TR_APIC;
-  for (int i = 0; i < nlocal; ++i) {
-    if (!is_point(i)) continue;
-    const PointShape &ps = shapes[i];
-    const double *C = pdata[i] + C_AFF;
-    const double *xp = x[i];
-    const double m = rmass[i];
-    MPM_FOR_NODES(ps, xp, {
-      double *g = &g_aux[3 * n];
-      for (int d = 0; d < 3; ++d) {
-        double vd = v[i][d];
-        if (affine) vd += C[3 * d] * off[0] + C[3 * d + 1] * off[1] + C[3 * d + 2] * off[2];
-        g[d] += w * m * vd;
-      }
-    })
-  }
-  grid.reverse_sum(g_aux.data(), 3);
+  if (shape == mpm::ShapeKind::QuadraticBSpline)
+    musl_kernel<3>();
+  else
+    musl_kernel<2>();
+}
+
+template <int NS>
+void FixMpmFluid::musl_kernel() {
+  const std::size_t sy = grid.stride_y(), sz = grid.stride_z();
+  const double *const ga = g_aux.data();
+  grid.reverse_sum(g_aux.data(), kAux);
   const double mmin = mass_threshold * point_mass_ref;
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double m = g_p2g[7 * n];
-    double *g = &g_aux[3 * n];
+    const double m = g_p2g[kP2g * n];
+    double *g = &g_aux[kAux * n];
     if (m <= mmin || m <= 0.0) {
       g[0] = g[1] = g[2] = 0.0;
       return;
     }
-    for (int d = 0; d < 3; ++d) g[d] /= m;
+    const double inv = 1.0 / m;
+    for (int d = 0; d < 3; ++d) g[d] *= inv;
     apply_grid_bc(g, i, j, k);
   });
-  grid.forward(g_aux.data(), 3);
-  for (int i = 0; i < nlocal; ++i) {
-    if (!is_point(i)) continue;
+  grid.forward(g_aux.data(), kAux);
+  const bool store_affine = transfer != TR_APIC;
+  for (const int i : plist) {
     const PointShape &ps = shapes[i];
-    const double *xp = x[i];
-    double *L = &velgrad[9 * static_cast<std::size_t>(i)];
-    std::fill(L, L + 9, 0.0);
-    MPM_FOR_NODES(ps, xp, {
-      const double *g = &g_aux[3 * n];
-      for (int d = 0; d < 3; ++d)
-        for (int e = 0; e < 3; ++e) L[3 * d + e] += g[d] * gw[e];
-    })
+    mpm::Row4 Lc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // Lc[e][d] = sum v_d dS/dx_e
+    mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double, double gx, double gy, double gz) {
+      const mpm::Row4 u = mpm::row4(ga + kAux * n);
+      Lc[0] += gx * u;
+      Lc[1] += gy * u;
+      Lc[2] += gz * u;
+    });
+    double L[9];
+    for (int d = 0; d < 3; ++d)
+      for (int e = 0; e < 3; ++e) L[3 * d + e] = Lc[e][d];
+    std::copy(L, L + 9, &velgrad[9 * static_cast<std::size_t>(i)]);
+    if (store_affine) std::copy(L, L + 9, pdata[i] + C_AFF);
   }
 }
 
@@ -1770,8 +1853,8 @@ void FixMpmFluid::write_output() {
           const std::size_t n = grid.index(i, j, k);
           gbuf.push_back(static_cast<double>((static_cast<long>(k) * nn[1] + j) * nn[0] + i));
           for (const auto &f : out_grid_fields) {
-            if (f == "mass") gbuf.push_back(g_p2g[7 * n]);
-            else for (int d = 0; d < 3; ++d) gbuf.push_back(g_vel[6 * n + d]);
+            if (f == "mass") gbuf.push_back(g_p2g[kP2g * n]);
+            else for (int d = 0; d < 3; ++d) gbuf.push_back(g_vel[kVel * n + d]);
           }
         }
     int gm = static_cast<int>(gbuf.size());

@@ -25,6 +25,7 @@ FixStyle(mpm/fluid,FixMpmFluid)
 #include "mpm/fluid_laws.h"
 #include "mpm/grid.h"
 #include "mpm/shape_functions.h"
+#include "mpm/stencil.h"
 #include "mesh_walls.h"
 
 namespace mpm { class Hdf5Series; }
@@ -75,7 +76,7 @@ class FixMpmFluid : public Fix {
   double stable_dt();
 
  private:
-  struct PointShape { int base[3]; double w[3][3]; double dw[3][3]; };
+  using PointShape = mpm::Stencil;
   enum BcKind { BC_NOSLIP, BC_FREESLIP, BC_PARTIAL };
   struct Face { int kind = BC_NOSLIP; double sticky = 1.0; };
   struct Gate {
@@ -183,11 +184,14 @@ class FixMpmFluid : public Fix {
   // grid work arrays
   mpm::LocalGrid grid;
   bool grid_ready = false;
-  std::vector<double> g_p2g;    // per node: m, mv(3), f(3)
-  std::vector<double> g_vel;    // per node: v_new(3), v_old(3)
+  // node records padded to 4-wide rows for vectorized transfers
+  static constexpr int kP2g = 8, kVel = 8, kAux = 4;
+  std::vector<double> g_p2g;    // per node: m, mv(3), f(3), pad
+  std::vector<double> g_vel;    // per node: v_new(3), pad, v_old(3), pad
   std::vector<double> g_cell;   // per cell (keyed by its low node): V, V div, theta V, m
-  std::vector<double> g_aux;    // per node: remapped momentum (MUSL)
+  std::vector<double> g_aux;    // per node: remapped momentum (3), pad (MUSL)
   std::vector<PointShape> shapes;
+  std::vector<int> plist;       // local indices of the material points (this sub-step)
   std::vector<double> vpic;     // grid (PIC) velocity at the points, for the position update
   std::vector<double> velgrad;  // velocity gradient at the points, for the stress update
   int nsub_last = 1;
@@ -219,6 +223,10 @@ class FixMpmFluid : public Fix {
   void apply_grid_bc(double *v, int nodeidx_i, int nodeidx_j, int nodeidx_k);
   void grid_to_particles(double h);
   void remap_velocity_musl();
+  // transfer kernels, instantiated per stencil size and transfer (docs/performance.md)
+  template <int NS, bool AFFINE> void p2g_kernel();
+  template <int NS, bool NEED_L, bool NEED_B, bool SCATTER, bool SCATTER_AFFINE> void g2p_kernel();
+  template <int NS> void musl_kernel();
   void update_stress(double h, bool theta_only = false);
   void advance_positions(double h);
   void write_output();

@@ -48,6 +48,9 @@ class LocalGrid {
   const IndexBox &owned() const { return owned_; }
   std::size_t size() const { return nnodes_; }
   int extent(int d) const { return n_[d]; }
+  // Flat-index strides of one node step in y and in z.
+  std::size_t stride_y() const { return std::size_t(n_[0]); }
+  std::size_t stride_z() const { return std::size_t(n_[0]) * n_[1]; }
   // Flat patch index of global (unwrapped) node indices; i fastest.
   std::size_t index(int i, int j, int k) const {
     return (std::size_t(k - patch_.lo[2]) * n_[1] + (j - patch_.lo[1])) * n_[0] + (i - patch_.lo[0]);
