@@ -88,7 +88,7 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   // the first setup and wipe the points' state; new rows are zeroed in grow_arrays
   time_integrate = 1;  // the fix moves its material points itself
   vector_flag = 1;
-  size_vector = 13;
+  size_vector = 15;
   global_freq = 1;
   extvector = 0;
   peratom_flag = 1;
@@ -687,6 +687,7 @@ void FixMpmFluid::setup_grid() {
   if (coupled) {
     g_cpl.assign(grid.size() * kPfit, 0.0);
     g_sol.assign(grid.size(), 0.0);
+    g_need.assign(grid.size(), 0.0);
     g_th.assign(grid.size(), 1.0);
     g_st.assign(grid.size() * kSt, 0.0);
     g_rx.assign(grid.size() * 3, 0.0);
@@ -733,6 +734,22 @@ void FixMpmFluid::setup(int) {
   if (coupled && !theta_initialized) init_theta();
   check_timestep(true);
   if (out_every > 0 && update->ntimestep % out_every == 0) write_output();
+  run_time_start[0] = time_fluid;
+  run_time_start[1] = time_couple;
+}
+
+/* Where the fix's time went in the run just finished (slowest rank), next
+   to LIGGGHTS' "Loop time": the fluid's own work and the coupling. */
+void FixMpmFluid::post_run() {
+  double t[2] = {time_fluid - run_time_start[0], time_couple - run_time_start[1]}, g[2];
+  MPI_Allreduce(t, g, 2, MPI_DOUBLE, MPI_MAX, world);
+  if (comm->me != 0) return;
+  std::ostringstream os;
+  os << "fix mpm/fluid: wall time in this run: fluid " << g[0] << " s";
+  if (coupled) os << ", coupling " << g[1] << " s (" << (g[0] > 0.0 ? g[1] / g[0] : 0.0) << " of the fluid time)";
+  os << "\n";
+  if (screen) fputs(os.str().c_str(), screen);
+  if (logfile) fputs(os.str().c_str(), logfile);
 }
 
 /* ----------------------------------------------------------------------
@@ -842,15 +859,28 @@ void FixMpmFluid::pre_final_integrate() {
 }
 
 void FixMpmFluid::substep(double h) {
+  // wall time of the fluid's own work and of the coupling (f_ID[14], f_ID[15])
+  const double t0 = MPI_Wtime();
   compute_shapes();
-  if (coupled) fluid_fraction();
+  double t1 = MPI_Wtime(), t2 = t1;
+  if (coupled) {
+    fluid_fraction();
+    t2 = MPI_Wtime();
+  }
   particles_to_grid();
-  if (coupled) couple_fluid_grains(h);
+  double t3 = MPI_Wtime(), t4 = t3;
+  if (coupled) {
+    couple_fluid_grains(h);
+    t4 = MPI_Wtime();
+  }
   update_grid(h);
   grid_to_particles(h);
   if (musl) remap_velocity_musl();
   update_stress(h);
   advance_positions(h);
+  const double t5 = MPI_Wtime();
+  time_fluid += (t1 - t0) + (t3 - t2) + (t5 - t4);
+  time_couple += (t2 - t1) + (t4 - t3);
 }
 
 void FixMpmFluid::compute_shapes() {
@@ -1043,6 +1073,7 @@ void FixMpmFluid::fluid_fraction() {
   if (static_cast<int>(grain_shapes.size()) < nlocal) grain_shapes.resize(nlocal);
   const int ns = mpm::support(shape);
   std::fill(g_sol.begin(), g_sol.end(), 0.0);
+  std::fill(g_need.begin(), g_need.end(), 0.0);
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k)) continue;
     PointShape &ps = grain_shapes[k];
@@ -1052,8 +1083,12 @@ void FixMpmFluid::fluid_fraction() {
     }
     const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
     const double *xp = x[k];
-    MPM_FOR_NODES(ps, xp, { g_sol[n] += w * Vk; })
+    MPM_FOR_NODES(ps, xp, {
+      g_sol[n] += w * Vk;
+      g_need[n] = 1.0;
+    })
   }
+  grid.reverse_sum(g_need.data(), 1);  // nodes some grain reads (fit of the pressure only there)
   // Walls: the solid volume mapped to a node outside a grid face is folded
   // onto its mirror node inside (reflected shape functions), so that no node
   // has the sliver volume that (8-13) gives the padding nodes (1/48 of a
@@ -1150,10 +1185,61 @@ void FixMpmFluid::add_mesh_wall_traction(const double *xp, double V, double p) {
    system grain + fluid seen by it (stable for any stiffness) and the
    pressure-gradient force -V grad p (7-15); the reaction of both goes to the
    nodes with the same shape functions (8-25), (8-26), so momentum is kept. */
+/* Moments of the points' pressures for the linear least-squares fit at each
+   node (couple_fluid_grains): with e = (1, x_s - x_j) for the point's
+   sample position x_s, the node collects r = sum S V p e and the normal
+   matrix M = sum S V e e^T (rows of g_cpl: r, then M's four rows). */
+template <int NS>
+void FixMpmFluid::pressure_moments() {
+  double **x = atom->x;
+  double *const g = g_cpl.data();
+  const double *const need = g_need.data();
+  const std::size_t sy = grid.stride_y(), sz = grid.stride_z();
+  for (const int i : plist) {
+    const PointShape &ps = shapes[i];
+    const double V = pdata[i][C_VOL], p = pdata[i][C_P];
+    const double *xp = x[i];
+    // With anti-locking the pressure is the cell's (its mean density): it
+    // belongs to the cell's centre, not to the point (a fit to the points'
+    // own positions sees a staircase and, near a wall, a flat one).
+    double dn[3][3];  // x_s - x_j per direction, for the stencil's node planes
+    for (int a = 0; a < 3; ++a) {
+      double xs = xp[a];
+      if (antilock) {
+        int c = static_cast<int>(std::floor((xp[a] - gspec.origin[a]) / gspec.dx));
+        if (!gspec.periodic[a]) c = std::min(std::max(c, 0), gspec.ncell[a] - 1);
+        xs = gspec.origin[a] + (c + 0.5) * gspec.dx;
+      }
+      for (int q = 0; q < 3; ++q) dn[a][q] = xs - (gspec.origin[a] + (ps.base[a] + q) * gspec.dx);
+    }
+    mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
+      if (need[n] == 0.0) return;
+      const mpm::Row4 e = {1.0, dn[0][a], dn[1][b], dn[2][c]};
+      const mpm::Row4 we = (w * V) * e;
+      double *cn = g + kPfit * n;
+      mpm::row4(cn) += p * we;
+      mpm::row4(cn + 4) += we;
+      mpm::row4(cn + 8) += e[1] * we;
+      mpm::row4(cn + 12) += e[2] * we;
+      mpm::row4(cn + 16) += e[3] * we;
+    });
+  }
+}
+
 void FixMpmFluid::couple_fluid_grains(double h) {
-  const int ns = mpm::support(shape);
+  if (shape == mpm::ShapeKind::QuadraticBSpline)
+    couple_kernel<3>(h);
+  else
+    couple_kernel<2>(h);
+}
+
+template <int NS>
+void FixMpmFluid::couple_kernel(double h) {
   const int nlocal = atom->nlocal;
-  double **x = atom->x, **v = atom->v;
+  const std::size_t sy = grid.stride_y(), sz = grid.stride_z();
+  const double *const gst = g_st.data();
+  double *const gdr = g_dr.data();
+  double **v = atom->v;
   double *radius = atom->radius, *rmass = atom->rmass;
   if (static_cast<int>(grain_shapes.size()) < nlocal) grain_shapes.resize(nlocal);
 
@@ -1165,43 +1251,7 @@ void FixMpmFluid::couple_fluid_grains(double h) {
   // fraction of the hydrostatic one (39 % of Archimedes at z = r, cell = 3 d;
   // docs/drag.md). The fit reproduces any linear pressure field exactly.
   std::fill(g_cpl.begin(), g_cpl.end(), 0.0);
-  for (int i = 0; i < nlocal; ++i) {
-    if (!is_point(i)) continue;
-    const PointShape &ps = shapes[i];
-    const double V = pdata[i][C_VOL], p = pdata[i][C_P];
-    const double *xp = x[i];
-    // With anti-locking the pressure is the cell's (its mean density): it
-    // belongs to the cell's centre, not to the point (a fit to the points'
-    // own positions sees a staircase and, near a wall, a flat one).
-    double xs[3];
-    for (int a = 0; a < 3; ++a) {
-      if (!antilock) {
-        xs[a] = xp[a];
-        continue;
-      }
-      int c = static_cast<int>(std::floor((xp[a] - gspec.origin[a]) / gspec.dx));
-      if (!gspec.periodic[a]) c = std::min(std::max(c, 0), gspec.ncell[a] - 1);
-      xs[a] = gspec.origin[a] + (c + 0.5) * gspec.dx;
-    }
-    MPM_FOR_NODES(ps, xp, {
-      double *c = &g_cpl[kPfit * n];
-      const double wv = w * V;
-      double d[3];
-      for (int a = 0; a < 3; ++a) d[a] = xs[a] - xp[a] - off[a];
-      c[0] += wv * p;
-      c[1] += wv;
-      for (int a = 0; a < 3; ++a) {
-        c[2 + a] += wv * d[a];
-        c[5 + a] += wv * p * d[a];
-      }
-      c[8] += wv * d[0] * d[0];
-      c[9] += wv * d[1] * d[1];
-      c[10] += wv * d[2] * d[2];
-      c[11] += wv * d[1] * d[2];
-      c[12] += wv * d[0] * d[2];
-      c[13] += wv * d[0] * d[1];
-    })
-  }
+  pressure_moments<NS>();
   grid.reverse_sum(g_cpl.data(), kPfit);
 
   const double mmin = mass_threshold * point_mass_ref;
@@ -1209,14 +1259,14 @@ void FixMpmFluid::couple_fluid_grains(double h) {
     const double *c = &g_cpl[kPfit * n];
     const double *g = &g_p2g[kP2g * n];
     double *st = &g_st[kSt * n];
-    st[3] = g_th[n];
-    st[6] = st[7] = st[8] = st[9] = 0.0;
-    st[4] = c[1] > 0.0 ? c[0] / c[1] : 0.0;
-    if (c[1] > 0.0) {
+    for (int q = 0; q < kSt; ++q) st[q] = 0.0;
+    st[S_TH] = g_th[n];
+    st[S_P] = c[4] > 0.0 ? c[0] / c[4] : 0.0;
+    if (c[4] > 0.0 && g_need[n] > 0.0) {
       Eigen::Matrix4d M;
-      M << c[1], c[2], c[3], c[4], c[2], c[8], c[13], c[12], c[3], c[13], c[9], c[11], c[4], c[12], c[11],
-          c[10];
-      const Eigen::Vector4d r(c[0], c[5], c[6], c[7]);
+      for (int r = 0; r < 4; ++r)
+        for (int q = 0; q < 4; ++q) M(r, q) = c[4 + 4 * r + q];
+      const Eigen::Vector4d r(c[0], c[1], c[2], c[3]);
       // scale the offsets by the cell so that the system is well conditioned
       const double s = 1.0 / gspec.dx;
       const Eigen::Vector4d D(1.0, s, s, s);
@@ -1225,14 +1275,17 @@ void FixMpmFluid::couple_fluid_grains(double h) {
       if (ldlt.info() == Eigen::Success && ldlt.rcond() > 1e-6) {
         const Eigen::Vector4d sol = D.asDiagonal() * ldlt.solve(D.asDiagonal() * r);
         if (std::isfinite(sol[0]) && std::isfinite(sol[1]) && std::isfinite(sol[2]) && std::isfinite(sol[3])) {
-          st[4] = sol[0];
-          for (int a = 0; a < 3; ++a) st[6 + a] = sol[1 + a];
-          st[9] = 1.0;  // the fit (value and gradient) is determined
+          st[S_P] = sol[0];
+          for (int a = 0; a < 3; ++a) st[S_FIT + a] = sol[1 + a];
+          st[S_FIT + 3] = 1.0;  // the fit (value and gradient) is determined
         }
       }
     }
-    st[5] = g[0];
-    for (int d = 0; d < 3; ++d) st[d] = g[0] > mmin ? g[1 + d] / g[0] : 0.0;
+    st[S_M] = g[0];
+    if (g[0] > mmin) {  // only nodes that hold fluid carry its velocity
+      for (int d = 0; d < 3; ++d) st[S_U + d] = g[1 + d] / g[0];
+      st[S_U + 3] = 1.0;
+    }
   });
   grid.forward(g_st.data(), kSt);
 
@@ -1254,27 +1307,28 @@ void FixMpmFluid::couple_fluid_grains(double h) {
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes[k].base[0] == INT_MIN) continue;
     const PointShape &ps = grain_shapes[k];
-    const double *xp = x[k];
-    double u[3] = {0, 0, 0}, gradp[3] = {0, 0, 0}, fitgrad[3] = {0, 0, 0}, th = 0.0, wet = 0.0, wfit = 0.0;
-    MPM_FOR_NODES(ps, xp, {
-      const double *st = &g_st[kSt * n];
-      th += w * st[3];
-      for (int d = 0; d < 3; ++d) gradp[d] += st[4] * gw[d];
-      if (st[9] > 0.0) {  // the fitted gradients of the nodes whose fit is determined
-        wfit += w;
-        for (int d = 0; d < 3; ++d) fitgrad[d] += w * st[6 + d];
-      }
-      if (st[5] > mmin) {  // only nodes that hold fluid carry its velocity
-        wet += w;
-        for (int d = 0; d < 3; ++d) u[d] += w * st[d];
-      }
-    })
+    // one pass over the stencil: velocity of the wet nodes (and their total
+    // weight, the record's 4th entry), fitted gradients of the determined
+    // nodes (and their weight), fluid fraction, gradient of the nodal pressures
+    mpm::Row4 uw = {0, 0, 0, 0}, fw = {0, 0, 0, 0};
+    double th = 0.0, gradp[3] = {0, 0, 0};
+    mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double gx, double gy, double gz) {
+      const double *st = gst + kSt * n;
+      uw += w * mpm::row4(st + S_U);
+      fw += w * mpm::row4(st + S_FIT);
+      th += w * st[S_TH];
+      gradp[0] += st[S_P] * gx;
+      gradp[1] += st[S_P] * gy;
+      gradp[2] += st[S_P] * gz;
+    });
+    const double wet = uw[3], wfit = fw[3];
+    double u[3] = {uw[0], uw[1], uw[2]};
     // Pressure gradient at the grain: the fitted nodal gradients interpolated
     // (exact for a linear pressure field, also next to walls where a node's
     // own fit is undetermined: all its points in one layer); the gradient of
     // the interpolated nodal pressures where no fit is determined.
     if (wfit > 0.5)
-      for (int d = 0; d < 3; ++d) gradp[d] = fitgrad[d] / wfit;
+      for (int d = 0; d < 3; ++d) gradp[d] = fw[d] / wfit;
     const double d_k = 2.0 * radius[k];
     const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
     double K = 0.0;
@@ -1296,15 +1350,16 @@ void FixMpmFluid::couple_fluid_grains(double h) {
     // a grain no integrator moves (a fixed bed) has, for the exchange, infinite mass
     const bool mobile = (atom->mask[k] & integrated_groupbits) != 0;
     if (!mobile) ak[0] = ak[1] = ak[2] = 0.0;
-    MPM_FOR_NODES(ps, xp, {
-      double *q = &g_dr[kDr * n];
-      q[0] += w * K;
-      for (int d = 0; d < 3; ++d) q[1 + d] += w * K * v[k][d];
-      q[4] += w * rmass[k];
-      for (int d = 0; d < 3; ++d) q[5 + d] -= w * Fp[d];
-      for (int d = 0; d < 3; ++d) q[8 + d] += w * K * ak[d];
-      if (!mobile) q[11] += w * K;
-    })
+    // record: K, K v (3); m, -Fp (3); K a (3), K of a fixed grain
+    const mpm::Row4 r0 = {K, K * v[k][0], K * v[k][1], K * v[k][2]};
+    const mpm::Row4 r1 = {rmass[k], -Fp[0], -Fp[1], -Fp[2]};
+    const mpm::Row4 r2 = {K * ak[0], K * ak[1], K * ak[2], mobile ? 0.0 : K};
+    mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+      double *q = gdr + kDr * n;
+      mpm::row4(q) += w * r0;
+      mpm::row4(q + 4) += w * r1;
+      mpm::row4(q + 8) += w * r2;
+    });
   }
   grid.reverse_sum(g_dr.data(), kDr);
 
@@ -1315,13 +1370,14 @@ void FixMpmFluid::couple_fluid_grains(double h) {
     const double *st = &g_st[kSt * n];
     double *rx = &g_rx[3 * n];
     double J[3] = {0, 0, 0};
-    if (q[0] > 0.0 && st[5] > mmin) {
+    if (q[0] > 0.0 && st[S_M] > mmin) {
       const double vg[3] = {q[1] / q[0], q[2] / q[0], q[3] / q[0]};
       const double ag[3] = {q[8] / q[0], q[9] / q[0], q[10] / q[0]};
       const double *f = &g_p2g[kP2g * n + 4];
-      const double af[3] = {(f[0] + q[5]) / st[5], (f[1] + q[6]) / st[5], (f[2] + q[7]) / st[5]};
+      const double mf = st[S_M];
+      const double af[3] = {(f[0] + q[5]) / mf, (f[1] + q[6]) / mf, (f[2] + q[7]) / mf};
       const double mg = q[11] > 0.0 ? HUGE_VAL : q[4];
-      mpm::drag_implicit_impulse(vg, st, mg, st[5], q[0], h, J, ag, af);
+      mpm::drag_implicit_impulse(vg, st + S_U, mg, mf, q[0], h, J, ag, af);
     }
     for (int d = 0; d < 3; ++d) {
       rx[d] = q[5 + d] - J[d] / h;                    // force on the fluid
@@ -1332,12 +1388,12 @@ void FixMpmFluid::couple_fluid_grains(double h) {
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
     const PointShape &ps = grain_shapes[k];
-    const double *xp = x[k];
-    double J[3] = {0, 0, 0};
-    MPM_FOR_NODES(ps, xp, {
-      for (int d = 0; d < 3; ++d) J[d] += w * Kgrain[k] * g_dr[kDr * n + 1 + d];
-    })
-    for (int d = 0; d < 3; ++d) grain_force[3 * static_cast<std::size_t>(k) + d] += J[d] / h / nsub_last;
+    mpm::Row4 J = {0, 0, 0, 0};  // J[1..3]: the impulse per unit K of the nodes, weighted
+    mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+      J += w * mpm::row4(gdr + kDr * n);
+    });
+    for (int d = 0; d < 3; ++d)
+      grain_force[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub_last;
   }
 }
 
@@ -1716,7 +1772,8 @@ void FixMpmFluid::compute_outputs() {
   double **x = atom->x, **v = atom->v;
   double *rmass = atom->rmass;
   double sum[4] = {0, 0, 0, n_clamped};  // mass, kinetic energy, points, clamped
-  double mx[4] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};  // |v|max, front, height, p max
+  // |v|max, front, height, p max, wall time of the fluid and of the coupling (slowest rank)
+  double mx[6] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, time_fluid, time_couple};
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
     const double v2 = v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2];
@@ -1736,9 +1793,9 @@ void FixMpmFluid::compute_outputs() {
         for (int d = 0; d < 3; ++d) fg[d] += pdata[k][C_FGRAIN + d];
   MPI_Allreduce(fg, gfg, 3, MPI_DOUBLE, MPI_SUM, world);
   for (int d = 0; d < 3; ++d) vector_cache[10 + d] = gfg[d];
-  double gsum[4], gmx[4];
+  double gsum[4], gmx[6];
   MPI_Allreduce(sum, gsum, 4, MPI_DOUBLE, MPI_SUM, world);
-  MPI_Allreduce(mx, gmx, 4, MPI_DOUBLE, MPI_MAX, world);
+  MPI_Allreduce(mx, gmx, 6, MPI_DOUBLE, MPI_MAX, world);
   vector_cache[0] = gsum[0];
   vector_cache[1] = gsum[1];
   vector_cache[2] = gmx[0];
@@ -1749,6 +1806,8 @@ void FixMpmFluid::compute_outputs() {
   vector_cache[7] = gsum[3];
   vector_cache[8] = gsum[2];
   vector_cache[9] = std::isfinite(gmx[3]) ? gmx[3] : 0.0;
+  vector_cache[13] = gmx[4];
+  vector_cache[14] = gmx[5];
   vector_step = update->ntimestep;
 }
 

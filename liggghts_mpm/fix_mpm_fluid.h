@@ -53,6 +53,7 @@ class FixMpmFluid : public Fix {
   void post_create() override;
   void init() override;
   void setup(int) override;
+  void post_run() override;
   void pre_final_integrate() override;
   void end_of_step() override;
 
@@ -151,12 +152,16 @@ class FixMpmFluid : public Fix {
   bool cell_check = true;
   bool theta_initialized = false;  // fluid mass reduced by the grains' volume once (restart)
   std::vector<PointShape> grain_shapes;
-  static constexpr int kPfit = 14;
-  std::vector<double> g_cpl;    // per node: moments of the points' pressure for its linear fit (kPfit)
+  static constexpr int kPfit = 20;
+  std::vector<double> g_cpl;    // per node: moments of the points' pressure for its linear fit: r (4), M (4 x 4)
   std::vector<double> g_sol;    // per node: solid volume of the grains (reverse-summed, smoothed)
   std::vector<double> g_th;     // per node: fluid fraction (forwarded)
-  static constexpr int kSt = 10;
-  std::vector<double> g_st;     // per node: u(3), theta, p, m, fitted grad p (3), fit determined (forwarded)
+  std::vector<double> g_need;   // per node: > 0 where a grain's shape functions reach (reverse-summed)
+  // per node (forwarded): u (3) and 1 where the node holds fluid; fitted grad p (3) and 1 where
+  // the fit is determined; theta, p, m, pad
+  enum { S_U = 0, S_FIT = 4, S_TH = 8, S_P = 9, S_M = 10 };
+  static constexpr int kSt = 12;
+  std::vector<double> g_st;
   std::vector<double> g_rx;     // per node: force of the grains on the fluid (3), owned nodes
   static constexpr int kDr = 12;
   int integrated_groupbits = 0;   // groups moved by some integrator: other grains are fixed
@@ -176,6 +181,9 @@ class FixMpmFluid : public Fix {
   double point_mass_ref = 0.0;   // typical point mass, for the nodal mass threshold
   double spacing[3] = {0, 0, 0}; // initial point spacing per direction
   double n_clamped = 0;          // points put back inside a wall (cumulative)
+  double time_fluid = 0.0;       // wall time of the fluid's own work on this rank (s, cumulative)
+  double time_couple = 0.0;      // wall time of the coupling on this rank (s, cumulative)
+  double run_time_start[2] = {0.0, 0.0};  // time_fluid, time_couple at the setup of the run
 
   // per-point state
   double **pdata = nullptr;
@@ -227,6 +235,8 @@ class FixMpmFluid : public Fix {
   template <int NS, bool AFFINE> void p2g_kernel();
   template <int NS, bool NEED_L, bool NEED_B, bool SCATTER, bool SCATTER_AFFINE> void g2p_kernel();
   template <int NS> void musl_kernel();
+  template <int NS> void pressure_moments();
+  template <int NS> void couple_kernel(double h);
   void update_stress(double h, bool theta_only = false);
   void advance_positions(double h);
   void write_output();
