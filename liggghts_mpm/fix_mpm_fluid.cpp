@@ -933,29 +933,16 @@ bool FixMpmFluid::shape_of(const double *x, PointShape &ps) {
   return true;
 }
 
-// Loops over the nodes a point touches; fn(node index, w, grad w[3], offset (x_i - x_p)[3]).
-#define MPM_FOR_NODES(ps, xp, BODY)                                                     \
-  for (int c = 0; c < ns; ++c) {                                                        \
-    const int kk = ps.base[2] + c;                                                      \
-    for (int b = 0; b < ns; ++b) {                                                      \
-      const int jj = ps.base[1] + b;                                                    \
-      const double wyz = ps.w[1][b] * ps.w[2][c];                                       \
-      for (int a = 0; a < ns; ++a) {                                                    \
-        const int ii = ps.base[0] + a;                                                  \
-        const std::size_t n = grid.index(ii, jj, kk);                                   \
-        const double w = ps.w[0][a] * wyz;                                              \
-        const double gw[3] = {ps.dw[0][a] * wyz, ps.w[0][a] * ps.dw[1][b] * ps.w[2][c], \
-                              ps.w[0][a] * ps.w[1][b] * ps.dw[2][c]};                   \
-        const double off[3] = {gspec.origin[0] + ii * gspec.dx - xp[0],                 \
-                               gspec.origin[1] + jj * gspec.dx - xp[1],                 \
-                               gspec.origin[2] + kk * gspec.dx - xp[2]};                \
-        (void)w;                                                                        \
-        (void)gw;                                                                       \
-        (void)off;                                                                      \
-        BODY                                                                            \
-      }                                                                                 \
-    }                                                                                   \
-  }
+// fn(n, w) for the nodes a stencil reaches (the fix's shape functions)
+template <class Fn>
+void FixMpmFluid::for_nodes(const PointShape &ps, Fn &&fn) const {
+  const std::size_t sy = grid.stride_y(), sz = grid.stride_z();
+  auto body = [&](std::size_t n, int, int, int, double w, double, double, double) { fn(n, w); };
+  if (shape == mpm::ShapeKind::QuadraticBSpline)
+    mpm::for_stencil<3>(ps, sy, sz, body);
+  else
+    mpm::for_stencil<2>(ps, sy, sz, body);
+}
 
 /* particles to grid: mass (8-19), momentum (8-10), internal force (8-24),
    external forces (gravity (8-18) and whatever LIGGGHTS fixes add) */
@@ -1071,7 +1058,6 @@ void FixMpmFluid::fluid_fraction() {
   double **x = atom->x;
   double *radius = atom->radius;
   if (static_cast<int>(grain_shapes.size()) < nlocal) grain_shapes.resize(nlocal);
-  const int ns = mpm::support(shape);
   std::fill(g_sol.begin(), g_sol.end(), 0.0);
   std::fill(g_need.begin(), g_need.end(), 0.0);
   for (int k = 0; k < nlocal; ++k) {
@@ -1082,11 +1068,10 @@ void FixMpmFluid::fluid_fraction() {
       continue;
     }
     const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
-    const double *xp = x[k];
-    MPM_FOR_NODES(ps, xp, {
+    for_nodes(ps, [&](std::size_t n, double w) {
       g_sol[n] += w * Vk;
       g_need[n] = 1.0;
-    })
+    });
   }
   grid.reverse_sum(g_need.data(), 1);  // nodes some grain reads (fit of the pressure only there)
   // Walls: the solid volume mapped to a node outside a grid face is folded
@@ -1132,12 +1117,10 @@ void FixMpmFluid::fluid_fraction() {
     g_th[n] = std::min(1.0, std::max(theta_min, 1.0 - g_sol[m] / Vj));  // (8-11), (8-14)
   });
   grid.forward(g_th.data(), 1);
-  for (int i = 0; i < nlocal; ++i) {
-    if (!is_point(i)) continue;
-    const PointShape &ps = shapes[i];
-    const double *xp = x[i];
+  const double *const gth = g_th.data();
+  for (const int i : plist) {
     double th = 0.0;
-    MPM_FOR_NODES(ps, xp, { th += w * g_th[n]; })
+    for_nodes(shapes[i], [&](std::size_t n, double w) { th += w * gth[n]; });
     pdata[i][C_THETA] = th;
   }
   if (theta_initialized) update_stress(0.0, true);

@@ -237,6 +237,7 @@ class FixMpmFluid : public Fix {
   template <int NS> void musl_kernel();
   template <int NS> void pressure_moments();
   template <int NS> void couple_kernel(double h);
+  template <class Fn> void for_nodes(const PointShape &ps, Fn &&fn) const;
   void update_stress(double h, bool theta_only = false);
   void advance_positions(double h);
   void write_output();
