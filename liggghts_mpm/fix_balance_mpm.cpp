@@ -42,7 +42,7 @@ bool parse_int(const char *s, int &v) {
 }  // namespace
 
 /* ----------------------------------------------------------------------
-   fix ID group-ID balance/mpm dim x|y|z [every N] [weight group-ID w]... [thresh t]
+   fix ID group-ID balance/mpm dim x|y|z [every N] [weight group-ID w]... [volume w] [thresh t]
 ------------------------------------------------------------------------- */
 
 FixBalanceMpm::FixBalanceMpm(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
@@ -70,9 +70,12 @@ FixBalanceMpm::FixBalanceMpm(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg,
       wgroup_bits_.push_back(group->bitmask[ig]);
       wvalues_.push_back(wv);
       iarg += 3;
+    } else if (strcmp(kw, "volume") == 0) {
+      if (!v || !parse_double(v, wvol_) || wvol_ < 0.0) bad_arg(kw, "a weight per unit volume >= 0", v);
+      iarg += 2;
     } else {
       error->all(FLERR, (std::string("Fix balance/mpm: unknown keyword '") + kw +
-                         "' (expected dim, every, weight or thresh)").c_str());
+                         "' (expected dim, every, weight, volume or thresh)").c_str());
     }
   }
   if (dim_ < 0) error->all(FLERR, "Fix balance/mpm: keyword 'dim' (x, y or z) is required");
@@ -121,8 +124,18 @@ double FixBalanceMpm::weight(int i) const {
   return w;
 }
 
+// Weight of the box volume below coordinate c along dim_ (keyword volume).
+double FixBalanceMpm::volume_below(double c) const {
+  if (wvol_ <= 0.0) return 0.0;
+  double area = 1.0;
+  for (int d = 0; d < domain->dimension; ++d)
+    if (d != dim_) area *= domain->prd[d];
+  const double lo = domain->boxlo[dim_], hi = domain->boxhi[dim_];
+  return wvol_ * area * (std::min(std::max(c, lo), hi) - lo);
+}
+
 double FixBalanceMpm::imbalance() const {
-  double mine = 0.0;
+  double mine = volume_below(domain->subhi[dim_]) - volume_below(domain->sublo[dim_]);
   for (int i = 0; i < atom->nlocal; ++i) mine += weight(i);
   double mx = 0.0, sum = 0.0;
   MPI_Allreduce(&mine, &mx, 1, MPI_DOUBLE, MPI_MAX, world);
@@ -167,6 +180,9 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
 
   double total = 0.0;
   MPI_Allreduce(&pre.back(), &total, 1, MPI_DOUBLE, MPI_SUM, world);
+  total += volume_below(hi);
+  // the volume's weight is added once, by rank 0, to the collective sums
+  const double vol_share = comm->me == 0 ? 1.0 : 0.0;
   cut.assign(P + 1, 0.0);
   cut[0] = lo;
   cut[P] = hi;
@@ -178,7 +194,10 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
   // bisection: W(< a_k) < T_k <= W(< b_k)
   std::vector<double> a(nc, lo), b(nc, hi + 1e-9 * len), loc(nc), glob(nc);
   for (int it = 0; it < 64; ++it) {
-    for (int k = 0; k < nc; ++k) loc[k] = below(0.5 * (a[k] + b[k]));
+    for (int k = 0; k < nc; ++k) {
+      const double mid = 0.5 * (a[k] + b[k]);
+      loc[k] = below(mid) + vol_share * volume_below(mid);
+    }
     MPI_Allreduce(loc.data(), glob.data(), nc, MPI_DOUBLE, MPI_SUM, world);
     for (int k = 0; k < nc; ++k) {
       const double mid = 0.5 * (a[k] + b[k]), target = total * (k + 1) / P;
@@ -192,8 +211,8 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
   // weights below and including the plane, the planes before and after it
   std::vector<double> w2(2 * nc), w2g(2 * nc), prev(nc), next(nc);
   for (int k = 0; k < nc; ++k) {
-    w2[2 * k] = std::isfinite(c[k]) ? below(c[k]) : 0.0;
-    w2[2 * k + 1] = below(b[k]);
+    w2[2 * k] = std::isfinite(c[k]) ? below(c[k]) + vol_share * volume_below(c[k]) : 0.0;
+    w2[2 * k + 1] = below(b[k]) + vol_share * volume_below(b[k]);
     loc[k] = std::isfinite(c[k]) ? last_below(c[k]) : -inf;
   }
   MPI_Allreduce(w2.data(), w2g.data(), 2 * nc, MPI_DOUBLE, MPI_SUM, world);
@@ -206,6 +225,8 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
     double x;
     if (!std::isfinite(c[k])) {
       x = b[k];
+    } else if (wvol_ > 0.0 && b[k] - c[k] > 1e-6 * len) {
+      x = b[k];  // the target is crossed by the volume's weight between two planes of atoms
     } else if (std::fabs(w2g[2 * k] - target) <= std::fabs(w2g[2 * k + 1] - target)) {
       x = 0.5 * ((std::isfinite(prev[k]) ? prev[k] : lo) + c[k]);  // plane goes to the upper slab
     } else {

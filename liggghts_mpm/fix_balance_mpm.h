@@ -30,6 +30,7 @@ class FixBalanceMpm : public Fix {
  private:
   void bad_arg(const char *keyword, const char *expected, const char *given);
   double weight(int i) const;
+  double volume_below(double c) const;      // weight of the box volume below c along dim_
   double imbalance() const;                 // max rank weight / mean rank weight (collective)
   void find_cuts(std::vector<double> &cut);  // new cut coordinates along dim_ (collective)
   void balance();
@@ -39,6 +40,7 @@ class FixBalanceMpm : public Fix {
   double thresh_ = 1.0;  // balance only if the imbalance exceeds this
   std::vector<int> wgroup_bits_;
   std::vector<double> wvalues_;
+  double wvol_ = 0.0;    // weight per unit volume of the box (keyword volume)
   std::vector<double> cut_;  // current cuts (absolute), procgrid[dim]+1 values
   double imb_before_ = 1.0, imb_after_ = 1.0;
   int nbalance_ = 0;

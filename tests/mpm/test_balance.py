@@ -5,7 +5,7 @@ Standard library only.
     test_balance.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR [--mpirun "mpirun ..."]
 
 CASE: np2 (3-D dam break of inputs/bench on 2 ranks with the balance fix against 1 rank),
-every_dem (re-balancing inside a run, no fluid), bad_input, all. Exit status 0 when every check passes.
+every_dem (re-balancing inside a run, no fluid), volume_dem (keyword volume), bad_input, all. Exit status 0 when every check passes.
 """
 import argparse
 import os
@@ -30,7 +30,7 @@ def cut_lines(text):
 def case_np2(r):
     """2 ranks with balance/mpm (re-balanced at the setup of each of 3 runs) = 1 rank to 1e-10."""
     inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
-    v = dict(cells=8, warm=10, nsteps=90, segments=3)
+    v = dict(cells=8, warm=10, nsteps=90, segments=3, cellw=0)  # by point counts (volume: volume_dem)
     d1, _ = r.run("balance_np2/np1", inp, v)
     d2, p2 = r.run("balance_np2/np2", inp, dict(v, balance=1), np=2)
     f1 = read_csv(os.path.join(d1, "bench3d.csv"))
@@ -73,6 +73,8 @@ run 0
         ("dim x thresh 0.5", "Fix balance/mpm: keyword 'thresh' expects an imbalance factor >= 1"),
         ("dim x weight nogroup 2", "Fix balance/mpm: keyword 'weight' expects an existing group ID"),
         ("dim x weight all", "Fix balance/mpm: keyword 'weight' expects a weight >= 0"),
+        ("dim x volume -1", "Fix balance/mpm: keyword 'volume' expects a weight per unit volume >= 0"),
+        ("dim x volume", "Fix balance/mpm: keyword 'volume' expects a weight per unit volume >= 0"),
         ("dim x every 100", "Fix balance/mpm: keyword 'every' > 0 cannot be used with fix mpm/fluid"),
     ]
     for i, (args, expect) in enumerate(bad):
@@ -120,7 +122,32 @@ def case_every_dem(r):
     check(re.search(r"^\s*400\s+1100\s", p.stdout, re.M) is not None, "no atom lost (1100 at step 400)")
 
 
-CASES = {"np2": case_np2, "bad_input": case_bad_input, "every_dem": case_every_dem}
+def case_volume_dem(r):
+    """Keyword volume: the box volume counts too (grid work where there are no atoms). 1100 atoms in
+    x < 1 of a 4 m box (cross-section 1 m^2), volume 1100 per m^3: total 5500, half at
+    1100 + 1100 c = 2750, so the cut is at c = 1.5 m, between planes of atoms no more."""
+    d = r.fresh("balance_volume_dem")
+    src = DEM.replace("fix bal all balance/mpm dim x every 50", "fix bal all balance/mpm dim x volume 1100")
+    src = src.replace("velocity all set 1.0 0 0 units box", "").replace("run 400", "run 0")
+    with open(os.path.join(d, "in.dem"), "w") as f:
+        f.write(src)
+    p = r.execute(d, "in.dem", np=2)
+    lines = cut_lines(p.stdout)
+    check(len(lines) == 1, f"balanced at setup ({len(lines)} of 1)")
+    if lines:
+        cut = lines[0][1][1]
+        check(abs(cut - 1.5) < 1e-6, f"cut at 1.5 m ({cut:.9f})")
+        check(lines[0][3] < 1.0 + 1e-6, f"imbalance after {lines[0][3]:.6f} (atoms + volume per rank equal)")
+    # without the volume the cut lies between the 5th and 6th plane
+    src0 = src.replace(" volume 1100", "")
+    d0 = r.fresh("balance_volume_dem0")
+    with open(os.path.join(d0, "in.dem"), "w") as f:
+        f.write(src0)
+    lines0 = cut_lines(r.execute(d0, "in.dem", np=2).stdout)
+    check(bool(lines0) and abs(lines0[0][1][1] - 0.45) < 1e-6, "without volume: cut at 0.45 m")
+
+
+CASES = {"np2": case_np2, "bad_input": case_bad_input, "every_dem": case_every_dem, "volume_dem": case_volume_dem}
 
 
 def main():
