@@ -709,6 +709,15 @@ void FixMpmFluid::mesh_refresh() {
   } catch (const std::exception &e) {
     error->all(FLERR, e.what());
   }
+  // the walls moved: the nodes' constraints are collected anew at their first use
+  ++mw_epoch;
+  mw_cache.clear();
+  if (mw_stamp.size() != grid.size()) {
+    mw_stamp.assign(grid.size(), -1);
+    mw_first.assign(grid.size(), 0);
+    mw_count.assign(grid.size(), 0);
+    mw_near.assign(grid.size(), 1);
+  }
 }
 
 void FixMpmFluid::setup(int) {
@@ -1137,7 +1146,7 @@ void FixMpmFluid::fluid_fraction() {
    in: docs/mesh_walls.md). */
 void FixMpmFluid::add_mesh_wall_traction(const double *xp, double V, double p) {
   double q[3], nrm[3];
-  if (p == 0.0 || !mesh_walls->nearest_face(xp, gspec.dx, q, nrm)) return;
+  if (p == 0.0 || !near_mesh_wall(xp) || !mesh_walls->nearest_face(xp, gspec.dx, q, nrm)) return;
   const double inv = 1.0 / gspec.dx;
   const mpm::IndexBox &pb = grid.patch();
   int base[3];
@@ -1451,9 +1460,11 @@ void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k) {
     for (int e = 0; e < 3; ++e) vel[e] = (e == d) ? 0.0 : keep * vel[e];
   }
   if (mesh_walls) {
-    const double xn[3] = {gspec.origin[0] + i * gspec.dx, gspec.origin[1] + j * gspec.dx,
-                          gspec.origin[2] + k * gspec.dx};
-    mesh_walls->apply(xn, vel, 1.0 * gspec.dx, 2.0 * gspec.dx);
+    // The triangles near a node and the closest points do not change between two refreshes
+    // (one per fluid step): the grid update and the MUSL remap, and every sub-step, reuse the
+    // node's constraints (node_walls).
+    const std::size_t n = node_walls(i, j, k);
+    mpm::MeshWalls::impose(mw_cache.data() + mw_first[n], mw_count[n], vel);
   }
   if (gate.active) {
     const int d = gate.dim;
@@ -1461,6 +1472,36 @@ void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k) {
     if (gate.fluid_below && xn >= gate.pos - 1e-9 * gspec.dx) vel[d] = std::min(vel[d], 0.0);
     if (!gate.fluid_below && xn <= gate.pos + 1e-9 * gspec.dx) vel[d] = std::max(vel[d], 0.0);
   }
+}
+
+/* The mesh-wall constraints of node (i, j, k) (in the patch) for the wall positions of the last
+   refresh, collected at the node's first use after it: entries mw_first[n] .. + mw_count[n] of
+   mw_cache, and mw_near[n] = some triangle within 2 cells of the node. Returns the flat index. */
+std::size_t FixMpmFluid::node_walls(int i, int j, int k) {
+  const std::size_t n = grid.index(i, j, k);
+  if (mw_stamp[n] != mw_epoch) {
+    const double xn[3] = {gspec.origin[0] + i * gspec.dx, gspec.origin[1] + j * gspec.dx,
+                          gspec.origin[2] + k * gspec.dx};
+    mpm::WallConstraint c[mpm::MeshWalls::kMaxConstraints];
+    bool near = true;
+    const int nc = mesh_walls->collect(xn, 1.0 * gspec.dx, 2.0 * gspec.dx, c, &near);
+    mw_stamp[n] = mw_epoch;
+    mw_first[n] = static_cast<int>(mw_cache.size());
+    mw_count[n] = nc;
+    mw_near[n] = near ? 1 : 0;
+    mw_cache.insert(mw_cache.end(), c, c + nc);
+  }
+  return n;
+}
+
+/* False if no triangle comes within 2 cells of the node nearest to x, which then lies more than
+   1.1 cells from every wall: no wall traction (reach 1 cell) and, for a point that moved less than
+   half a cell (the acoustic limit), no crossing to undo. True if unsure (outside the patch). */
+bool FixMpmFluid::near_mesh_wall(const double *x) {
+  int c[3];
+  for (int d = 0; d < 3; ++d) c[d] = static_cast<int>(std::floor((x[d] - gspec.origin[d]) / gspec.dx + 0.5));
+  if (!grid.in_patch(c[0], c[1], c[2])) return true;
+  return mw_near[node_walls(c[0], c[1], c[2])] != 0;
 }
 
 /* grid momentum update (8-35), velocity (8-36), boundary conditions */
@@ -1720,7 +1761,8 @@ void FixMpmFluid::advance_positions(double h) {
     if (!is_point(i)) continue;
     const double xold[3] = {x[i][0], x[i][1], x[i][2]};
     for (int d = 0; d < 3; ++d) x[i][d] += h * vpic[3 * i + d];
-    if (mesh_walls && mesh_walls->push_back(x[i], v[i], 1.0 * gspec.dx, xold)) n_clamped += 1.0;
+    if (mesh_walls && near_mesh_wall(x[i]) && mesh_walls->push_back(x[i], v[i], 1.0 * gspec.dx, xold))
+      n_clamped += 1.0;
     for (int d = 0; d < 3; ++d) {
       if (gspec.periodic[d]) continue;
       const double lo = gspec.origin[d], hi = gspec.upper(d);

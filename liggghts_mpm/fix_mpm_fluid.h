@@ -119,6 +119,14 @@ class FixMpmFluid : public Fix {
   Gate gate;
   std::vector<mpm::MeshWallSpec> mesh_specs;
   std::unique_ptr<mpm::MeshWalls> mesh_walls;
+  // per node: the mesh-wall constraints of the current wall positions (apply_grid_bc)
+  long mw_epoch = 0;
+  std::vector<long> mw_stamp;
+  std::vector<int> mw_first, mw_count;
+  std::vector<char> mw_near;
+  std::size_t node_walls(int i, int j, int k);
+  bool near_mesh_wall(const double *x);
+  std::vector<mpm::WallConstraint> mw_cache;
   bool mesh_sides_done = false;
   void mesh_refresh();
   double damping = 0.0;

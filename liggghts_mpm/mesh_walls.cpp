@@ -397,7 +397,20 @@ void MeshWalls::closest_point(const Tri &t, const double x[3], Hit &h) {
 // Grid nodes
 
 bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, double reach_behind) const {
-  if (tris_.empty()) return false;
+  WallConstraint c[kMaxConstraints];
+  const int nc = collect(x, reach_fluid, reach_behind, c);
+  impose(c, nc, vel);
+  return nc > 0;
+}
+
+void MeshWalls::impose(const WallConstraint *c, int nc, double vel[3]) {
+  for (int k = 0; k < nc; ++k) constrain(vel, c[k].w, c[k].n, c[k].behind, c[k].sticky, c[k].imposed);
+}
+
+int MeshWalls::collect(const double x[3], double reach_fluid, double reach_behind, WallConstraint *out,
+                       bool *near) const {
+  if (near) *near = false;
+  if (tris_.empty()) return 0;
   if (reach_behind < 0.0) reach_behind = reach_fluid;
   const double reach = std::max(reach_fluid, reach_behind);
   const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
@@ -434,7 +447,8 @@ bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, doub
     if (lb > reach) continue;
     cl[ncl++] = {lb, i};
   }
-  if (ncl == 0) return false;
+  if (near) *near = ncl > 0 || !cand;
+  if (ncl == 0) return 0;
   std::sort(cl, cl + ncl);
   int idx[kMax];
   Hit hits[kMax];
@@ -494,9 +508,9 @@ bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, doub
     idx[slot] = i;
     if (slot == nh) ++nh;
   }
-  if (nh == 0) return false;
+  if (nh == 0) return 0;
 
-  bool touched = false;
+  int nout = 0;
   for (size_t k = 0; k < specs_.size(); ++k) {
     // Face-region hits of a mesh take precedence over its edge/vertex hits, so that the internal
     // edges of a flat or gently curved wall add no constraint. A node near edges/vertices only is
@@ -538,13 +552,16 @@ bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, doub
         for (int q = 0; q < 3; ++q) n[q] = f * dd[h][q];
       }
       if (hits[h].dist2 > (behind ? rb2 : rf2)) continue;
-      double w[3];
-      wall_velocity(t, hits[h].b, w);
-      constrain(vel, w, n, behind, sticky, specs_[k].kind == 3);
-      touched = true;
+      if (nout >= kMaxConstraints) continue;
+      WallConstraint &o = out[nout++];
+      wall_velocity(t, hits[h].b, o.w);
+      for (int q = 0; q < 3; ++q) o.n[q] = n[q];
+      o.sticky = sticky;
+      o.behind = behind;
+      o.imposed = specs_[k].kind == 3;
     }
   }
-  return touched;
+  return nout;
 }
 
 bool MeshWalls::nearest_face(const double x[3], double reach, double q[3], double n[3]) const {

@@ -28,6 +28,17 @@ enum MeshSide : int {
   SIDE_BOTH = 2        // thin two-sided wall (a plate): no "behind"; only crossings are undone
 };
 
+// One wall condition at a grid node: wall velocity w at the closest point, unit normal n towards
+// the fluid, whether the node is behind the wall, the tangential fraction (sticky) and whether it
+// is imposed (kind 3) rather than damped.
+struct WallConstraint {
+  double w[3];
+  double n[3];
+  double sticky;
+  bool behind;
+  bool imposed;
+};
+
 struct MeshWallSpec {
   std::string fix_id;  // ID of a fix mesh/surface (or a style derived from it)
   int kind = 0;        // 0 noslip, 1 freeslip, 2 partial, 3 sticky (imposed fraction of the wall's tangential velocity)
@@ -53,6 +64,17 @@ class MeshWalls {
   // behind it (one-sided meshes only). Both reaches <= margin of the last refresh, else the query
   // scans all gathered triangles. Returns true if touched.
   bool apply(const double x[3], double vel[3], double reach, double reach_behind = -1.0) const;
+
+  // apply() in two halves, for a node whose velocity is constrained more than once between two
+  // refresh() calls (the fix's grid update and MUSL remap): collect() writes the constraints
+  // apply() would impose at x (at most kMaxConstraints) and returns their number; impose() applies
+  // them, in the same order, to vel.
+  static constexpr int kMaxConstraints = 16;
+  // near (optional): whether any triangle comes within max(reach, reach_behind) of x (false: no
+  // wall condition, contact or crossing can concern anything that close to x).
+  int collect(const double x[3], double reach, double reach_behind, WallConstraint *out,
+              bool *near = nullptr) const;
+  static void impose(const WallConstraint *c, int n, double vel[3]);
 
   // Nearest triangle face to x within 'reach' (the closest point inside a triangle, not on an edge
   // or vertex only): q = that point, n = unit normal towards x's side (the fluid side of a
