@@ -683,6 +683,20 @@ bool MeshWalls::push_back(double x[3], double v[3], double reach, const double *
     const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
     const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
     const double r2 = reach * reach;
+    // Behind the nearest triangles means behind (or on) their planes, and x - q . n is the plane
+    // distance for any point q of a triangle: if x is in front of the plane of every one-sided
+    // triangle within reach (inside a closed convex mesh: always), nothing is to be done.
+    bool any_behind = false;
+    for (int c = 0; c < ncand && !any_behind; ++c) {
+      const Tri &t = tris_[cand ? (*cand)[c] : c];
+      const int side = specs_[t.mesh].side;
+      if (side != SIDE_NORMAL && side != SIDE_OPPOSITE) continue;
+      double a[3];
+      sub3(x, t.p[0], a);
+      const double pd = side * dot3(a, t.n);
+      any_behind = pd < 1e-12 * reach && pd > -reach;
+    }
+    if (!any_behind) break;
     constexpr int kMax = 64;
     int idx[kMax];
     Hit hits[kMax];
