@@ -9,12 +9,14 @@ Sections (all by default):
             with fix balance/mpm), parallel efficiency t1 / (np t_np), memory per point (peak RSS
             minus a run with 512 points). Quick: 100k points; full: 30k, 100k, 250k.
   coupling  C3 tank (inputs/tank/in.tank) at Grid40 x 8 (32000 points, 7762 beads), a short segment
-            (dry phase 20 steps, 10 coupled settling + 10 lift steps) under valgrind --tool=callgrind,
-            collected inside Verlet::run only: instructions in FixMpmFluid::couple_fluid_grains
-            (coupling), in FixMpmFluid::pre_final_integrate (fluid step, coupling included) and the
-            rest (LIGGGHTS). coupling_overhead_fraction = coupling / (fluid step - coupling). The
-            same for a pure-fluid dam break (the coupling code must not run) with the hot spots.
-            Full mode adds the wall time of the whole tank case (about 30 min on one core).
+            (dry phase 20 steps, 50 coupled settling + 50 lift steps), one rank: the fix's own
+            timers (f_ID[14], f_ID[15], printed after each run) split the wall time into the
+            fluid's work and the coupling (fluid fraction, pressure fit, drag and pressure
+            exchange); the rest of LIGGGHTS' "Loop time" is LIGGGHTS (DEM, neighbour lists, other
+            fixes) and output. coupling_overhead_fraction = coupling / fluid. Then a pure-fluid
+            dam break under valgrind --tool=callgrind (collected inside Verlet::run): the coupling
+            code must not run, and the hot spots. Full mode adds the wall time of the whole tank
+            case (about 30 min on one core).
   laser     one Table 5.1 case (inputs/laser/table51.toml), wall time of the process; full mode:
             the sweep of tools/laser_sweep.py --full (every model x 7 intensities) on 1 and 2 cores.
   sph       2-D square-column dam break against Martin & Moyce: LIGGGHTS SPH
@@ -25,7 +27,7 @@ Sections (all by default):
 
 Writes DIR/results.csv (metric,value,unit,note), DIR/results.md, DIR/runs.csv (every run),
 plots DIR/*.png, DIR/hotspots.md, and bench-results.csv (metric,value,unit) in the current
-folder. Quick mode takes about 5-10 minutes on 2 cores. Timings depend on the load of the machine.
+folder. Quick mode takes about 1-3 minutes on 2 cores. Timings depend on the load of the machine.
 """
 import argparse
 import concurrent.futures as cf
@@ -139,7 +141,7 @@ def section_mpm(a):
         note = "%d points, %d steps after 10 warm-up steps" % (s1["points"], nsteps)
         add("mpm_point_steps_per_s_per_core" + sfx, s1["point_steps_per_s"], "point-steps/s", note + ", serial")
         add("mpm_parallel_efficiency_%dranks%s" % (a.np, sfx), eff_b, "0..1",
-            note + ", fix balance/mpm (cuts by point counts at setup)")
+            note + ", fix balance/mpm (cuts at setup by point counts + 0.1 point per grid cell)")
         add("mpm_parallel_efficiency_%dranks_uniform%s" % (a.np, sfx), eff_u, "0..1",
             note + ", uniform LIGGGHTS cuts (all points on one rank)")
         add("mpm_memory_per_point" + sfx, mem, "bytes/point",
@@ -213,43 +215,49 @@ def callgrind_run(a, tag, cmd):
     return d, wall, incl, self_, total
 
 
+def fix_times(text):
+    """[(fluid s, coupling s)] of each run, from fix mpm/fluid's summary lines."""
+    out = []
+    for m in re.finditer(r"fix mpm/fluid: wall time in this run: fluid (\S+) s(?:, coupling (\S+) s)?", text):
+        out.append((float(m.group(1)), float(m.group(2) or 0.0)))
+    return out
+
+
 def section_coupling(a):
-    say("== coupling: C3 tank at Grid40 x 8 under callgrind (Verlet::run only)")
+    say("== coupling: C3 tank at Grid40 x 8, fix timers (one rank)")
     tank = os.path.join(TOP, "inputs", "tank", "in.tank")
-    short = ["-var", "tdry", "0.0004", "-var", "tsnap", "0.0001", "-var", "tsettle", "0.0001",
-             "-var", "tend", "0.0001", "-var", "tfront", "0.0001"]
+    short = ["-var", "tdry", "0.0004", "-var", "tsnap", "0.0001", "-var", "tsettle", "0.0005",
+             "-var", "tend", "0.0005", "-var", "tfront", "0.0001"]
     cmd = [a.exe, "-in", tank, "-echo", "none"] + short
-    # native timing of the same segment (coupled steps only)
     wall, out, _ = run(cmd, os.path.join(a.out, "coupling", "native"))
-    lt = [t for t in loop_times(out)]
-    coupled = lt[1:]
-    ms_step = 1e3 * sum(t[0] for t in coupled) / max(1, sum(t[2] for t in coupled))
-    d, wall, incl, self_, total = callgrind_run(a, "tank", cmd)
-    pfi = find_cost(incl, "FixMpmFluid::pre_final_integrate()")
-    cpl = find_cost(incl, "FixMpmFluid::couple_fluid_grains(double)")
-    eos = find_cost(incl, "FixMpmFluid::end_of_step()")
-    fluid = pfi - cpl
-    lig_ = total - pfi - eos
-    say("    Ir in Verlet::run: total %.4g, fluid step %.4g (coupling %.4g), output %.4g, LIGGGHTS %.4g"
-        % (total, pfi, cpl, eos, lig_))
-    note = ("C3 Grid40x8 (32000 points, 7762 beads, not settled: 20 dry steps), 20 coupled steps, "
-            "callgrind Ir in Verlet::run; coupling / (fluid step without coupling)")
+    coupled = loop_times(out)[1:]       # the dry run has no fluid
+    ft = fix_times(out)
+    loop = sum(t[0] for t in coupled)
+    steps = max(1, sum(t[2] for t in coupled))
+    fluid = sum(t[0] for t in ft)
+    cpl = sum(t[1] for t in ft)
+    rest = loop - fluid - cpl
+    say("    %d coupled steps: loop %.3f s, fluid %.3f s, coupling %.3f s, LIGGGHTS + output %.3f s"
+        % (steps, loop, fluid, cpl, rest))
+    note = ("C3 Grid40x8 (32000 points, 7762 beads, 20 dry steps), %d coupled steps, one rank, "
+            "fix timers: coupling / fluid" % steps)
     add("coupling_overhead_fraction", cpl / fluid if fluid else float("nan"), "ratio", note)
-    add("c3_share_liggghts", lig_ / total, "fraction of step", "DEM, neighbour lists, exchange, other fixes")
-    add("c3_share_mpm_fluid", fluid / total, "fraction of step", "pre_final_integrate minus coupling")
-    add("c3_share_coupling", cpl / total, "fraction of step", "couple_fluid_grains (4 halo exchanges incl.)")
-    add("c3_share_mpm_output", eos / total, "fraction of step", "HDF5 output every 10 steps (end_of_step)")
-    add("c3_ms_per_coupled_step", ms_step, "ms/step", "native, same segment, 1 rank")
-    RUNS.append(dict(section="coupling", case="tank_callgrind", wall_s=wall, ir_total=total, ir_fluid_step=pfi,
-                     ir_coupling=cpl, ir_output=eos, ms_per_step=ms_step))
+    add("c3_share_liggghts", rest / loop, "fraction of step", "Loop time minus the fix's timers: DEM, neighbour "
+        "lists, exchange, other fixes, HDF5 output every 10 steps")
+    add("c3_share_mpm_fluid", fluid / loop, "fraction of step", "fix timer: the fluid's own work")
+    add("c3_share_coupling", cpl / loop, "fraction of step", "fix timer: fluid fraction, pressure fit, "
+        "drag and pressure exchange (halo exchanges included)")
+    add("c3_ms_per_coupled_step", 1e3 * loop / steps, "ms/step", "native, same segment, 1 rank")
+    RUNS.append(dict(section="coupling", case="tank_timers", wall_s=wall, loop_s=loop, fluid_s=fluid,
+                     coupling_s=cpl, steps=steps))
 
     say("== coupling: pure-fluid 3-D dam break under callgrind (hot spots)")
     cmd = [a.exe, "-in", os.path.join(TOP, "inputs", "bench", "in.dambreak3d"), "-echo", "none",
            "-var", "cells", "10", "-var", "warm", "2", "-var", "nsteps", "10"]
     d, wall, incl, self_, total = callgrind_run(a, "dambreak3d", cmd)
-    cpl0 = find_cost(incl, "couple_fluid_grains")
+    cpl0 = find_cost(incl, "FixMpmFluid::couple_fluid_grains") + find_cost(incl, "FixMpmFluid::fluid_fraction")
     add("coupling_cost_without_grains", cpl0, "instructions",
-        "pure-fluid run (8000 points, 12 steps): couple_fluid_grains never runs")
+        "pure-fluid run (8000 points, 12 steps): couple_fluid_grains and fluid_fraction never run")
     pfi0 = find_cost(incl, "FixMpmFluid::pre_final_integrate()")
     steps_pts = 8000 * 12
     add("mpm_instructions_per_point_step", pfi0 / steps_pts, "Ir/(point step)",
