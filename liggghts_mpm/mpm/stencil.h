@@ -27,15 +27,15 @@ struct Stencil {
 // sy, sz: flat-index strides of the patch in y and z.
 template <int NS, class Fn>
 inline void for_stencil(const Stencil &s, std::size_t sy, std::size_t sz, Fn &&fn) {
-  for (int c = 0; c < NS; ++c) {
+  // A point at a cell centre reaches the B-spline's last node plane with weight and gradient
+  // exactly 0 (the 2-D dam-break slab one cell thick: a third of the work); such a y or z plane
+  // is left out (it only adds zeros). Decided once per point, not per node row.
+  const int nb = (NS == 3 && s.w[1][2] == 0.0 && s.dw[1][2] == 0.0) ? 2 : NS;
+  const int nc = (NS == 3 && s.w[2][2] == 0.0 && s.dw[2][2] == 0.0) ? 2 : NS;
+  for (int c = 0; c < nc; ++c) {
     const double wz = s.w[2][c], dwz = s.dw[2][c];
-    if (wz == 0.0 && dwz == 0.0) continue;  // a plane the point does not reach (see below)
-    for (int b = 0; b < NS; ++b) {
+    for (int b = 0; b < nb; ++b) {
       const double wy = s.w[1][b];
-      // A point at a cell centre reaches the third node plane of the
-      // B-spline with weight and gradient exactly 0 (a 2-D slab one cell
-      // thick: a third of the work); the skip changes no sum.
-      if (wy == 0.0 && s.dw[1][b] == 0.0) continue;
       const double wyz = wy * wz, dyz = s.dw[1][b] * wz, ydz = wy * dwz;
       const std::size_t row = s.n0 + c * sz + b * sy;
       for (int a = 0; a < NS; ++a) {
