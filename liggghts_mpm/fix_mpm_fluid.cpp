@@ -874,25 +874,24 @@ void FixMpmFluid::pre_final_integrate() {
       if (logfile) fputs(os.str().c_str(), logfile);
     }
   }
-  if (fluid_every > 1 && update->ntimestep % fluid_every != 0) {
-    // between two fluid steps the grains keep the fluid force of the last one
-    if (coupled)
-      for (int k = 0; k < atom->nlocal; ++k)
-        if (is_grain(k))
-          for (int d = 0; d < 3; ++d) atom->f[k][d] += pdata[k][C_FGRAIN + d];
-    return;
-  }
+  // between two fluid steps the grains get no fluid force: the fluid step gave them the
+  // whole impulse of its N steps at once (below)
+  if (fluid_every > 1 && update->ntimestep % fluid_every != 0) return;
   check_timestep(false);
   mesh_refresh();
   const double h = fluid_every * update->dt / nsub_last;
   if (coupled) grain_force.assign(3 * static_cast<std::size_t>(atom->nlocal), 0.0);
   for (int s = 0; s < nsub_last; ++s) substep(h);
   if (coupled) {
-    // fluid force on the grains (mean over the sub-steps), for final_integrate
+    // fluid force on the grains (mean over the sub-steps), for final_integrate. With every N
+    // the grains get the impulse of the N steps, N h F, in this step (force N F): velocity
+    // Verlet then advances them as one symplectic step of N dt. Keeping F for N steps
+    // instead spreads the kick over the drift and makes every undamped coupled oscillation
+    // grow (docs/coupled_stability.md, "every N").
     for (int k = 0; k < atom->nlocal; ++k) {
       if (!is_grain(k)) continue;
       for (int d = 0; d < 3; ++d) {
-        atom->f[k][d] += grain_force[3 * k + d];
+        atom->f[k][d] += fluid_every * grain_force[3 * k + d];
         pdata[k][C_FGRAIN + d] = grain_force[3 * k + d];
         if (fix_dragforce) fix_dragforce->array_atom[k][d] = grain_force[3 * k + d];
       }
