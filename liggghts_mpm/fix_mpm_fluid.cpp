@@ -766,40 +766,100 @@ void FixMpmFluid::post_run() {
 ------------------------------------------------------------------------- */
 
 double FixMpmFluid::stable_dt() {
-  // max |v|, max density, -min density
-  double loc[3] = {0.0, eos.rho0, -eos.rho0};
+  // max |v|, max density, -min density; with couple: max of rho (1 - theta) / theta over the
+  // points, -min theta, -min density of the grains an integrator moves
+  double loc[6] = {0.0, eos.rho0, -eos.rho0, 0.0, -1.0, -HUGE_VAL};
   for (int i = 0; i < atom->nlocal; ++i) {
-    if (!is_point(i)) continue;
-    const double *v = atom->v[i];
-    loc[0] = std::max(loc[0], std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
-    loc[1] = std::max(loc[1], pdata[i][C_RHO]);
-    loc[2] = std::max(loc[2], -pdata[i][C_RHO]);
+    if (is_point(i)) {
+      const double *v = atom->v[i];
+      loc[0] = std::max(loc[0], std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+      loc[1] = std::max(loc[1], pdata[i][C_RHO]);
+      loc[2] = std::max(loc[2], -pdata[i][C_RHO]);
+      const double th = pdata[i][C_THETA];
+      if (coupled && th > 0.0 && th < 1.0) {
+        loc[3] = std::max(loc[3], pdata[i][C_RHO] * (1.0 - th) / th);
+        loc[4] = std::max(loc[4], -th);
+      }
+    } else if (is_grain(i) && (atom->mask[i] & integrated_groupbits) && atom->radius[i] > 0.0) {
+      const double r = atom->radius[i];
+      loc[5] = std::max(loc[5], -atom->rmass[i] / (4.0 / 3.0 * M_PI * r * r * r));
+    }
   }
-  double glob[3];
-  MPI_Allreduce(loc, glob, 3, MPI_DOUBLE, MPI_MAX, world);
+  double glob[6];
+  MPI_Allreduce(loc, glob, 6, MPI_DOUBLE, MPI_MAX, world);
   // Sound speed: largest over the density range (Tait stiffens under
   // compression, the linear law under tension).
   c_max = std::sqrt(std::max(eos.sound_speed_sq(glob[1]), eos.sound_speed_sq(-glob[2])));
   const double c = c_max;
   const double dt_ac = mpm::acoustic_dt_limit(cfl, gspec.dx, c, glob[0]);
   const double dt_visc = mpm::viscous_dt_limit(gspec.dx, eos.rho0, viscosity, domain->dimension);
+  // Grains an integrator moves: the pore-pressure wave. Fluid and grains pushed by the same
+  // pressure form one wave, c^2 = c_f^2 (1 + rho_f (1 - theta) / (theta rho_p)), that limits
+  // the fluid step when the fluid is not sub-cycled; with sub-cycling the fluid follows the
+  // grains within the step and the grains' own wave, c_g^2 = c_f^2 rho_f (1 - theta) /
+  // (theta rho_p), limits the grains' step (docs/coupled_stability.md). Largest
+  // rho_f (1 - theta) / theta over the points against the lightest moving grain.
+  couple_theta_min = glob[4] < 0.0 ? -glob[4] : 1.0;
+  couple_rho_grain = glob[5] > -HUGE_VAL ? -glob[5] : 0.0;
+  c_couple = c_grain = 0.0;
+  dt_couple_last = dt_grain_last = HUGE_VAL;
+  if (couple_rho_grain > 0.0) {
+    const double r = glob[3] / couple_rho_grain;
+    c_couple = c * std::sqrt(1.0 + r);
+    c_grain = c * std::sqrt(r);
+    dt_couple_last = mpm::acoustic_dt_limit(cfl, gspec.dx, c_couple, glob[0]);
+    dt_grain_last = c_grain > 0.0 ? mpm::acoustic_dt_limit(cfl, gspec.dx, c_grain, glob[0]) : HUGE_VAL;
+  }
   return std::min(dt_ac, dt_visc);
 }
 
 void FixMpmFluid::check_timestep(bool at_setup) {
   dt_stable_last = stable_dt();
   const double dt = fluid_every * update->dt;
-  if (!std::isfinite(dt_stable_last) || dt_stable_last <= 0.0)
+  if (!std::isfinite(dt_stable_last) || dt_stable_last <= 0.0 || std::isnan(dt_couple_last) ||
+      std::isnan(dt_grain_last))
     error->all(FLERR, "Fix mpm/fluid: the fluid state is not finite (NaN velocity or density); "
                       "the run was unstable before this check");
-  if (dt <= dt_stable_last) {
+  const char *what = fluid_every > 1 ? "fluid step (every x timestep) " : "timestep ";
+  // the grains' wave: sub-cycling the fluid does not help, the grains move once per step
+  if (subcycle && dt > dt_grain_last) {
+    std::ostringstream os;
+    os.precision(4);
+    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << dt_grain_last
+       << " of the grains coupled with the fluid (pore-pressure wave of the grains with the fluid sub-cycled: "
+          "cfl*dx/(c_g+|v|max) with cfl = "
+       << cfl << ", dx = " << gspec.dx << ", c_g = c_f*sqrt(rho_f*(1-theta)/(theta*rho_p)) = " << c_grain
+       << ", fluid sound speed c_f = " << c_max << ", lowest fluid fraction theta = " << couple_theta_min
+       << ", lightest moving grain rho_p = " << couple_rho_grain << "); the grains move once per timestep, "
+       << "so 'subcycle yes' cannot help: reduce the timestep to " << dt_grain_last / fluid_every
+       << " (docs/coupled_stability.md)" << (at_setup ? "" : " (limit reached during the run)");
+    error->all(FLERR, os.str().c_str());
+  }
+  // without sub-cycling, fluid and grains together: the coupled wave
+  if (!subcycle && dt > dt_couple_last) {
+    std::ostringstream os;
+    os.precision(4);
+    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << dt_couple_last
+       << " of the fluid coupled with the grains (pore-pressure wave of fluid and grains: "
+          "cfl*dx/(c+|v|max) with cfl = "
+       << cfl << ", dx = " << gspec.dx << ", c = c_f*sqrt(1 + rho_f*(1-theta)/(theta*rho_p)) = " << c_couple
+       << ", fluid sound speed c_f = " << c_max << ", lowest fluid fraction theta = " << couple_theta_min
+       << ", lightest moving grain rho_p = " << couple_rho_grain << "); reduce the timestep to "
+       << dt_couple_last / fluid_every << " or use keyword 'subcycle yes' (docs/coupled_stability.md)"
+       << (at_setup ? "" : " (limit reached during the run)");
+    error->all(FLERR, os.str().c_str());
+  }
+  // the fluid (sub-)step: its own limit and, so that a step that is not sub-cycled also
+  // satisfies it, the coupled one
+  const double dt_sub = std::min(dt_stable_last, dt_couple_last);
+  if (dt <= dt_sub) {
     nsub_last = 1;
     return;
   }
   if (!subcycle) {
     std::ostringstream os;
     os.precision(4);
-    os << "Fix mpm/fluid: " << (fluid_every > 1 ? "fluid step (every x timestep) " : "timestep ") << dt
+    os << "Fix mpm/fluid: " << what << dt
        << " exceeds the largest stable time step " << dt_stable_last
        << " (acoustic limit cfl*dx/(c+|v|max) with cfl = " << cfl << ", dx = " << gspec.dx
        << ", c = " << c_max
@@ -807,17 +867,17 @@ void FixMpmFluid::check_timestep(bool at_setup) {
        << " or use keyword 'subcycle yes'" << (at_setup ? "" : " (limit reached during the run)");
     error->all(FLERR, os.str().c_str());
   }
-  const int nsub = static_cast<int>(std::ceil(dt / dt_stable_last));
+  const int nsub = static_cast<int>(std::ceil(dt / dt_sub));
   if (nsub > max_subcycle) {
     std::ostringstream os;
     os << "Fix mpm/fluid: 'subcycle yes' would need " << nsub << " sub-steps per timestep (more than "
-       << max_subcycle << "); reduce the timestep to at most " << max_subcycle * dt_stable_last;
+       << max_subcycle << "); reduce the timestep to at most " << max_subcycle * dt_sub;
     error->all(FLERR, os.str().c_str());
   }
   if (at_setup && comm->me == 0 && nsub != nsub_last) {
     std::ostringstream os;
     os << "fix mpm/fluid: sub-cycling with " << nsub << " fluid sub-steps of " << dt / nsub
-       << " per timestep (stable limit " << dt_stable_last << ")\n";
+       << " per timestep (stable limit " << dt_sub << ")\n";
     if (screen) fputs(os.str().c_str(), screen);
     if (logfile) fputs(os.str().c_str(), logfile);
   }
@@ -840,25 +900,24 @@ void FixMpmFluid::pre_final_integrate() {
       if (logfile) fputs(os.str().c_str(), logfile);
     }
   }
-  if (fluid_every > 1 && update->ntimestep % fluid_every != 0) {
-    // between two fluid steps the grains keep the fluid force of the last one
-    if (coupled)
-      for (int k = 0; k < atom->nlocal; ++k)
-        if (is_grain(k))
-          for (int d = 0; d < 3; ++d) atom->f[k][d] += pdata[k][C_FGRAIN + d];
-    return;
-  }
+  // between two fluid steps the grains get no fluid force: the fluid step gave them the
+  // whole impulse of its N steps at once (below)
+  if (fluid_every > 1 && update->ntimestep % fluid_every != 0) return;
   check_timestep(false);
   mesh_refresh();
   const double h = fluid_every * update->dt / nsub_last;
   if (coupled) grain_force.assign(3 * static_cast<std::size_t>(atom->nlocal), 0.0);
   for (int s = 0; s < nsub_last; ++s) substep(h);
   if (coupled) {
-    // fluid force on the grains (mean over the sub-steps), for final_integrate
+    // fluid force on the grains (mean over the sub-steps), for final_integrate. With every N
+    // the grains get the impulse of the N steps, N h F, in this step (force N F): velocity
+    // Verlet then advances them as one symplectic step of N dt. Keeping F for N steps
+    // instead spreads the kick over the drift and makes every undamped coupled oscillation
+    // grow (docs/coupled_stability.md, "every N").
     for (int k = 0; k < atom->nlocal; ++k) {
       if (!is_grain(k)) continue;
       for (int d = 0; d < 3; ++d) {
-        atom->f[k][d] += grain_force[3 * k + d];
+        atom->f[k][d] += fluid_every * grain_force[3 * k + d];
         pdata[k][C_FGRAIN + d] = grain_force[3 * k + d];
         if (fix_dragforce) fix_dragforce->array_atom[k][d] = grain_force[3 * k + d];
       }
@@ -1827,7 +1886,7 @@ void FixMpmFluid::compute_outputs() {
   vector_cache[3] = std::isfinite(gmx[1]) ? gmx[1] : 0.0;
   vector_cache[4] = std::isfinite(gmx[2]) ? gmx[2] - gspec.origin[height_axis] : 0.0;
   vector_cache[5] = nsub_last;
-  vector_cache[6] = dt_stable_last;
+  vector_cache[6] = std::min(dt_stable_last, dt_couple_last);
   vector_cache[7] = gsum[3];
   vector_cache[8] = gsum[2];
   vector_cache[9] = std::isfinite(gmx[3]) ? gmx[3] : 0.0;

@@ -213,6 +213,12 @@ class FixMpmFluid : public Fix {
   int nsub_last = 1;
   double dt_stable_last = 0.0;
   double c_max = 0.0;           // sound speed used by the last time-step check
+  double dt_couple_last = HUGE_VAL;  // stable step of fluid and moving grains together (couple)
+  double dt_grain_last = HUGE_VAL;   // stable step of the moving grains with the fluid sub-cycled
+  double c_couple = 0.0;            // pore-pressure wave speed of fluid and grains, last check
+  double c_grain = 0.0;             // its grains' part (fluid held), last check
+  double couple_theta_min = 1.0;    // lowest fluid fraction at a point at the last check
+  double couple_rho_grain = 0.0;    // lightest moving grain's density at the last check (0: none)
 
   // cached global outputs
   bigint vector_step = -1;
