@@ -167,6 +167,7 @@ bool FixMpmFluid::*FixMpmFluid::find_flag(const char *kw) {
       {"subcycle", &FixMpmFluid::subcycle},
       {"cell_check", &FixMpmFluid::cell_check},
       {"wall_traction", &FixMpmFluid::wall_traction},
+      {"theta_transport", &FixMpmFluid::theta_transport},
   };
   for (const auto &k : table)
     if (strcmp(k.name, kw) == 0) return k.flag;
@@ -301,6 +302,15 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
         bad_arg(kw, "a drag law ergun_wenyu, difelice or stokes", arg[iarg + 1]);
       iarg += 2;
       if (iarg < narg && mpm::parse_drag_form(arg[iarg], drag_form)) ++iarg;
+    } else if (strcmp(kw, "grad_p") == 0) {
+      need(iarg, 1, kw, "'fit' or 'nodal'");
+      if (strcmp(arg[iarg + 1], "fit") == 0)
+        grad_p_fit = true;
+      else if (strcmp(arg[iarg + 1], "nodal") == 0)
+        grad_p_fit = false;
+      else
+        bad_arg(kw, "'fit' or 'nodal'", arg[iarg + 1]);
+      iarg += 2;
     } else if (strcmp(kw, "pmin") == 0) {
       need(iarg, 1, kw, "the lowest (cavitation) pressure, a number or 'none'");
       if (strcmp(arg[iarg + 1], "none") == 0)
@@ -377,7 +387,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
           static const char *keywords[] = {"cell", "grid", "density", "bulk", "viscosity", "eos", "shape",
                                            "transfer", "update", "antilock", "boundary", "gate", "damping",
                                            "cfl", "subcycle", "every", "mass_threshold", "fill", "hydrostatic", "pmin",
-                                           "couple", "drag", "cell_check", "theta_min", "theta_smooth", "wall_traction",
+                                           "couple", "drag", "cell_check", "theta_min", "theta_smooth", "wall_traction", "theta_transport", "grad_p",
                                            "front", "height", "output", "mesh_wall"};
           bool is_kw = false;
           for (const char *k : keywords) is_kw = is_kw || strcmp(arg[iarg], k) == 0;
@@ -625,6 +635,12 @@ void FixMpmFluid::init() {
   if (anybad)
     error->all(FLERR, "Fix mpm/fluid: the fix group contains atoms that are not material points of this fix "
                       "(use a group of the fill type only)");
+  if (theta_transport && !coupled)
+    error->all(FLERR, "Fix mpm/fluid: keyword 'theta_transport yes' needs keyword 'couple' (there is no "
+                      "fluid fraction to transport without grains)");
+  if (theta_transport && !musl)
+    error->all(FLERR, "Fix mpm/fluid: keyword 'theta_transport yes' needs 'update musl' (the divergence of "
+                      "theta u is taken in the MUSL remap)");
   if (coupled) {
     integrated_groupbits = 0;
     for (int m = 0; m < modify->nfix; ++m)
@@ -682,13 +698,15 @@ void FixMpmFluid::setup_grid() {
   grid.setup(gspec, world, domain->sublo, domain->subhi, halo);
   g_p2g.assign(grid.size() * kP2g, 0.0);
   g_vel.assign(grid.size() * kVel, 0.0);
-  g_cell.assign(grid.size() * 4, 0.0);
+  g_cell.assign(grid.size() * kCell, 0.0);
+  th_prev_valid = false;
   if (musl) g_aux.assign(grid.size() * kAux, 0.0);
   if (coupled) {
     g_cpl.assign(grid.size() * kPfit, 0.0);
     g_sol.assign(grid.size(), 0.0);
     g_need.assign(grid.size(), 0.0);
     g_th.assign(grid.size(), 1.0);
+    if (theta_transport) g_th_prev.assign(grid.size(), 1.0);
     g_st.assign(grid.size() * kSt, 0.0);
     g_rx.assign(grid.size() * 3, 0.0);
     g_dr.assign(grid.size() * kDr, 0.0);
@@ -740,7 +758,14 @@ void FixMpmFluid::setup(int) {
       error->all(FLERR, (std::string("Fix mpm/fluid: ") + e.what()).c_str());
     }
   }
-  if (coupled && !theta_initialized) init_theta();
+  if (coupled && !theta_initialized) {
+    init_theta();
+  } else if (coupled && theta_transport) {
+    // the nodes' fraction of the grains' present positions, from which the next sub-step's
+    // change is taken (the points keep their own theta, also across a restart)
+    compute_shapes();
+    fluid_fraction();
+  }
   check_timestep(true);
   if (out_every > 0 && update->ntimestep % out_every == 0) write_output();
   run_time_start[0] = time_fluid;
@@ -1186,10 +1211,26 @@ void FixMpmFluid::fluid_fraction() {
   });
   grid.forward(g_th.data(), 1);
   const double *const gth = g_th.data();
-  for (const int i : plist) {
-    double th = 0.0;
-    for_nodes(shapes[i], [&](std::size_t n, double w) { th += w * gth[n]; });
-    pdata[i][C_THETA] = th;
+  if (!theta_transport || !theta_initialized) {
+    for (const int i : plist) {
+      double th = 0.0;
+      for_nodes(shapes[i], [&](std::size_t n, double w) { th += w * gth[n]; });
+      pdata[i][C_THETA] = th;
+    }
+  } else if (th_prev_valid) {
+    // theta_transport: the point keeps its own fluid fraction; here it takes the change of the
+    // nodes' fraction since the last sub-step (the grains moved), the fluid's motion enters in
+    // update_stress through the divergence of theta u (docs/fix_mpm_fluid.md)
+    const double *const gprev = g_th_prev.data();
+    for (const int i : plist) {
+      double dth = 0.0;
+      for_nodes(shapes[i], [&](std::size_t n, double w) { dth += w * (gth[n] - gprev[n]); });
+      pdata[i][C_THETA] = std::min(1.0, std::max(theta_min, pdata[i][C_THETA] + dth));
+    }
+  }
+  if (theta_transport) {
+    g_th_prev = g_th;
+    th_prev_valid = true;
   }
   if (theta_initialized) update_stress(0.0, true);
 }
@@ -1313,7 +1354,7 @@ void FixMpmFluid::couple_kernel(double h) {
     for (int q = 0; q < kSt; ++q) st[q] = 0.0;
     st[S_TH] = g_th[n];
     st[S_P] = c[4] > 0.0 ? c[0] / c[4] : 0.0;
-    if (c[4] > 0.0 && g_need[n] > 0.0) {
+    if (grad_p_fit && c[4] > 0.0 && g_need[n] > 0.0) {
       Eigen::Matrix4d M;
       for (int r = 0; r < 4; ++r)
         for (int q = 0; q < 4; ++q) M(r, q) = c[4 + 4 * r + q];
@@ -1725,15 +1766,21 @@ void FixMpmFluid::musl_kernel() {
   });
   grid.forward(g_aux.data(), kAux);
   const bool store_affine = transfer != TR_APIC;
+  const bool transport = coupled && theta_transport;
+  const double *const gth = transport ? g_th.data() : nullptr;
+  if (transport && divthu.size() < static_cast<std::size_t>(atom->nlocal)) divthu.resize(atom->nlocal);
   for (const int i : plist) {
     const PointShape &ps = shapes[i];
     mpm::Row4 Lc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // Lc[e][d] = sum v_d dS/dx_e
+    double dtu = 0.0;  // divergence of theta u (theta_transport)
     mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double, double gx, double gy, double gz) {
       const mpm::Row4 u = mpm::row4(ga + kAux * n);
       Lc[0] += gx * u;
       Lc[1] += gy * u;
       Lc[2] += gz * u;
+      if (transport) dtu += gth[n] * (gx * u[0] + gy * u[1] + gz * u[2]);
     });
+    if (transport) divthu[i] = dtu;
     double L[9];
     for (int d = 0; d < 3; ++d)
       for (int e = 0; e < 3; ++e) L[3 * d + e] = Lc[e][d];
@@ -1751,6 +1798,9 @@ void FixMpmFluid::update_stress(double h, bool theta_only) {
   double **x = atom->x;
   double *rmass = atom->rmass;
   const double inv = 1.0 / gspec.dx;
+  // theta_transport: the fluid volume theta V changes by h V div(theta u) (grid operators), so
+  // that flow through a fixed irregular bed keeps it; else theta stays, V changes by h V div u
+  const bool transport = coupled && theta_transport && theta_initialized && !theta_only;
   auto cell_node = [&](int i) {
     int c[3];
     for (int d = 0; d < 3; ++d) c[d] = static_cast<int>(std::floor((x[i][d] - gspec.origin[d]) * inv));
@@ -1763,18 +1813,19 @@ void FixMpmFluid::update_stress(double h, bool theta_only) {
     for (int i = 0; i < nlocal; ++i) {
       if (!is_point(i)) continue;
       const double *s = pdata[i];
-      double *c = &g_cell[4 * cell_node(i)];
+      double *c = &g_cell[kCell * cell_node(i)];
       const double V = s[C_VOL];
       c[0] += V;
       if (!theta_only) {
         const double *L = &velgrad[9 * static_cast<std::size_t>(i)];
         c[1] += V * (L[0] + L[4] + L[8]);
+        if (transport) c[4] += V * divthu[i];
       }
       c[2] += s[C_THETA] * V;
       c[3] += rmass[i];
     }
-    grid.reverse_sum(g_cell.data(), 4);
-    grid.forward(g_cell.data(), 4);
+    grid.reverse_sum(g_cell.data(), kCell);
+    grid.forward(g_cell.data(), kCell);
   }
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
@@ -1784,14 +1835,17 @@ void FixMpmFluid::update_stress(double h, bool theta_only) {
     const double *L = theta_only ? nullptr : &velgrad[9 * static_cast<std::size_t>(i)];
     double div = theta_only ? 0.0 : L[0] + L[4] + L[8];
     double p;
+    double fgrow = transport ? 1.0 + h * divthu[i] / s[C_THETA] : 1.0;  // growth of theta V
     if (antilock) {
-      const double *c = &g_cell[4 * cell_node(i)];
+      const double *c = &g_cell[kCell * cell_node(i)];
       div = c[1] / c[0];
-      const double rho_cell = c[3] / (c[2] * (1.0 + h * div));
+      if (transport) fgrow = 1.0 + h * c[4] / c[2];
+      const double rho_cell = transport ? c[3] / (c[2] * fgrow) : c[3] / (c[2] * (1.0 + h * div));
       p = eos.pressure(rho_cell);
     }
     const double J = 1.0 + h * div;
     s[C_VOL] *= J;
+    if (transport) s[C_THETA] = std::min(1.0, std::max(theta_min, s[C_THETA] * fgrow / J));
     s[C_RHO] = rmass[i] / (s[C_THETA] * s[C_VOL]);
     if (!antilock) p = eos.pressure(s[C_RHO]);
     // Liquid cannot carry tension beyond its cavitation pressure: without the

@@ -115,6 +115,8 @@ class FixMpmFluid : public Fix {
   bool musl = true;
   bool antilock = true;
   bool wall_traction = true;  // (8-23) at grid-face walls for bspline2
+  bool grad_p_fit = true;       // grad p at the grains: fitted nodal gradients (fit) or of the nodal means (nodal)
+  bool theta_transport = false;  // points carry theta (updated by div(theta u)) instead of re-interpolating it
   Face face[6];
   Gate gate;
   std::vector<mpm::MeshWallSpec> mesh_specs;
@@ -204,7 +206,11 @@ class FixMpmFluid : public Fix {
   static constexpr int kP2g = 8, kVel = 8, kAux = 4;
   std::vector<double> g_p2g;    // per node: m, mv(3), f(3), pad
   std::vector<double> g_vel;    // per node: v_new(3), pad, v_old(3), pad
-  std::vector<double> g_cell;   // per cell (keyed by its low node): V, V div, theta V, m
+  static constexpr int kCell = 5;
+  std::vector<double> g_cell;   // per cell (keyed by its low node): V, V div, theta V, m, V div(theta u)
+  std::vector<double> g_th_prev;  // theta_transport: nodal fraction of the last sub-step
+  bool th_prev_valid = false;
+  std::vector<double> divthu;   // theta_transport: div(theta u) at the points (MUSL pass)
   std::vector<double> g_aux;    // per node: remapped momentum (3), pad (MUSL)
   std::vector<PointShape> shapes;
   std::vector<int> plist;       // local indices of the material points (this sub-step)
