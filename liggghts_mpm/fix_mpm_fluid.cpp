@@ -195,8 +195,20 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
   auto need = [&](int iarg, int n, const char *kw, const char *what) {
     if (iarg + n >= narg) bad_arg(kw, what, nullptr);
   };
-
   int iarg = 3;
+  // a keyword with one of two words: flag = (word == first)
+  auto choice = [&](const char *kw, const char *first, const char *second, bool &flag) {
+    const std::string expected = std::string("'") + first + "' or '" + second + "'";
+    need(iarg, 1, kw, expected.c_str());
+    if (strcmp(arg[iarg + 1], first) == 0)
+      flag = true;
+    else if (strcmp(arg[iarg + 1], second) == 0)
+      flag = false;
+    else
+      bad_arg(kw, expected.c_str(), arg[iarg + 1]);
+    iarg += 2;
+  };
+
   while (iarg < narg) {
     const char *kw = arg[iarg];
     if (const ScalarKeyword *sk = find_scalar(kw)) {
@@ -262,14 +274,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       } else
         bad_arg(kw, "'apic', 'pic' or 'flip'", arg[iarg + 1]);
     } else if (strcmp(kw, "update") == 0) {
-      need(iarg, 1, kw, "'musl' or 'usl'");
-      if (strcmp(arg[iarg + 1], "musl") == 0)
-        musl = true;
-      else if (strcmp(arg[iarg + 1], "usl") == 0)
-        musl = false;
-      else
-        bad_arg(kw, "'musl' or 'usl'", arg[iarg + 1]);
-      iarg += 2;
+      choice(kw, "musl", "usl", musl);
     } else if (strcmp(kw, "boundary") == 0) {
       need(iarg, 2, kw, "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip' or 'partial f'");
       parse_face(arg[iarg + 1], arg[iarg + 2], narg, arg, iarg);
@@ -303,14 +308,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       iarg += 2;
       if (iarg < narg && mpm::parse_drag_form(arg[iarg], drag_form)) ++iarg;
     } else if (strcmp(kw, "grad_p") == 0) {
-      need(iarg, 1, kw, "'fit' or 'nodal'");
-      if (strcmp(arg[iarg + 1], "fit") == 0)
-        grad_p_fit = true;
-      else if (strcmp(arg[iarg + 1], "nodal") == 0)
-        grad_p_fit = false;
-      else
-        bad_arg(kw, "'fit' or 'nodal'", arg[iarg + 1]);
-      iarg += 2;
+      choice(kw, "fit", "nodal", grad_p_fit);
     } else if (strcmp(kw, "pmin") == 0) {
       need(iarg, 1, kw, "the lowest (cavitation) pressure, a number or 'none'");
       if (strcmp(arg[iarg + 1], "none") == 0)
