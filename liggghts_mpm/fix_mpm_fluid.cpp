@@ -844,34 +844,29 @@ void FixMpmFluid::check_timestep(bool at_setup) {
     error->all(FLERR, "Fix mpm/fluid: the fluid state is not finite (NaN velocity or density); "
                       "the run was unstable before this check");
   const char *what = fluid_every > 1 ? "fluid step (every x timestep) " : "timestep ";
-  // the grains' wave: sub-cycling the fluid does not help, the grains move once per step
-  if (subcycle && dt > dt_grain_last) {
+  // a coupled limit exceeded: the error names the wave, its speed and the step to use
+  auto coupled_error = [&](double limit, const char *whose, const char *wave, const char *csym,
+                           const char *cformula, double cval, const char *before, const char *after) {
     std::ostringstream os;
     os.precision(4);
-    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << dt_grain_last
-       << " of the grains coupled with the fluid (pore-pressure wave of the grains with the fluid sub-cycled: "
-          "cfl*dx/(c_g+|v|max) with cfl = "
-       << cfl << ", dx = " << gspec.dx << ", c_g = c_f*sqrt(rho_f*(1-theta)/(theta*rho_p)) = " << c_grain
-       << ", fluid sound speed c_f = " << c_max << ", lowest fluid fraction theta = " << couple_theta_min
-       << ", lightest moving grain rho_p = " << couple_rho_grain << "); the grains move once per timestep, "
-       << "so 'subcycle yes' cannot help: reduce the timestep to " << dt_grain_last / fluid_every
+    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << limit << " of the "
+       << whose << " (" << wave << ": cfl*dx/(" << csym << "+|v|max) with cfl = " << cfl << ", dx = " << gspec.dx
+       << ", " << csym << " = " << cformula << " = " << cval << ", fluid sound speed c_f = " << c_max
+       << ", lowest fluid fraction theta = " << couple_theta_min << ", lightest moving grain rho_p = "
+       << couple_rho_grain << "); " << before << "reduce the timestep to " << limit / fluid_every << after
        << " (docs/coupled_stability.md)" << (at_setup ? "" : " (limit reached during the run)");
     error->all(FLERR, os.str().c_str());
-  }
+  };
+  // the grains' wave: sub-cycling the fluid does not help, the grains move once per step
+  if (subcycle && dt > dt_grain_last)
+    coupled_error(dt_grain_last, "grains coupled with the fluid",
+                  "pore-pressure wave of the grains with the fluid sub-cycled", "c_g",
+                  "c_f*sqrt(rho_f*(1-theta)/(theta*rho_p))", c_grain,
+                  "the grains move once per timestep, so 'subcycle yes' cannot help: ", "");
   // without sub-cycling, fluid and grains together: the coupled wave
-  if (!subcycle && dt > dt_couple_last) {
-    std::ostringstream os;
-    os.precision(4);
-    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << dt_couple_last
-       << " of the fluid coupled with the grains (pore-pressure wave of fluid and grains: "
-          "cfl*dx/(c+|v|max) with cfl = "
-       << cfl << ", dx = " << gspec.dx << ", c = c_f*sqrt(1 + rho_f*(1-theta)/(theta*rho_p)) = " << c_couple
-       << ", fluid sound speed c_f = " << c_max << ", lowest fluid fraction theta = " << couple_theta_min
-       << ", lightest moving grain rho_p = " << couple_rho_grain << "); reduce the timestep to "
-       << dt_couple_last / fluid_every << " or use keyword 'subcycle yes' (docs/coupled_stability.md)"
-       << (at_setup ? "" : " (limit reached during the run)");
-    error->all(FLERR, os.str().c_str());
-  }
+  if (!subcycle && dt > dt_couple_last)
+    coupled_error(dt_couple_last, "fluid coupled with the grains", "pore-pressure wave of fluid and grains", "c",
+                  "c_f*sqrt(1 + rho_f*(1-theta)/(theta*rho_p))", c_couple, "", " or use keyword 'subcycle yes'");
   // the fluid (sub-)step: its own limit and, so that a step that is not sub-cycled also
   // satisfies it, the coupled one
   const double dt_sub = std::min(dt_stable_last, dt_couple_last);
