@@ -1297,6 +1297,15 @@ void FixMpmFluid::pressure_moments() {
       }
       for (int q = 0; q < 3; ++q) dn[a][q] = xs - (gspec.origin[a] + (ps.base[a] + q) * gspec.dx);
     }
+    if (!grad_p_fit) {
+      // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
+      mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+        double *cn = g + kPfit * n;
+        cn[0] += w * V * p;
+        cn[4] += w * V;
+      });
+      continue;
+    }
     mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
       if (need[n] == 0.0) return;
       const mpm::Row4 e = {1.0, dn[0][a], dn[1][b], dn[2][c]};
