@@ -1049,6 +1049,13 @@ static inline void stencil_offsets(const mpm::GridSpec &gs, const mpm::Stencil &
     for (int a = 0; a < 3; ++a) o[d][a] = gs.origin[d] + (ps.base[d] + a) * gs.dx - xp[d];
 }
 
+// APIC: the affine part m C (x_i - x_p) of the momentum a point gives node (a, b, c) of its
+// stencil, from mC = m C (row-major) and the node-plane offsets o.
+static inline void affine_momentum(const double mC[9], const double o[3][3], int a, int b, int c, double d[3]) {
+  const double ox = o[0][a], oy = o[1][b], oz = o[2][c];
+  for (int r = 0; r < 3; ++r) d[r] = mC[3 * r] * ox + mC[3 * r + 1] * oy + mC[3 * r + 2] * oz;
+}
+
 template <int NS, bool AFFINE>
 void FixMpmFluid::p2g_kernel() {
   double **x = atom->x, **v = atom->v, **f = atom->f;
@@ -1078,10 +1085,9 @@ void FixMpmFluid::p2g_kernel() {
                                          double gz) {
       mpm::Row4 u = mv;
       if (AFFINE) {
-        const double ox = o[0][a], oy = o[1][b], oz = o[2][c];
-        u[1] += mC[0] * ox + mC[1] * oy + mC[2] * oz;
-        u[2] += mC[3] * ox + mC[4] * oy + mC[5] * oz;
-        u[3] += mC[6] * ox + mC[7] * oy + mC[8] * oz;
+        double d[3];
+        affine_momentum(mC, o, a, b, c, d);
+        for (int r = 0; r < 3; ++r) u[1 + r] += d[r];
       }
       double *gn = g + kP2g * n;
       mpm::row4(gn) += w * u;
@@ -1728,10 +1734,9 @@ void FixMpmFluid::g2p_kernel() {
       mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
         mpm::Row4 u = mv;
         if (SCATTER_AFFINE) {
-          const double ox = o[0][a], oy = o[1][b], oz = o[2][c];
-          u[0] += mC[0] * ox + mC[1] * oy + mC[2] * oz;
-          u[1] += mC[3] * ox + mC[4] * oy + mC[5] * oz;
-          u[2] += mC[6] * ox + mC[7] * oy + mC[8] * oz;
+          double d[3];
+          affine_momentum(mC, o, a, b, c, d);
+          for (int r = 0; r < 3; ++r) u[r] += d[r];
         }
         mpm::row4(ga + kAux * n) += w * u;
       });

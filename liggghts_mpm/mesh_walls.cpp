@@ -39,6 +39,12 @@ std::string fix_msg(const std::string &id, const std::string &what) {
   return "mesh wall: fix ID '" + id + "': " + what;
 }
 
+// x lies farther than r from the triangle's bounding box along some axis (cannot be within r).
+inline bool beyond_box(const MeshWalls::Tri &t, const double x[3], double r) {
+  return x[0] < t.lo[0] - r || x[0] > t.hi[0] + r || x[1] < t.lo[1] - r || x[1] > t.hi[1] + r ||
+         x[2] < t.lo[2] - r || x[2] > t.hi[2] + r;
+}
+
 // Velocity of the wall at barycentric weights b.
 inline void wall_velocity(const MeshWalls::Tri &t, const double b[3], double w[3]) {
   for (int d = 0; d < 3; ++d) w[d] = b[0] * t.w[0][d] + b[1] * t.w[1][d] + b[2] * t.w[2][d];
@@ -432,9 +438,7 @@ int MeshWalls::collect(const double x[3], double reach_fluid, double reach_behin
   for (int c = 0; c < ncand && ncl < kCand; ++c) {
     const int i = cand ? (*cand)[c] : c;
     const Tri &t = tris_[i];
-    if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
-        x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
-      continue;
+    if (beyond_box(t, x, reach)) continue;
     // lower bound of the distance: to the plane and to the bounding box
     double a[3], bd2 = 0.0;
     sub3(x, t.p[0], a);
@@ -574,9 +578,7 @@ bool MeshWalls::nearest_face(const double x[3], double reach, double q[3], doubl
   for (int c = 0; c < ncand; ++c) {
     const int i = cand ? (*cand)[c] : c;
     const Tri &t = tris_[i];
-    if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
-        x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
-      continue;
+    if (beyond_box(t, x, reach)) continue;
     double a[3];
     sub3(x, t.p[0], a);
     const double pd = dot3(a, t.n);
@@ -707,9 +709,7 @@ bool MeshWalls::push_back(double x[3], double v[3], double reach, const double *
       const Tri &t = tris_[i];
       const int side = specs_[t.mesh].side;
       if (side != SIDE_NORMAL && side != SIDE_OPPOSITE) continue;
-      if (x[0] < t.lo[0] - reach || x[0] > t.hi[0] + reach || x[1] < t.lo[1] - reach ||
-          x[1] > t.hi[1] + reach || x[2] < t.lo[2] - reach || x[2] > t.hi[2] + reach)
-        continue;
+      if (beyond_box(t, x, reach)) continue;
       double a[3];
       sub3(x, t.p[0], a);
       const double pd = dot3(a, t.n);
