@@ -183,6 +183,7 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
   total += volume_below(hi);
   // the volume's weight is added once, by rank 0, to the collective sums
   const double vol_share = comm->me == 0 ? 1.0 : 0.0;
+  auto below_all = [&](double c) { return below(c) + vol_share * volume_below(c); };  // this rank's share
   cut.assign(P + 1, 0.0);
   cut[0] = lo;
   cut[P] = hi;
@@ -196,7 +197,7 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
   for (int it = 0; it < 64; ++it) {
     for (int k = 0; k < nc; ++k) {
       const double mid = 0.5 * (a[k] + b[k]);
-      loc[k] = below(mid) + vol_share * volume_below(mid);
+      loc[k] = below_all(mid);
     }
     MPI_Allreduce(loc.data(), glob.data(), nc, MPI_DOUBLE, MPI_SUM, world);
     for (int k = 0; k < nc; ++k) {
@@ -211,8 +212,8 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
   // weights below and including the plane, the planes before and after it
   std::vector<double> w2(2 * nc), w2g(2 * nc), prev(nc), next(nc);
   for (int k = 0; k < nc; ++k) {
-    w2[2 * k] = std::isfinite(c[k]) ? below(c[k]) + vol_share * volume_below(c[k]) : 0.0;
-    w2[2 * k + 1] = below(b[k]) + vol_share * volume_below(b[k]);
+    w2[2 * k] = std::isfinite(c[k]) ? below_all(c[k]) : 0.0;
+    w2[2 * k + 1] = below_all(b[k]);
     loc[k] = std::isfinite(c[k]) ? last_below(c[k]) : -inf;
   }
   MPI_Allreduce(w2.data(), w2g.data(), 2 * nc, MPI_DOUBLE, MPI_SUM, world);

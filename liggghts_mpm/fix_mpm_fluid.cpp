@@ -1269,13 +1269,6 @@ void FixMpmFluid::add_mesh_wall_traction(const double *xp, double V, double p) {
       }
 }
 
-/* Two-way coupling with the DEM grains (chapter 7.2, 8.1-8.2):
-   fluid fraction at the nodes from the grains' volumes (8-11)-(8-14) and at
-   the points (8-16); fluid velocity, fraction and pressure gradient at each
-   grain; drag (7-7) integrated exactly over the sub-step for the two-body
-   system grain + fluid seen by it (stable for any stiffness) and the
-   pressure-gradient force -V grad p (7-15); the reaction of both goes to the
-   nodes with the same shape functions (8-25), (8-26), so momentum is kept. */
 /* Moments of the points' pressures for the linear least-squares fit at each
    node (couple_fluid_grains): with e = (1, x_s - x_j) for the point's
    sample position x_s, the node collects r = sum S V p e and the normal
@@ -1289,6 +1282,15 @@ void FixMpmFluid::pressure_moments() {
   for (const int i : plist) {
     const PointShape &ps = shapes[i];
     const double V = pdata[i][C_VOL], p = pdata[i][C_P];
+    if (!grad_p_fit) {
+      // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
+      mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+        double *cn = g + kPfit * n;
+        cn[0] += w * V * p;
+        cn[4] += w * V;
+      });
+      continue;
+    }
     const double *xp = x[i];
     // With anti-locking the pressure is the cell's (its mean density): it
     // belongs to the cell's centre, not to the point (a fit to the points'
@@ -1302,15 +1304,6 @@ void FixMpmFluid::pressure_moments() {
         xs = gspec.origin[a] + (c + 0.5) * gspec.dx;
       }
       for (int q = 0; q < 3; ++q) dn[a][q] = xs - (gspec.origin[a] + (ps.base[a] + q) * gspec.dx);
-    }
-    if (!grad_p_fit) {
-      // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
-      mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-        double *cn = g + kPfit * n;
-        cn[0] += w * V * p;
-        cn[4] += w * V;
-      });
-      continue;
     }
     mpm::for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
       if (need[n] == 0.0) return;
@@ -1326,6 +1319,13 @@ void FixMpmFluid::pressure_moments() {
   }
 }
 
+/* Two-way coupling with the DEM grains (chapter 7.2, 8.1-8.2):
+   fluid fraction at the nodes from the grains' volumes (8-11)-(8-14) and at
+   the points (8-16); fluid velocity, fraction and pressure gradient at each
+   grain; drag (7-7) integrated exactly over the sub-step for the two-body
+   system grain + fluid seen by it (stable for any stiffness) and the
+   pressure-gradient force -V grad p (7-15); the reaction of both goes to the
+   nodes with the same shape functions (8-25), (8-26), so momentum is kept. */
 void FixMpmFluid::couple_fluid_grains(double h) {
   if (shape == mpm::ShapeKind::QuadraticBSpline)
     couple_kernel<3>(h);
