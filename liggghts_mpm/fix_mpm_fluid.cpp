@@ -399,7 +399,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
         ++iarg;
       }
     } else if (strcmp(kw, "mesh_wall") == 0) {
-      need(iarg, 2, kw, "a fix ID and noslip | freeslip | partial f | sticky f");
+      need(iarg, 2, kw, "a fix ID and noslip | freeslip | partial f | sticky f | shear delta f");
       mpm::MeshWallSpec ms;
       ms.fix_id = arg[iarg + 1];
       ms.side = mpm::SIDE_AUTO;
@@ -414,7 +414,16 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
         ms.kind = sticky_kind ? 3 : 2;
         if (!parse_double(arg[iarg], ms.sticky)) bad_arg(kwname, "a sticky fraction in [0,1]", arg[iarg]);
         ++iarg;
-      } else bad_arg("mesh_wall", "noslip, freeslip, partial f or sticky f", k);
+      } else if (strcmp(k, "shear") == 0) {
+        // wall shear stress mu (f w_t - v_t) / delta: an unresolved viscous layer of thickness delta
+        need(iarg - 1, 2, "mesh_wall shear", "a wall layer thickness delta (length) and a fraction f in [0,1]");
+        ms.kind = 4;
+        if (!parse_double(arg[iarg], ms.delta) || !(ms.delta > 0.0))
+          bad_arg("mesh_wall shear", "a positive wall layer thickness delta (length)", arg[iarg]);
+        if (!parse_double(arg[iarg + 1], ms.sticky) || ms.sticky < 0.0 || ms.sticky > 1.0)
+          bad_arg("mesh_wall shear", "a fraction f in [0,1] of the wall's tangential velocity", arg[iarg + 1]);
+        iarg += 2;
+      } else bad_arg("mesh_wall", "noslip, freeslip, partial f, sticky f or shear delta f", k);
       if (iarg + 1 < narg && strcmp(arg[iarg], "side") == 0) {
         const char *sd = arg[iarg + 1];
         if (strcmp(sd, "auto") == 0) ms.side = mpm::SIDE_AUTO;
@@ -743,6 +752,7 @@ void FixMpmFluid::setup(int) {
       std::vector<mpm::MeshWallSpec> sp = mesh_specs;
       if (mesh_walls) for (size_t k = 0; k < sp.size(); ++k) sp[k].side = mesh_walls->side(k);
       mesh_walls.reset(new mpm::MeshWalls(lmp, sp));
+      mesh_walls->set_kinematic_viscosity(viscosity / eos.rho0);
     } catch (const std::exception &e) {
       error->all(FLERR, (std::string("Fix mpm/fluid: ") + e.what()).c_str());
     }
@@ -961,7 +971,7 @@ void FixMpmFluid::substep(double h) {
   }
   update_grid(h);
   grid_to_particles(h);
-  if (musl) remap_velocity_musl();
+  if (musl) remap_velocity_musl(h);
   update_stress(h);
   advance_positions(h);
   const double t5 = MPI_Wtime();
@@ -1553,7 +1563,7 @@ void FixMpmFluid::init_theta() {
 }
 
 // Wall, gate: velocity v of node (i,j,k) after the momentum update.
-void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k) {
+void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k, double h) {
   const int idx[3] = {i, j, k};
   for (int d = 0; d < 3; ++d) {
     if (gspec.periodic[d]) continue;
@@ -1572,7 +1582,7 @@ void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k) {
     // (one per fluid step): the grid update and the MUSL remap, and every sub-step, reuse the
     // node's constraints (node_walls).
     const std::size_t n = node_walls(i, j, k);
-    mpm::MeshWalls::impose(mw_cache.data() + mw_first[n], mw_count[n], vel);
+    mpm::MeshWalls::impose(mw_cache.data() + mw_first[n], mw_count[n], vel, h);
   }
   if (gate.active) {
     const int d = gate.dim;
@@ -1630,7 +1640,7 @@ void FixMpmFluid::update_grid(double h) {
       // damping is implicit in time so that any rate is stable
       vnew[d] = (gv[4 + d] + h * f * inv) / (1.0 + h * damping);
     }
-    apply_grid_bc(vnew, i, j, k);
+    apply_grid_bc(vnew, i, j, k, h);
     for (int d = 0; d < 3; ++d) gv[d] = vnew[d];
   });
   grid.forward(g_vel.data(), kVel);
@@ -1747,15 +1757,15 @@ void FixMpmFluid::g2p_kernel() {
 /* MUSL (Buzzi et al. 2008, text after (8-41)): the updated point momentum,
    mapped back to the grid by grid_to_particles, gives the velocity gradient
    for the stress update, still at the positions of the start of the step. */
-void FixMpmFluid::remap_velocity_musl() {
+void FixMpmFluid::remap_velocity_musl(double h) {
   if (shape == mpm::ShapeKind::QuadraticBSpline)
-    musl_kernel<3>();
+    musl_kernel<3>(h);
   else
-    musl_kernel<2>();
+    musl_kernel<2>(h);
 }
 
 template <int NS>
-void FixMpmFluid::musl_kernel() {
+void FixMpmFluid::musl_kernel(double h) {
   const std::size_t sy = grid.stride_y(), sz = grid.stride_z();
   const double *const ga = g_aux.data();
   grid.reverse_sum(g_aux.data(), kAux);
@@ -1769,7 +1779,10 @@ void FixMpmFluid::musl_kernel() {
     }
     const double inv = 1.0 / m;
     for (int d = 0; d < 3; ++d) g[d] *= inv;
-    apply_grid_bc(g, i, j, k);
+    // the remapped velocity moves the points and gives their velocity gradient; the momentum of
+    // the points is not changed here, so the wall conditions (a shear wall's stress over h too)
+    // are those of the grid update
+    apply_grid_bc(g, i, j, k, h);
   });
   grid.forward(g_aux.data(), kAux);
   const bool store_affine = transfer != TR_APIC;

@@ -248,13 +248,14 @@ class FixMpmFluid : public Fix {
   void particles_to_grid();
   void add_wall_traction(const PointShape &ps, const double *xp, double V, double p);
   void update_grid(double h);
-  void apply_grid_bc(double *v, int nodeidx_i, int nodeidx_j, int nodeidx_k);
+  // h: time step of the grid update (the stress of shear mesh walls acts over h)
+  void apply_grid_bc(double *v, int nodeidx_i, int nodeidx_j, int nodeidx_k, double h);
   void grid_to_particles(double h);
-  void remap_velocity_musl();
+  void remap_velocity_musl(double h);
   // transfer kernels, instantiated per stencil size and transfer (docs/performance.md)
   template <int NS, bool AFFINE> void p2g_kernel();
   template <int NS, bool NEED_L, bool NEED_B, bool SCATTER, bool SCATTER_AFFINE> void g2p_kernel();
-  template <int NS> void musl_kernel();
+  template <int NS> void musl_kernel(double h);
   template <int NS> void pressure_moments();
   template <int NS> void couple_kernel(double h);
   template <class Fn> void for_nodes(const PointShape &ps, Fn &&fn) const;

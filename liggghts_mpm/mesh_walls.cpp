@@ -50,25 +50,31 @@ inline void wall_velocity(const MeshWalls::Tri &t, const double b[3], double w[3
   for (int d = 0; d < 3; ++d) w[d] = b[0] * t.w[0][d] + b[1] * t.w[1][d] + b[2] * t.w[2][d];
 }
 
-// Relative velocity r = v - w: normal part along unit n -> max(0, r.n) (fluid side) or 0 (behind),
-// tangential part scaled by (1 - sticky).
-// imposed (kind 'sticky f'): the tangential velocity becomes f times the wall's tangential
-// velocity (the text's "50 % sticky wall" of C4), whatever it was.
-inline void constrain(double v[3], const double w[3], const double n[3], bool behind, double sticky,
-                      bool imposed = false) {
+// Relative velocity r = v - w: normal part along unit n -> max(0, r.n) (fluid side) or 0 (behind).
+// Tangential part: v_t -> target w_t + keep (v_t - target w_t), with
+//   noslip / freeslip / partial f: target 1, keep 1 - f (0, 1, 1 - f);
+//   sticky f (imposed): target f, keep 0: the tangential velocity becomes f times the wall's (the
+//     text's "50 % sticky wall" of C4), whatever it was;
+//   shear delta f: target f, keep exp(-rate h): the exact solution over h of
+//     dv_t/dt = -rate (v_t - f w_t), the wall shear stress mu (f w_t - v_t) / delta acting on the
+//     fluid within 'reach' of the wall, rate = nu / (delta reach) (docs/mesh_walls.md).
+inline void constrain(double v[3], const WallConstraint &c, double h) {
   double r[3];
-  sub3(v, w, r);
-  const double rn = dot3(r, n);
-  const double rn_new = behind ? 0.0 : std::max(0.0, rn);
-  const double keep = 1.0 - sticky;
-  const double wn = dot3(w, n);
+  sub3(v, c.w, r);
+  const double rn = dot3(r, c.n);
+  const double rn_new = c.behind ? 0.0 : std::max(0.0, rn);
+  const double wn = dot3(c.w, c.n), vn = dot3(v, c.n);
+  double keep = 1.0 - c.sticky, target = 1.0;
+  if (c.imposed) {
+    keep = 0.0;
+    target = c.sticky;
+  } else if (c.rate > 0.0) {
+    keep = std::exp(-c.rate * h);
+    target = c.sticky;
+  }
   for (int d = 0; d < 3; ++d) {
-    if (imposed) {
-      v[d] = (wn + rn_new) * n[d] + sticky * (w[d] - wn * n[d]);
-      continue;
-    }
-    const double rt = r[d] - rn * n[d];
-    v[d] = w[d] + rn_new * n[d] + keep * rt;
+    const double wt = c.w[d] - wn * c.n[d], vt = v[d] - vn * c.n[d];
+    v[d] = (wn + rn_new) * c.n[d] + target * wt + keep * (vt - target * wt);
   }
 }
 
@@ -88,15 +94,21 @@ MeshWalls::MeshWalls(LAMMPS_NS::LAMMPS *lmp, std::vector<MeshWallSpec> specs)
       case 1: s.sticky = 0.0; break;
       case 2:
       case 3:
+      case 4:
         if (!(s.sticky >= 0.0 && s.sticky <= 1.0)) {
           std::ostringstream m;
           m << "sticky fraction " << s.sticky << " of a partial-slip wall must lie in [0,1]";
           throw std::runtime_error(fix_msg(s.fix_id, m.str()));
         }
+        if (s.kind == 4 && !(s.delta > 0.0 && std::isfinite(s.delta))) {
+          std::ostringstream m;
+          m << "wall layer thickness " << s.delta << " of a shear wall must be positive";
+          throw std::runtime_error(fix_msg(s.fix_id, m.str()));
+        }
         break;
       default:
         throw std::runtime_error(fix_msg(s.fix_id, "unknown wall kind " + std::to_string(s.kind) +
-                                                       " (0 noslip, 1 freeslip, 2 partial, 3 sticky)"));
+                                                       " (0 noslip, 1 freeslip, 2 partial, 3 sticky, 4 shear)"));
     }
     if (s.side != SIDE_NORMAL && s.side != SIDE_OPPOSITE && s.side != SIDE_AUTO && s.side != SIDE_BOTH)
       throw std::runtime_error(fix_msg(s.fix_id, "unknown fluid side " + std::to_string(s.side)));
@@ -402,15 +414,16 @@ void MeshWalls::closest_point(const Tri &t, const double x[3], Hit &h) {
 // ---------------------------------------------------------------------------------------------
 // Grid nodes
 
-bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, double reach_behind) const {
+bool MeshWalls::apply(const double x[3], double vel[3], double reach_fluid, double reach_behind,
+                      double h) const {
   WallConstraint c[kMaxConstraints];
   const int nc = collect(x, reach_fluid, reach_behind, c);
-  impose(c, nc, vel);
+  impose(c, nc, vel, h);
   return nc > 0;
 }
 
-void MeshWalls::impose(const WallConstraint *c, int nc, double vel[3]) {
-  for (int k = 0; k < nc; ++k) constrain(vel, c[k].w, c[k].n, c[k].behind, c[k].sticky, c[k].imposed);
+void MeshWalls::impose(const WallConstraint *c, int nc, double vel[3], double h) {
+  for (int k = 0; k < nc; ++k) constrain(vel, c[k], h);
 }
 
 int MeshWalls::collect(const double x[3], double reach_fluid, double reach_behind, WallConstraint *out,
@@ -561,6 +574,7 @@ int MeshWalls::collect(const double x[3], double reach_fluid, double reach_behin
       wall_velocity(t, hits[h].b, o.w);
       for (int q = 0; q < 3; ++q) o.n[q] = n[q];
       o.sticky = sticky;
+      o.rate = specs_[k].kind == 4 ? nu_ / (specs_[k].delta * reach_fluid) : 0.0;
       o.behind = behind;
       o.imposed = specs_[k].kind == 3;
     }

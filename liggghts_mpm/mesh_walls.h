@@ -7,7 +7,9 @@
 // then applies, node by node, the wall condition in the wall's frame:
 //   relative velocity r = v - w (w = wall velocity at the closest point),
 //   normal part   r.n -> max(0, r.n) on the fluid side, 0 behind the wall,
-//   tangential    r_t -> (1 - sticky) r_t.
+//   tangential    r_t -> (1 - sticky) r_t;
+// kinds 'sticky f' and 'shear delta f' work on the tangential velocity relative to f times the
+// wall's tangential velocity instead (imposed, or relaxed by the wall shear stress; see impose()).
 #pragma once
 
 #include <string>
@@ -30,19 +32,24 @@ enum MeshSide : int {
 
 // One wall condition at a grid node: wall velocity w at the closest point, unit normal n towards
 // the fluid, whether the node is behind the wall, the tangential fraction (sticky) and whether it
-// is imposed (kind 3) rather than damped.
+// is imposed (kind 3) rather than damped; rate > 0 (kind 4, shear): the relaxation rate (1/time)
+// of the tangential velocity towards sticky times the wall's, from the wall shear stress.
 struct WallConstraint {
   double w[3];
   double n[3];
   double sticky;
+  double rate;
   bool behind;
   bool imposed;
 };
 
 struct MeshWallSpec {
   std::string fix_id;  // ID of a fix mesh/surface (or a style derived from it)
-  int kind = 0;        // 0 noslip, 1 freeslip, 2 partial, 3 sticky (imposed fraction of the wall's tangential velocity)
-  double sticky = 1.0; // tangential damping in [0,1]; forced to 1 (noslip) or 0 (freeslip)
+  int kind = 0;        // 0 noslip, 1 freeslip, 2 partial, 3 sticky (imposed fraction of the wall's
+                       // tangential velocity), 4 shear (wall shear stress mu (f w_t - v_t) / delta)
+  double sticky = 1.0; // tangential damping in [0,1]; forced to 1 (noslip) or 0 (freeslip);
+                       // kinds 3 and 4: the fraction f of the wall's tangential velocity
+  double delta = 0.0;  // kind 4: thickness of the (unresolved) viscous wall layer, > 0 (length)
   int side = SIDE_NORMAL;  // MeshSide
 };
 
@@ -63,7 +70,8 @@ class MeshWalls {
   // triangle within 'reach' of x on its fluid side, or within 'reach_behind' (default: reach) of x
   // behind it (one-sided meshes only). Both reaches <= margin of the last refresh, else the query
   // scans all gathered triangles. Returns true if touched.
-  bool apply(const double x[3], double vel[3], double reach, double reach_behind = -1.0) const;
+  bool apply(const double x[3], double vel[3], double reach, double reach_behind = -1.0,
+             double h = 0.0) const;
 
   // apply() in two halves, for a node whose velocity is constrained more than once between two
   // refresh() calls (the fix's grid update and MUSL remap): collect() writes the constraints
@@ -72,9 +80,16 @@ class MeshWalls {
   static constexpr int kMaxConstraints = 16;
   // near (optional): whether any triangle comes within max(reach, reach_behind) of x (false: no
   // wall condition, contact or crossing can concern anything that close to x).
+  // A shear wall (kind 4) acts on the fluid mass within 'reach' of it: rate = nu / (delta reach)
+  // (set_kinematic_viscosity() first).
   int collect(const double x[3], double reach, double reach_behind, WallConstraint *out,
               bool *near = nullptr) const;
-  static void impose(const WallConstraint *c, int n, double vel[3]);
+  // h: the time over which a shear wall's stress acts (the grid update's step); h = 0 applies only
+  // its normal condition (a second pass over the same velocities, e.g. the MUSL remap, must not
+  // apply the stress again).
+  static void impose(const WallConstraint *c, int n, double vel[3], double h = 0.0);
+  // Kinematic viscosity of the fluid, for the shear walls (kind 4).
+  void set_kinematic_viscosity(double nu) { nu_ = nu; }
 
   // Nearest triangle face to x within 'reach' (the closest point inside a triangle, not on an edge
   // or vertex only): q = that point, n = unit normal towards x's side (the fluid side of a
@@ -135,6 +150,7 @@ class MeshWalls {
   double offset_ = 0.0;
   bool use_bins_ = true;
   double margin_ = 0.0;
+  double nu_ = 0.0;  // kinematic viscosity (shear walls)
   // uniform bins over [blo_, blo_ + nb_*bsize_]
   double blo_[3] = {0, 0, 0}, bsize_ = 1.0;
   int nb_[3] = {0, 0, 0};

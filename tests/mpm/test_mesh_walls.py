@@ -147,6 +147,18 @@ def case_drum(r):
     ratio = st["vcm_x"][1] / ns["vcm_x"][1]
     print(f"  sticky 0.5: vcm_x {st['vcm_x'][1]:.3f} m/s = {ratio:.2f} x noslip")
     check(0.3 < ratio < 0.75, f"sticky 0.5 drags about half as much as noslip (ratio {ratio:.2f} in 0.3..0.75)")
+    # shear delta f: wall stress mu (f w_t - v_t)/delta, relaxation rate nu/(delta dx) = 5e-5/delta 1/s
+    # here. A thin layer (rate 1e5 1/s: exp(-24) left after one step of 2.4e-4 s) is the no-slip
+    # (f = 1) and the imposed sticky (f = 0.5) wall in the limit; a thick one (rate 0.5 1/s: 2 % of
+    # the relaxation by 0.04 s) drags little.
+    sh = drum_run(r, "drum_shear_thin", "shear 5e-10 1")
+    sh5 = drum_run(r, "drum_shear_thin_half", "shear 5e-10 0.5")
+    thick = drum_run(r, "drum_shear_thick", "shear 1e-4 1")
+    for c, ref, name in ((sh, ns, "shear 5e-10 1 vs noslip"), (sh5, st, "shear 5e-10 0.5 vs sticky 0.5")):
+        check(abs(c["vcm_x"][1] - ref["vcm_x"][1]) <= 0.02 * abs(ref["vcm_x"][1]),
+              f"{name}: vcm_x {c['vcm_x'][1]:.4f} vs {ref['vcm_x'][1]:.4f} m/s within 2 %")
+    check(abs(thick["vcm_x"][1]) < 0.3 * abs(ns["vcm_x"][1]),
+          f"shear 1e-4 1 drags little: |vcm_x| {abs(thick['vcm_x'][1]):.3f} < 0.3 x {abs(ns['vcm_x'][1]):.3f}")
 
 
 def case_drum_np2(r):
@@ -164,7 +176,10 @@ def case_bad_input(r):
            ({"wallfix": "grav"}, "mesh/surface"),
            ({"kind": "partial 1.5"}, "[0,1]"),
            ({"kind": "sticky -0.5"}, "[0,1]"),
-           ({"fside": "sideways"}, "sideways")]
+           ({"fside": "sideways"}, "sideways"),
+           ({"kind": "shear 0 1"}, "positive wall layer thickness"),
+           ({"kind": "shear 1e-3 1.5"}, "fraction f in [0,1]"),
+           ({"kind": "shear 1e-3"}, "mesh_wall shear")]
     for i, (v, needle) in enumerate(bad):
         d, p = r.run(f"bad_input/{i}", "in.mesh_walls_box", "box.stl", dict(v, steps=10), expect_ok=False)
         ok = p.returncode != 0 and "ERROR" in p.stdout and needle in p.stdout

@@ -272,6 +272,51 @@ TEST_F(MeshWallsTest, MovingWallImposesItsVelocity) {
   EXPECT_FALSE(noslip.push_back(q, uq, 0.075));
 }
 
+// shear delta f: the tangential velocity relaxes towards f times the wall's over h with the exact
+// exponential of dv_t/dt = -nu/(delta reach) (v_t - f w_t); the normal condition is the free-slip
+// one; h = 0 (a second pass) leaves the tangential velocity alone.
+TEST_F(MeshWallsTest, ShearWallRelaxesTowardsAFractionOfTheWallVelocity) {
+  write_stl("plate.stl", plate_z(0, 1, 0, 1, 0.5));
+  make_box();
+  mesh("plate", "plate.stl");
+  cmd("fix slide all move/mesh mesh plate linear 0.5 0 2.0");
+  cmd("run 1");  // wall velocity (0.5, 0, 2)
+  MeshWallSpec s = spec("plate", 4, 0.5);
+  s.delta = 1e-3;
+  MeshWalls shear(lmp.get(), {s});
+  const double nu = 1e-6, reach = 0.075, h = 2e-3;
+  shear.set_kinematic_viscosity(nu);
+  shear.refresh(kAll[0], kAll[1], 0.1);
+  const double x[3] = {0.3, 0.6, 0.55};
+  const double keep = std::exp(-nu / (1e-3 * reach) * h);
+  double v[3] = {1.0, -0.4, 0.0};  // approaching the rising plate: normal part becomes 2
+  EXPECT_TRUE(shear.apply(x, v, reach, -1.0, h));
+  expect_v(v, 0.25 + keep * (1.0 - 0.25), keep * -0.4, 2.0);
+  // two steps of h equal one of 2h (the exponential is exact)
+  double a[3] = {1.0, -0.4, 3.0}, b[3] = {1.0, -0.4, 3.0};
+  shear.apply(x, a, reach, -1.0, h);
+  shear.apply(x, a, reach, -1.0, h);
+  shear.apply(x, b, reach, -1.0, 2 * h);
+  expect_v(a, b[0], b[1], b[2]);
+  // h = 0: only the normal condition
+  double c[3] = {1.0, -0.4, 0.0};
+  shear.apply(x, c, reach, -1.0, 0.0);
+  expect_v(c, 1.0, -0.4, 2.0);
+  // a long time: the tangential velocity is f times the wall's
+  double d[3] = {1.0, -0.4, 3.0};
+  shear.apply(x, d, reach, -1.0, 1e6);
+  expect_v(d, 0.25, 0.0, 3.0);
+  // a non-positive layer thickness is refused, naming the fix
+  s.delta = 0.0;
+  try {
+    MeshWalls bad(lmp.get(), {s});
+    ADD_FAILURE() << "no error for delta = 0";
+  } catch (const std::runtime_error &e) {
+    EXPECT_NE(std::string(e.what()).find("'plate'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("must be positive"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(MeshWallsTest, CrossingOfTwoSidedWallIsUndone) {
   write_stl("plate.stl", plate_z(0, 1, 0, 1, 0.5));
   make_box();
