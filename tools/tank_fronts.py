@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Fronts of the C3 tank runs (inputs/tank/in.tank) and their convergence against wall time.
 
-  tools/python tools/tank_fronts.py RUNDIR [RUNDIR ...] [--ref RUNDIR] [--labels L1 L2 ...]
+  tools/python tools/tank_fronts.py RUNDIR [RUNDIR ...] [--ref RUNDIR] [--labels L1 L2 ...] [--cpu]
         [--times 0.05 0.10 0.15 0.20] [--out PREFIX]
 
 Every RUNDIR is the work folder of one run of in.tank; it holds fronts.csv (t, x_water, x_beads,
@@ -66,11 +66,17 @@ def read_info(rundir):
     return info
 
 
-def wall_time(rundir):
-    """Seconds: /usr/bin/time output (time.txt), else the sum of LIGGGHTS loop times."""
+def wall_time(rundir, cpu=False):
+    """Seconds: /usr/bin/time output (time.txt), else the sum of LIGGGHTS loop times. cpu: the
+    user + system time of time.txt instead of the elapsed time (runs that shared the cores)."""
     p = os.path.join(rundir, "time.txt")
     if os.path.exists(p):
         txt = open(p).read()
+        if cpu:
+            u = re.search(r"User time \(seconds\):\s*([\d.]+)", txt)
+            k = re.search(r"System time \(seconds\):\s*([\d.]+)", txt)
+            if u and k:
+                return float(u.group(1)) + float(k.group(1)), "cpu"
         m = re.search(r"Elapsed \(wall clock\) time[^:]*:\s*([\d:.]+)", txt)
         if not m:
             m = re.search(r"([\d:.]+)elapsed", txt)
@@ -114,6 +120,9 @@ def main():
     ap.add_argument("--labels", nargs="+", default=None)
     ap.add_argument("--times", type=float, nargs="+", default=[0.05, 0.10, 0.15, 0.20])
     ap.add_argument("--out", default="tank", help="output prefix")
+    ap.add_argument("--cpu", action="store_true",
+                    help="cost = user + system time of time.txt (/usr/bin/time -v) instead of the wall "
+                         "time: for runs that shared the cores")
     ap.add_argument("--pct", type=float, default=99.0, help="percentile of the snapshot table")
     a = ap.parse_args()
 
@@ -125,7 +134,7 @@ def main():
             continue
         info = read_info(d)
         c = read_csv(p)
-        wt, src = wall_time(d)
+        wt, src = wall_time(d, a.cpu)
         lab = a.labels[k] if a.labels and k < len(a.labels) else label_of(info, d)
         npc = info.get("pnx", 1) * info.get("pny", 1) * info.get("pnz", 1)
         runs.append(dict(dir=d, info=info, c=c, wall=wt, wsrc=src, label=lab,
@@ -258,7 +267,7 @@ def main():
         for rw in grp:
             ax.annotate(rw["run"], (rw["wall"], max(rw["rms_water"], 1e-6)), fontsize=7,
                         textcoords="offset points", xytext=(4, 4))
-    ax.set_xlabel("wall time (s)")
+    ax.set_xlabel("CPU time, user + system (s)" if a.cpu else "wall time (s)")
     ax.set_ylabel("RMS difference from %s (m)" % ref["label"])
     ax.set_title("C3 tank: convergence against cost")
     ax.grid(alpha=0.3, which="both")
