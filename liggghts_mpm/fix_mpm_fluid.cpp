@@ -276,7 +276,7 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
     } else if (strcmp(kw, "update") == 0) {
       choice(kw, "musl", "usl", musl);
     } else if (strcmp(kw, "boundary") == 0) {
-      need(iarg, 2, kw, "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip' or 'partial f'");
+      need(iarg, 2, kw, "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip', 'partial f' or 'shear delta'");
       parse_face(arg[iarg + 1], arg[iarg + 2], narg, arg, iarg);
     } else if (strcmp(kw, "gate") == 0) {
       need(iarg, 4, kw, "'dim pos lower|upper release_time'");
@@ -500,8 +500,15 @@ void FixMpmFluid::parse_face(const char *name, const char *kind, int narg, char 
       bad_arg("boundary partial", "a sticky fraction in [0,1]", arg[iarg + 3]);
     fc.kind = BC_PARTIAL;
     used = 4;
+  } else if (strcmp(kind, "shear") == 0) {
+    if (iarg + 3 >= narg) bad_arg("boundary shear", "a positive wall layer thickness delta (length)", nullptr);
+    if (!parse_double(arg[iarg + 3], fc.delta) || !(fc.delta > 0.0))
+      bad_arg("boundary shear", "a positive wall layer thickness delta (length)", arg[iarg + 3]);
+    fc.kind = BC_SHEAR;
+    fc.sticky = 0.0;
+    used = 4;
   } else
-    bad_arg("boundary", "'noslip', 'freeslip' or 'partial f'", kind);
+    bad_arg("boundary", "'noslip', 'freeslip', 'partial f' or 'shear delta'", kind);
   for (int f = f0; f <= f1; ++f) face[f] = fc;
   iarg += used;
 }
@@ -1573,8 +1580,12 @@ void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k, double h) {
     else if (idx[d] >= gspec.ncell[d])
       fc = 2 * d + 1;
     if (fc < 0) continue;
-    // normal component: no penetration; tangential: keep (1 - sticky) of it
-    const double keep = 1.0 - face[fc].sticky;
+    // normal component: no penetration; tangential: keep (1 - sticky) of it, or for a shear
+    // face the exact decay over h under the wall stress mu v_t / delta on the fluid within a cell
+    // of the face, rate nu / (delta dx) (as mesh_wall ... shear, docs/mesh_walls.md)
+    const double keep = face[fc].kind == BC_SHEAR
+                            ? std::exp(-h * viscosity / (eos.rho0 * face[fc].delta * gspec.dx))
+                            : 1.0 - face[fc].sticky;
     for (int e = 0; e < 3; ++e) vel[e] = (e == d) ? 0.0 : keep * vel[e];
   }
   if (mesh_walls) {
@@ -1992,7 +2003,7 @@ int FixMpmFluid::modify_param(int narg, char **arg) {
     return 2;
   }
   if (strcmp(arg[0], "boundary") == 0) {
-    if (narg < 3) bad_arg("fix_modify boundary", "a face and 'noslip', 'freeslip' or 'partial f'", nullptr);
+    if (narg < 3) bad_arg("fix_modify boundary", "a face and 'noslip', 'freeslip', 'partial f' or 'shear delta'", nullptr);
     int iarg = 0;  // arg[0] is the keyword, as in the fix command
     parse_face(arg[1], arg[2], narg, arg, iarg);
     return iarg;

@@ -78,8 +78,9 @@ class FixMpmFluid : public Fix {
 
  private:
   using PointShape = mpm::Stencil;
-  enum BcKind { BC_NOSLIP, BC_FREESLIP, BC_PARTIAL };
-  struct Face { int kind = BC_NOSLIP; double sticky = 1.0; };
+  enum BcKind { BC_NOSLIP, BC_FREESLIP, BC_PARTIAL, BC_SHEAR };
+  // BC_SHEAR: wall stress mu v_t / delta of an unresolved wall layer delta (docs/mesh_walls.md)
+  struct Face { int kind = BC_NOSLIP; double sticky = 1.0; double delta = 0.0; };
   struct Gate {
     bool active = false;
     int dim = 0;

@@ -182,6 +182,25 @@ def case_dambreak_reduced(r):
     check(f["x_front"][-1] > 4.0 * 4.0, "front travelled beyond x = 4a by T = 3")
 
 
+def case_shear_face(r):
+    """Grid face 'shear delta' (wall stress mu v_t / delta, rate nu / (delta dx)): a very thin layer
+    is the no-slip floor, a very thick one the free-slip floor, a layer in between lies between."""
+    runs = {}
+    for name, floor in (("noslip", "noslip"), ("freeslip", "freeslip"), ("thin", "shear 1e-12"),
+                        ("thick", "shear 1e3"), ("mid", "shear 1e-6")):
+        d, _ = r.dambreak(f"shear_face/{name}", cells=8, tend=1.5, floor=floor)
+        runs[name] = read_csv(os.path.join(d, "front.csv"))["x_front"]
+    # rate nu / (delta dx) with nu = 1e-6, dx = 0.5: 2e6 1/s (thin: exp(-2e6 h) = 0 each step),
+    # 2e-9 1/s (thick: a factor 1 - 1e-12 per step), 2 1/s (mid: half the slip gone in 0.35 s)
+    ns, fs, th, tk, md = (runs[k][-1] for k in ("noslip", "freeslip", "thin", "thick", "mid"))
+    print(f"  front at T = 1.5: noslip {ns:.6f}, freeslip {fs:.6f}, shear 1e-12 {th:.6f}, "
+          f"shear 1e3 {tk:.6f}, shear 1e-6 {md:.6f} m")
+    check(abs(th - ns) <= 1e-9 * ns, "shear 1e-12 gives the no-slip front")
+    check(abs(tk - fs) <= 1e-6 * fs, "shear 1e3 gives the free-slip front")
+    check(fs > ns, "the free-slip front runs ahead of the no-slip one")
+    check(ns < md < fs, "shear 1e-6 lies between no-slip and free-slip")
+
+
 def case_np2_vs_np1(r):
     """2 MPI ranks against 1: the front crosses the subdomain boundary at x = 6."""
     v = dict(cells=8, length=12.0, tend=2.0)
@@ -226,6 +245,8 @@ def case_bad_input(r):
         (base + " shape cubic", "keyword 'shape' expects 'linear' or 'bspline2'"),
         (base + " boundary xlo sticky", "keyword 'boundary' expects"),
         (base + " boundary xlo partial 1.5", "'boundary partial' expects a sticky fraction in [0,1]"),
+        (base + " boundary zlo shear 0", "'boundary shear' expects a positive wall layer thickness"),
+        (base + " boundary zlo shear", "'boundary shear' expects a positive wall layer thickness"),
         (base + " transfer flip 2", "'transfer flip' expects a FLIP fraction"),
         (base + " grid 0 2 0 2 0 9", "bounds must lie inside the simulation box"),
         (base + " gate x 7 lower 0.1", "keyword 'gate' expects a position inside the grid"),
