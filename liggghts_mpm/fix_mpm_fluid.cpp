@@ -1584,7 +1584,7 @@ void FixMpmFluid::apply_grid_bc(double *vel, int i, int j, int k, double h) {
     // face the exact decay over h under the wall stress mu v_t / delta on the fluid within a cell
     // of the face, rate nu / (delta dx) (as mesh_wall ... shear, docs/mesh_walls.md)
     const double keep = face[fc].kind == BC_SHEAR
-                            ? std::exp(-h * viscosity / (eos.rho0 * face[fc].delta * gspec.dx))
+                            ? std::exp(-h * mpm::wall_layer_rate(viscosity / eos.rho0, face[fc].delta, gspec.dx))
                             : 1.0 - face[fc].sticky;
     for (int e = 0; e < 3; ++e) vel[e] = (e == d) ? 0.0 : keep * vel[e];
   }

@@ -574,7 +574,7 @@ int MeshWalls::collect(const double x[3], double reach_fluid, double reach_behin
       wall_velocity(t, hits[h].b, o.w);
       for (int q = 0; q < 3; ++q) o.n[q] = n[q];
       o.sticky = sticky;
-      o.rate = specs_[k].kind == 4 ? nu_ / (specs_[k].delta * reach_fluid) : 0.0;
+      o.rate = specs_[k].kind == 4 ? wall_layer_rate(nu_, specs_[k].delta, reach_fluid) : 0.0;
       o.behind = behind;
       o.imposed = specs_[k].kind == 3;
     }

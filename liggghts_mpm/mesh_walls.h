@@ -43,6 +43,11 @@ struct WallConstraint {
   bool imposed;
 };
 
+// Relaxation rate (1/time) of the tangential slip of the fluid within 'depth' of a wall whose
+// unresolved viscous layer of thickness delta carries the stress mu v_slip / delta: the law of the
+// shear kinds of mesh walls and grid faces (docs/mesh_walls.md).
+inline double wall_layer_rate(double nu, double delta, double depth) { return nu / (delta * depth); }
+
 struct MeshWallSpec {
   std::string fix_id;  // ID of a fix mesh/surface (or a style derived from it)
   int kind = 0;        // 0 noslip, 1 freeslip, 2 partial, 3 sticky (imposed fraction of the wall's
