@@ -12,6 +12,9 @@ turns on; the experiment (Sun et al. 2013): 62.18 mm, standard deviation 1.71 mm
 
   tools/python tools/jar_altitude.py RUNDIR [RUNDIR ...] [--from-turn 1] [--out jar_altitude]
 Writes OUT.csv (run,t,turn,altitude_mm,zmax_mm,nbed) and OUT.png.
+It also checks each run's jar.csv (rows of a resumed run replace the rows after its restart
+step): the fluid mass (largest relative deviation from the first row), non-finite values, and the
+largest point pressure (median / 95th percentile / largest from --from-turn on).
 """
 import argparse
 import glob
@@ -78,6 +81,41 @@ def analyse(d, contacts, gap):
     return info, rows
 
 
+def read_jar_csv(d):
+    """jar.csv as {column: array}, one row per time (a resumed run appends the rows after its
+    restart step again: the last one of each time is kept), or None."""
+    path = os.path.join(d, "jar.csv")
+    if not os.path.exists(path):
+        return None
+    rows, names = {}, None
+    with open(path) as f:
+        for line in f:
+            line = line.strip()
+            if not line or line.startswith("#"):
+                continue
+            if names is None:
+                names = line.split(",")
+                continue
+            v = [float(x) for x in line.split(",")]
+            rows[v[0]] = v
+    data = np.array([rows[t] for t in sorted(rows)]) if rows else np.zeros((0, len(names)))
+    return {n: data[:, k] for k, n in enumerate(names)}
+
+
+def csv_summary(c, from_turn):
+    """One line on the fluid mass, the finiteness and the largest pressure of a jar.csv."""
+    if c is None or len(c["t"]) == 0:
+        return "no jar.csv rows"
+    finite = all(np.isfinite(v).all() for v in c.values())
+    m = c["mass"]
+    dev = np.abs(m - m[0]).max() / m[0]
+    p = c["pmax"][c["turn"] >= from_turn]
+    ptxt = (f"largest pressure median {np.median(p) / 1e3:.1f} / 95 % {np.percentile(p, 95) / 1e3:.1f} / "
+            f"max {p.max() / 1e3:.1f} kPa" if len(p) else "no pressure rows yet")
+    return (f"jar.csv: {len(m)} rows to turn {c['turn'][-1]:.2f}, {'all finite' if finite else 'NON-FINITE VALUES'}, "
+            f"fluid mass {m[0]:.15g} kg (largest rel. deviation {dev:.1e}), {ptxt}")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+")
@@ -95,6 +133,7 @@ def main():
         label = f"{os.path.basename(os.path.normpath(d))} ({info.get('wall', '?')}, cells {info.get('cells', '?')})"
         steady = np.array([r[2] for r in rows if r[1] >= a.from_turn])
         print(f"{label}: {len(rows)} dumps up to turn {rows[-1][1]:.2f}")
+        print("  " + csv_summary(read_jar_csv(d), a.from_turn))
         if len(steady):
             print(f"  steady state (turn >= {a.from_turn}): bed altitude {steady.mean():.2f} mm "
                   f"(std {steady.std():.2f} mm, {len(steady)} dumps); experiment {EXPERIMENT_MM} mm "
