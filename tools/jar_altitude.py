@@ -43,7 +43,7 @@ def read_dump(path):
         lines = f.readlines()
     i = next(k for k, l in enumerate(lines) if l.startswith("ITEM: ATOMS"))
     cols = lines[i].split()[2:]
-    data = np.array([l.split() for l in lines[i + 1:] if l.strip()], dtype=float)
+    data = np.loadtxt(lines[i + 1:], ndmin=2) if len(lines) > i + 1 else np.zeros((0, len(cols)))
     if data.size == 0:
         return np.zeros((0, 3)), np.zeros(0)
     c = {name: k for k, name in enumerate(cols)}
@@ -55,11 +55,19 @@ def bed_altitude(x, rad, contacts=3, gap=1.2):
     if len(x) == 0:
         return float("nan"), float("nan"), 0
     d = 2.0 * rad.max()
-    cut2 = (gap * d) ** 2
-    nnb = np.zeros(len(x), dtype=int)
-    for a in range(0, len(x), 1000):
-        dd = ((x[a:a + 1000, None, :] - x[None, :, :]) ** 2).sum(axis=2)
-        nnb[a:a + 1000] = (dd < cut2).sum(axis=1) - 1
+    cut = gap * d
+    # neighbour counts: beads sorted by z, each block of 256 against the beads within cut in z
+    order = np.argsort(x[:, 2], kind="stable")
+    xs = x[order]
+    z = xs[:, 2]
+    nnb_sorted = np.zeros(len(x), dtype=int)
+    for a in range(0, len(x), 256):
+        b = min(a + 256, len(x))
+        lo, hi = np.searchsorted(z, z[a] - cut, "left"), np.searchsorted(z, z[b - 1] + cut, "right")
+        dd = ((xs[a:b, None, :] - xs[None, lo:hi, :]) ** 2).sum(axis=2)
+        nnb_sorted[a:b] = (dd < cut * cut).sum(axis=1) - 1
+    nnb = np.empty_like(nnb_sorted)
+    nnb[order] = nnb_sorted
     top = x[:, 2] + rad
     bed = nnb >= contacts
     alt = top[bed].max() if bed.any() else float("nan")
