@@ -24,6 +24,10 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from render_tank import read_dump  # noqa: E402  (LIGGGHTS dump reader shared with the snapshot tools)
+from tank_fronts import read_csv  # noqa: E402  (csv reader that drops repeated times)
+
 EXPERIMENT_MM, EXPERIMENT_STD_MM = 62.18, 1.71
 
 
@@ -35,19 +39,6 @@ def read_info(d):
                 k, v = line.split("=", 1)
                 info[k.strip()] = v.strip()
     return info
-
-
-def read_dump(path):
-    """Positions (N x 3) and radii of a LIGGGHTS custom dump with columns id type x y z ... radius."""
-    with open(path) as f:
-        lines = f.readlines()
-    i = next(k for k, l in enumerate(lines) if l.startswith("ITEM: ATOMS"))
-    cols = lines[i].split()[2:]
-    data = np.loadtxt(lines[i + 1:], ndmin=2) if len(lines) > i + 1 else np.zeros((0, len(cols)))
-    if data.size == 0:
-        return np.zeros((0, 3)), np.zeros(0)
-    c = {name: k for k, name in enumerate(cols)}
-    return data[:, [c["x"], c["y"], c["z"]]], data[:, c["radius"]]
 
 
 def bed_altitude(x, rad, contacts=3, gap=1.2):
@@ -83,31 +74,19 @@ def analyse(d, contacts, gap):
         if step < n0:
             continue
         t = (step - n0) * dt
-        alt, zmax, nbed = bed_altitude(*read_dump(path), contacts=contacts, gap=gap)
+        b = read_dump(path)
+        x = np.column_stack((b["x"], b["y"], b["z"])) if len(b["x"]) else np.zeros((0, 3))
+        alt, zmax, nbed = bed_altitude(x, b["radius"], contacts=contacts, gap=gap)
         rows.append((t, t / period, 1e3 * alt, 1e3 * zmax, nbed))
     rows.sort()
     return info, rows
 
 
 def read_jar_csv(d):
-    """jar.csv as {column: array}, one row per time (a resumed run appends the rows after its
-    restart step again: the last one of each time is kept), or None."""
+    """jar.csv as {column: array}, one row per time (tank_fronts.read_csv keeps the last row of a
+    time that a resumed run wrote again), or None."""
     path = os.path.join(d, "jar.csv")
-    if not os.path.exists(path):
-        return None
-    rows, names = {}, None
-    with open(path) as f:
-        for line in f:
-            line = line.strip()
-            if not line or line.startswith("#"):
-                continue
-            if names is None:
-                names = line.split(",")
-                continue
-            v = [float(x) for x in line.split(",")]
-            rows[v[0]] = v
-    data = np.array([rows[t] for t in sorted(rows)]) if rows else np.zeros((0, len(names)))
-    return {n: data[:, k] for k, n in enumerate(names)}
+    return read_csv(path) if os.path.exists(path) else None
 
 
 def csv_summary(c, from_turn):
