@@ -4,7 +4,8 @@
 set -euo pipefail
 pkgs=(cmake ninja-build g++ make pkg-config
       liggghts libliggghts-dev libeigen3-dev libopenmpi-dev openmpi-bin
-      libhdf5-dev libgtest-dev python3 python3-venv)
+      libhdf5-dev libgtest-dev python3 python3-venv
+      libhypre-dev libcli11-dev libtomlplusplus-dev nlohmann-json3-dev)
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
