@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Whole-program tests of liggghts_mpm / fix mpm/fluid at reduced size.
 
-Each case runs the executable on an input of inputs/ (or tests/mpm) in its own
+Each case runs the executable on an input of inputs/ (or tests/data) in its own
 work folder and checks its outputs against stated tolerances. Standard library
 only, so that CTest needs no virtual environment.
 
@@ -17,6 +17,7 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+DATA = os.path.join(HERE, "..", "data")  # input scripts and STL files of the cases
 FAILURES = []
 
 
@@ -217,7 +218,7 @@ def case_np2_vs_np1(r):
 
 def case_restart_roundtrip(r):
     """write_restart / read_restart continue a run exactly."""
-    inp = os.path.join(HERE, "in.restart")
+    inp = os.path.join(DATA, "in.restart")
     d0, _ = r.run("restart/full", inp, {"mode": 0})
     d1, _ = r.run("restart/split", inp, {"mode": 1})
     # the second half runs in the same folder, from restart.mpm
@@ -422,7 +423,7 @@ def case_every(r):
 def case_buoyancy_floor(r):
     """A grain at rest in a fluid at rest gets Archimedes' force, also next to the floor: the
     pressure gradient at the grain comes from linear fits of the cell pressures (cell = 3 d)."""
-    inp = os.path.join(os.path.dirname(os.path.abspath(__file__)), "in.buoyancy")
+    inp = os.path.join(DATA, "in.buoyancy")
     for zg, tol in ((0.0005, 0.2), (0.0015, 0.2), (0.006, 0.03), (0.012, 0.01)):
         _, p = r.run(f"buoyancy_floor/z{zg}", inp, {"zg": zg})
         m = re.search(r"RESULT zg \S+ ratio (\S+)", p.stdout)

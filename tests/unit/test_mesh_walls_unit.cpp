@@ -4,8 +4,8 @@
 // material points. Runs on 1 or 2 MPI ranks (the 2-rank run checks the triangle gathering across
 // ranks and periodic images).
 //
-// Build by hand from the repository root (until it is in tests/mpm/CMakeLists.txt):
-//   mpicxx -std=c++17 -O2 -Iliggghts_mpm -I/usr/include/liggghts tests/mpm/test_mesh_walls_unit.cpp liggghts_mpm/mesh_walls.cpp -o build/test_mesh_walls_unit -lliggghts -lgtest -pthread
+// Build by hand from the repository root (CTest builds it: tests/unit/CMakeLists.txt):
+//   mpicxx -std=c++17 -O2 -Iliggghts_mpm -I/usr/include/liggghts tests/unit/test_mesh_walls_unit.cpp liggghts_mpm/mesh_walls.cpp -o build/test_mesh_walls_unit -lliggghts -lgtest -pthread
 //   build/test_mesh_walls_unit
 //   mpirun --allow-run-as-root --oversubscribe -np 2 build/test_mesh_walls_unit
 // (own main(): MPI_Init before GoogleTest; do not link gtest_main.)

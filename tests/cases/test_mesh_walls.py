@@ -6,8 +6,8 @@ fix mpm/fluid, liggghts_mpm/mesh_walls.h; docs/mesh_walls.md). Standard library 
                             [--unit build/test_mesh_walls_unit]
 
 CASE is one of: box, box_np2, gate, gate_np2, drum, drum_np2, bad_input, unit, unit_np2, all.
-The inputs are tests/mpm/in.mesh_walls_box, in.mesh_walls_gate and in.mesh_walls_drum with the
-STL files tests/mpm/box.stl, gate.stl and drum.stl. Exit status 0 when every check passes.
+The inputs are tests/data/in.mesh_walls_box, in.mesh_walls_gate and in.mesh_walls_drum with the
+STL files tests/data/box.stl, gate.stl and drum.stl. Exit status 0 when every check passes.
 """
 import argparse
 import os
@@ -15,6 +15,7 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+DATA = os.path.join(HERE, "..", "data")
 
 
 # the same check/CSV helpers as the other whole-program cases
@@ -31,8 +32,8 @@ class Runner(cases.Runner):
         self.unit = os.path.abspath(a.unit) if a.unit else None
 
     def run(self, case, infile, stl, variables, np=1, expect_ok=True):
-        return super().run(case, os.path.join(HERE, infile), variables, np, expect_ok,
-                           extra_files=(os.path.join(HERE, stl),))
+        return super().run(case, os.path.join(DATA, infile), variables, np, expect_ok,
+                           extra_files=(os.path.join(DATA, stl),))
 
 
 # ---------------------------------------------------------------- cases
