@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <sstream>
@@ -18,28 +17,13 @@
 #include "group.h"
 #include "irregular.h"
 #include "modify.h"
+#include "mpm/args.h"
 #include "neighbor.h"
 #include "update.h"
 
 using namespace LAMMPS_NS;
-
-namespace {
-
-bool parse_double(const char *s, double &v) {
-  char *end = nullptr;
-  v = std::strtod(s, &end);
-  return end != s && *end == '\0' && std::isfinite(v);
-}
-
-bool parse_int(const char *s, int &v) {
-  char *end = nullptr;
-  const long l = std::strtol(s, &end, 10);
-  if (end == s || *end != '\0' || l < 0 || l > std::numeric_limits<int>::max()) return false;
-  v = static_cast<int>(l);
-  return true;
-}
-
-}  // namespace
+using mpm::parse_double;
+using mpm::parse_int;
 
 /* ----------------------------------------------------------------------
    fix ID group-ID balance/mpm dim x|y|z [every N] [weight group-ID w]... [volume w] [thresh t]
@@ -51,11 +35,11 @@ FixBalanceMpm::FixBalanceMpm(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg,
     const char *kw = arg[iarg];
     const char *v = iarg + 1 < narg ? arg[iarg + 1] : nullptr;
     if (strcmp(kw, "dim") == 0) {
-      if (!v || strlen(v) != 1 || !strchr("xyz", v[0])) bad_arg(kw, "x, y or z", v);
-      dim_ = v[0] - 'x';
+      dim_ = mpm::axis_of(v);
+      if (dim_ < 0) bad_arg(kw, "x, y or z", v);
       iarg += 2;
     } else if (strcmp(kw, "every") == 0) {
-      if (!v || !parse_int(v, every_)) bad_arg(kw, "a number of steps >= 0", v);
+      if (!v || !parse_int(v, every_, 0)) bad_arg(kw, "a number of steps >= 0", v);
       iarg += 2;
     } else if (strcmp(kw, "thresh") == 0) {
       if (!v || !parse_double(v, thresh_) || thresh_ < 1.0) bad_arg(kw, "an imbalance factor >= 1", v);
