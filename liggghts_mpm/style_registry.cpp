@@ -1,5 +1,7 @@
 #include "style_registry.h"
 
+#include <cstdio>
+#include <cstring>
 #include <map>
 #include <string>
 
@@ -29,15 +31,63 @@ struct FixMapAccess {
 };
 template struct FixMapAccess<&Modify::fix_map>;
 
+// LAMMPS::help() is private too; the same explicit instantiation gives its
+// pointer-to-member.
+typedef void (LAMMPS::*HelpMember)();
+
+HelpMember lammps_help();
+
+template <HelpMember M>
+struct HelpAccess {
+  friend HelpMember lammps_help() { return M; }
+};
+template struct HelpAccess<&LAMMPS::help>;
+
 template <class T>
 Fix *create_fix(LAMMPS *lmp, int narg, char **arg) {
   return new T(lmp, narg, arg);
 }
 
+// Every fix style of this project: the one list registration and help use.
+struct FixStyle {
+  const char *name;
+  FixCreatorFn create;
+};
+const FixStyle kFixStyles[] = {
+    {"balance/mpm", &create_fix<FixBalanceMpm>},
+    {"mpm/fluid", &create_fix<FixMpmFluid>},
+};
+
 }  // namespace
 
 void mpm::register_styles(LAMMPS *lmp) {
   std::map<std::string, FixCreatorFn> &fixes = *(lmp->modify->*modify_fix_map());
-  fixes["mpm/fluid"] = &create_fix<FixMpmFluid>;
-  fixes["balance/mpm"] = &create_fix<FixBalanceMpm>;
+  for (const FixStyle &s : kFixStyles) fixes[s.name] = s.create;
+}
+
+std::vector<std::string> mpm::fix_style_names() {
+  std::vector<std::string> names;
+  for (const FixStyle &s : kFixStyles) names.push_back(s.name);
+  return names;
+}
+
+void mpm::print_help(LAMMPS *lmp, const char *version) {
+  (lmp->*lammps_help())();
+  FILE *out = lmp->screen;
+  if (!out) return;
+  // LIGGGHTS' layout: a '* ... styles' heading, then the names in columns of
+  // 32 characters, five to a line.
+  std::fprintf(out, "\n* Fix styles added by liggghts_mpm %s (pages: docs/fix_<name, / as _>.md):\n\n", version);
+  int column = 0;
+  for (const FixStyle &s : kFixStyles) {
+    const int width = std::strlen(s.name) < 32 ? 32 : 64;
+    if (column + width > 160) {
+      std::fprintf(out, "\n");
+      column = 0;
+    }
+    std::fprintf(out, "%-*s", width, s.name);
+    column += width;
+  }
+  std::fprintf(out, "\n\n");
+  std::fflush(out);
 }
