@@ -13,6 +13,8 @@ import sys
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from mpm_io import read_csv  # noqa: E402,F401  (also used as dambreak_error.read_csv by bench.py)
 DATA = os.path.normpath(os.path.join(HERE, "..", "..", "shared", "data"))
 
 
@@ -23,15 +25,6 @@ def find_data(name):
         if d and os.path.exists(p):
             return p
     raise FileNotFoundError(name + " (set MPM_SHARED_DATA to the folder with the reference data)")
-
-
-def read_csv(path):
-    """A CSV with '#' comment lines and one header line, as a dict of columns."""
-    with open(path) as f:
-        rows = [ln.strip() for ln in f if ln.strip() and not ln.lstrip().startswith("#")]
-    names = rows[0].split(",")
-    vals = np.array([[float(v) for v in r.split(",")] for r in rows[1:]]).reshape(-1, len(names))
-    return {n: vals[:, i] for i, n in enumerate(names)}
 
 
 def input_defaults(path):

@@ -41,6 +41,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 TOP = os.path.normpath(os.path.join(HERE, ".."))
 sys.path.insert(0, HERE)
 import dambreak_error  # noqa: E402
+from mpm_io import read_csv  # noqa: E402
 
 INPUT = os.path.join(TOP, "inputs", "dambreak", "in.dambreak")
 EXE = os.path.join(TOP, "build", "liggghts_mpm")
@@ -107,7 +108,7 @@ def front_ok(csvpath, tend_s):
     if not os.path.exists(csvpath):
         return "no front.csv"
     try:
-        d = dambreak_error.read_csv(csvpath)
+        d = read_csv(csvpath)
     except Exception as e:  # noqa: BLE001
         return "unreadable front.csv (%s)" % e
     if len(d["t"]) < 2:
@@ -282,7 +283,7 @@ def plots(rows, cases, a, width, g):
             if not os.path.exists(p):
                 continue
             try:
-                d = dambreak_error.read_csv(p)
+                d = read_csv(p)
             except Exception:  # noqa: BLE001
                 continue
             T = d["t"] * math.sqrt(g / width)

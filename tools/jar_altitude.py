@@ -17,28 +17,20 @@ step): the fluid mass (largest relative deviation from the first row), non-finit
 largest point pressure (median / 95th percentile / largest from --from-turn on).
 """
 import argparse
-import glob
 import os
-import re
 import sys
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from render_tank import read_dump  # noqa: E402  (LIGGGHTS dump reader shared with the snapshot tools)
-from tank_fronts import read_csv  # noqa: E402  (csv reader that drops repeated times)
+from mpm_io import dump_series, read_csv, read_dump, read_key_values  # noqa: E402
 
 EXPERIMENT_MM, EXPERIMENT_STD_MM = 62.18, 1.71
 
 
 def read_info(d):
-    info = {}
-    with open(os.path.join(d, "jar_run.txt")) as f:
-        for line in f:
-            if "=" in line:
-                k, v = line.split("=", 1)
-                info[k.strip()] = v.strip()
-    return info
+    """jar_run.txt of a run folder (written by in.jar) as {key: string}."""
+    return read_key_values(os.path.join(d, "jar_run.txt"))
 
 
 def bed_altitude(x, rad, contacts=3, gap=1.2):
@@ -69,8 +61,7 @@ def analyse(d, contacts, gap):
     info = read_info(d)
     dt, n0, period = float(info["dt"]), int(float(info["rot_start_step"])), float(info["period"])
     rows = []
-    for path in glob.glob(os.path.join(d, "beads_*.dump")):
-        step = int(re.search(r"beads_(\d+)\.dump$", path).group(1))
+    for step, path in dump_series(d, "beads").get("beads", {}).items():
         if step < n0:
             continue
         t = (step - n0) * dt
@@ -83,10 +74,10 @@ def analyse(d, contacts, gap):
 
 
 def read_jar_csv(d):
-    """jar.csv as {column: array}, one row per time (tank_fronts.read_csv keeps the last row of a
-    time that a resumed run wrote again), or None."""
+    """jar.csv as {column: array}, one row per time (the last row of a time that a resumed run
+    wrote again), or None."""
     path = os.path.join(d, "jar.csv")
-    return read_csv(path) if os.path.exists(path) else None
+    return read_csv(path, keep_last_of="t") if os.path.exists(path) else None
 
 
 def csv_summary(c, from_turn):

@@ -16,10 +16,8 @@ Geometry (width a, height, length, g, ppc) is read from RUNDIR/in.dambreak if
 present (override with --width/--length/--g).
 """
 import argparse
-import glob
 import math
 import os
-import re
 import sys
 
 import numpy as np
@@ -27,30 +25,12 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import dambreak_error  # noqa: E402
-
-
-def frames(rundir, prefix):
-    import h5py
-    out = []
-    for p in sorted(glob.glob(os.path.join(rundir, prefix + "_*.h5"))):
-        try:
-            with h5py.File(p, "r") as f:
-                t = float(np.ravel(f.attrs["time"])[0])
-        except (OSError, KeyError):
-            continue
-        out.append((t, p))
-    out.sort()
-    return out
+from mpm_io import h5_series, read_csv, read_points  # noqa: E402
 
 
 def load(path, field):
-    import h5py
-    with h5py.File(path, "r") as f:
-        xyz = f["points/xyz"][()]
-        if field == "p":
-            val = f["points/p"][()]
-        else:
-            val = np.linalg.norm(f["points/v"][()], axis=1)
+    xyz, vals, _ = read_points(path, ["p"] if field == "p" else ["v"])
+    val = vals["p"] if field == "p" else np.linalg.norm(vals["v"], axis=1)
     return xyz[:, 0], xyz[:, 2], val
 
 
@@ -84,7 +64,7 @@ def main():
     g = a.g or float(d.get("g", 9.81))
     tscale = math.sqrt(g / width)
 
-    fr = frames(a.rundir, a.prefix)
+    fr = h5_series(a.rundir, a.prefix)
     if not fr:
         sys.exit("no %s_*.h5 in %s (run with -var h5every N)" % (a.prefix, a.rundir))
     Tf = np.array([(t - a.tsettle) * tscale for t, _ in fr])
@@ -165,7 +145,7 @@ def main():
     cb.ax.tick_params(labelsize=8)
 
     if with_front:
-        sim = dambreak_error.read_csv(a.front)
+        sim = read_csv(a.front)
         T = sim["t"] * tscale
         x0 = 1 - 4.15 / figw
         w = 3.75 / figw

@@ -21,7 +21,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from jar_altitude import EXPERIMENT_MM, read_info  # noqa: E402
-from render_tank import BEADS, WATER, frames, read_dump, read_points  # noqa: E402
+from mpm_io import BEADS, WATER, paired_frames, read_dump, read_points  # noqa: E402
 
 
 def main():
@@ -45,7 +45,7 @@ def main():
     dt, n0, period = float(info["dt"]), int(float(info["rot_start_step"])), float(info["period"])
     D, d = float(info.get("D", 0.1)), float(info.get("d", 0.0027))
     dx = float(info.get("dx", D / 18))
-    fr = frames(a.rundir, "jar")
+    fr = paired_frames(a.rundir, "jar")
     if not fr:
         sys.exit("render_jar: no frame with both jar_*.h5 and beads_*.dump in %s" % a.rundir)
     steps = np.array(sorted(fr))
@@ -61,7 +61,7 @@ def main():
         s = int(steps[np.argmin(np.abs(steps - (n0 + turn * period / dt)))])
         ts = (s - n0) * dt
         h5, dump = fr[s]
-        xyz = read_points(h5)
+        xyz = read_points(h5)[0]
         b = read_dump(dump)
         if a.slab:
             xyz = xyz[(xyz[:, 1] > a.slab[0]) & (xyz[:, 1] < a.slab[1])]

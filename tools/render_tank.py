@@ -16,52 +16,13 @@ on top, like Figures 9.3 and 10.5 of the dissertation. The tank outline is black
 (grey) is drawn at its height at that time. Top view: x along the tank, y across.
 """
 import argparse
-import glob
 import os
-import re
 import sys
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from tank_fronts import read_info  # noqa: E402  (tank_run.txt reader shared with the fronts tool)
-
-WATER = "#8ecae6"   # light blue
-BEADS = "#08306b"   # dark blue
-
-
-def read_dump(path):
-    """LIGGGHTS/LAMMPS 'dump custom' text file (one frame) -> dict column -> array."""
-    with open(path) as f:
-        lines = f.read().splitlines()
-    i = lines.index("ITEM: NUMBER OF ATOMS")
-    n = int(lines[i + 1])
-    j = next(k for k, s in enumerate(lines) if s.startswith("ITEM: ATOMS"))
-    names = lines[j].split()[2:]
-    if n == 0:
-        return {c: np.zeros(0) for c in names}
-    data = np.loadtxt(lines[j + 1:j + 1 + n], ndmin=2)
-    return {c: data[:, k] for k, c in enumerate(names)}
-
-
-def read_points(path):
-    import h5py
-    with h5py.File(path, "r") as f:
-        return f["points/xyz"][()]
-
-
-def frames(rundir, prefix):
-    """step -> (h5 path or None, dump path or None) for every written step."""
-    out = {}
-    for p in glob.glob(os.path.join(rundir, prefix + "_*.h5")):
-        m = re.search(r"_(\d+)\.h5$", p)
-        if m:
-            out.setdefault(int(m.group(1)), [None, None])[0] = p
-    for p in glob.glob(os.path.join(rundir, "beads_*.dump")):
-        m = re.search(r"beads_(\d+)\.dump$", p)
-        if m:
-            out.setdefault(int(m.group(1)), [None, None])[1] = p
-    return {s: tuple(v) for s, v in out.items() if v[0] and v[1]}
+from mpm_io import BEADS, WATER, paired_frames, read_dump, read_key_values, read_points  # noqa: E402
 
 
 def main():
@@ -80,14 +41,14 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    info = read_info(a.rundir)
+    info = read_key_values(os.path.join(a.rundir, "tank_run.txt"), numbers=True, missing_ok=True)
     if not info:
         sys.exit(f"render_tank: no tank_run.txt in {a.rundir} (not a run of inputs/tank/in.tank?)")
     dt, n0 = info["dt"], int(info["gate_start_step"])
     prefix = str(info.get("prefix", "tank"))
     L, W, H = info.get("L", 0.2), info.get("W", 0.1), info.get("H", 0.15)
     xg, vg, d = info.get("xg", 0.05), info.get("vgate", 0.68), info.get("d", 0.0027)
-    fr = frames(a.rundir, prefix)
+    fr = paired_frames(a.rundir, prefix)
     if not fr:
         sys.exit("no frame with both %s_*.h5 and beads_*.dump in %s" % (prefix, a.rundir))
     steps = np.array(sorted(fr))
@@ -105,7 +66,7 @@ def main():
         s = int(steps[np.argmin(np.abs(steps - want))])
         ts = (s - n0) * dt
         h5, dump = fr[s]
-        xyz = read_points(h5)
+        xyz = read_points(h5)[0]
         b = read_dump(dump)
         bx, by, bz = b["x"], b["y"], b["z"]
         if a.view == "side":

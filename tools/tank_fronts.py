@@ -31,39 +31,8 @@ import sys
 
 import numpy as np
 
-
-def read_csv(path):
-    with open(path) as f:
-        rows = [ln.strip() for ln in f if ln.strip() and not ln.lstrip().startswith("#")]
-    names = rows[0].split(",")
-    data = {n: [] for n in names}
-    for r in rows[1:]:
-        vals = r.split(",")
-        if len(vals) != len(names):
-            continue
-        for n, v in zip(names, vals):
-            data[n].append(float(v))
-    out = {n: np.array(v) for n, v in data.items()}
-    # a restarted or repeated print may repeat a time: keep the last value of each time
-    t = out["t"]
-    _, idx = np.unique(t[::-1], return_index=True)
-    keep = np.sort(len(t) - 1 - idx)
-    return {n: v[keep] for n, v in out.items()}
-
-
-def read_info(rundir):
-    info = {}
-    p = os.path.join(rundir, "tank_run.txt")
-    if os.path.exists(p):
-        with open(p) as f:
-            for line in f:
-                if "=" in line:
-                    k, v = (s.strip() for s in line.split("=", 1))
-                    try:
-                        info[k] = float(v)
-                    except ValueError:
-                        info[k] = v
-    return info
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mpm_io import paired_frames, read_csv, read_dump, read_key_values, read_points  # noqa: E402
 
 
 def wall_time(rundir, cpu=False):
@@ -132,8 +101,8 @@ def main():
         if not os.path.exists(p):
             print("skip %s: no fronts.csv" % d, file=sys.stderr)
             continue
-        info = read_info(d)
-        c = read_csv(p)
+        info = read_key_values(os.path.join(d, "tank_run.txt"), numbers=True, missing_ok=True)
+        c = read_csv(p, keep_last_of="t")
         wt, src = wall_time(d, a.cpu)
         lab = a.labels[k] if a.labels and k < len(a.labels) else label_of(info, d)
         npc = info.get("pnx", 1) * info.get("pny", 1) * info.get("pnz", 1)
@@ -163,14 +132,12 @@ def main():
 
     # percentile fronts from the snapshots
     try:
-        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-        import render_tank as rt
         head = False
         for r in runs:
             info = r["info"]
             if "gate_start_step" not in info:
                 continue
-            fr = rt.frames(r["dir"], str(info.get("prefix", "tank")))
+            fr = paired_frames(r["dir"], str(info.get("prefix", "tank")))
             if not fr:
                 continue
             if not head:
@@ -185,8 +152,8 @@ def main():
                     line += "  t=%.3f %7s %7s" % (tq, "-", "-")
                     continue
                 h5, dump = fr[s_]
-                xw = rt.read_points(h5)[:, 0]
-                xb = rt.read_dump(dump)["x"]
+                xw = read_points(h5)[0][:, 0]
+                xb = read_dump(dump)["x"]
                 line += "  t=%.3f %7.4f %7.4f" % ((s_ - n0) * dt, np.percentile(xw, a.pct),
                                                    np.percentile(xb, a.pct) if len(xb) else float("nan"))
             print(line)
