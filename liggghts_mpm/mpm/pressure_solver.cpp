@@ -1,0 +1,301 @@
+#include "mpm/pressure_solver.h"
+
+#include <HYPRE_struct_ls.h>
+#include <HYPRE_utilities.h>
+
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <vector>
+
+namespace mpm {
+
+namespace {
+
+// hypre 2.26 wants HYPRE_Init before its first object; once per process.
+void hypre_init_once() {
+  static bool done = false;
+  if (!done) {
+    HYPRE_Init();
+    done = true;
+  }
+}
+
+// Symmetric storage: the centre and the couplings to the lower neighbours;
+// hypre mirrors them onto the upper ones.
+constexpr int kEntries = 4;
+int stencil_offsets[kEntries][3] = {{0, 0, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
+
+}  // namespace
+
+struct PressureSolver::Hypre {
+  IndexBox box;  // the owned box the grid was built on
+  bool have_box = false;
+  HYPRE_StructGrid grid = nullptr;
+  HYPRE_StructStencil stencil = nullptr;
+  HYPRE_StructMatrix A = nullptr;
+  HYPRE_StructVector b = nullptr, x = nullptr;
+  HYPRE_StructSolver pcg = nullptr, precond = nullptr;
+  std::vector<double> values;  // kEntries per owned node, box order (i fastest)
+  bool valid_values = false;
+  std::vector<double> bbuf, xbuf;
+
+  void destroy_all(PressureSettings::Preconditioner kind) {
+    if (pcg) HYPRE_StructPCGDestroy(pcg);
+    if (precond) {
+      if (kind == PressureSettings::Preconditioner::PFMG) HYPRE_StructPFMGDestroy(precond);
+      if (kind == PressureSettings::Preconditioner::SMG) HYPRE_StructSMGDestroy(precond);
+    }
+    pcg = precond = nullptr;
+    if (A) HYPRE_StructMatrixDestroy(A);
+    if (b) HYPRE_StructVectorDestroy(b);
+    if (x) HYPRE_StructVectorDestroy(x);
+    if (stencil) HYPRE_StructStencilDestroy(stencil);
+    if (grid) HYPRE_StructGridDestroy(grid);
+    A = nullptr;
+    b = x = nullptr;
+    stencil = nullptr;
+    grid = nullptr;
+    valid_values = false;
+  }
+};
+
+PressureSolver::PressureSolver(LocalGrid &grid, MPI_Comm comm, const PressureSettings &settings,
+                               const ProjectionGeometry &geometry)
+    : grid_(grid), comm_(comm), settings_(settings), geo_(geometry), h_(new Hypre) {
+  if (!(settings.tolerance > 0.0))
+    throw std::invalid_argument("pressure solver: tolerance must be > 0");
+  if (settings.max_iterations < 1)
+    throw std::invalid_argument("pressure solver: max_iterations must be >= 1");
+  hypre_init_once();
+}
+
+PressureSolver::~PressureSolver() { h_->destroy_all(settings_.preconditioner); }
+
+void PressureSolver::build_grid() {
+  h_->destroy_all(settings_.preconditioner);
+  const IndexBox &ob = grid_.owned();
+  const GridSpec &g = grid_.spec();
+  HYPRE_StructGridCreate(comm_, 3, &h_->grid);
+  if (!ob.empty()) {
+    int lo[3] = {ob.lo[0], ob.lo[1], ob.lo[2]}, hi[3] = {ob.hi[0], ob.hi[1], ob.hi[2]};
+    HYPRE_StructGridSetExtents(h_->grid, lo, hi);
+  }
+  int period[3];
+  for (int d = 0; d < 3; ++d) period[d] = g.periodic[d] ? g.ncell[d] : 0;
+  HYPRE_StructGridSetPeriodic(h_->grid, period);
+  HYPRE_StructGridAssemble(h_->grid);
+
+  HYPRE_StructStencilCreate(3, kEntries, &h_->stencil);
+  for (int e = 0; e < kEntries; ++e) HYPRE_StructStencilSetElement(h_->stencil, e, stencil_offsets[e]);
+
+  HYPRE_StructMatrixCreate(comm_, h_->grid, h_->stencil, &h_->A);
+  HYPRE_StructMatrixSetSymmetric(h_->A, 1);
+  HYPRE_StructMatrixInitialize(h_->A);
+  HYPRE_StructVectorCreate(comm_, h_->grid, &h_->b);
+  HYPRE_StructVectorInitialize(h_->b);
+  HYPRE_StructVectorCreate(comm_, h_->grid, &h_->x);
+  HYPRE_StructVectorInitialize(h_->x);
+
+  h_->box = ob;
+  h_->have_box = true;
+  const std::size_t n = std::size_t(ob.count());
+  h_->values.assign(kEntries * n, 0.0);
+  h_->bbuf.assign(n, 0.0);
+  h_->xbuf.assign(n, 0.0);
+}
+
+/* The matrix of -dx^2 L (symmetric positive): row n of a FLUID node has
+   sum area_f beta_f over its open faces on the diagonal and -area_f beta_f towards
+   each FLUID neighbour; EMPTY neighbours stay on the diagonal only (their value
+   goes to the rhs); EMPTY and SOLID rows are the identity. Returns true if the
+   values differ from those hypre holds. */
+bool PressureSolver::assemble_values(const NodeLabels &labels, const double *beta) {
+  std::vector<double> v(h_->values.size(), 0.0);
+  std::size_t row = 0;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    double *r = &v[kEntries * row++];
+    if (labels.kind[n] != kFluid) {
+      r[0] = 1.0;
+      return;
+    }
+    for (int d = 0; d < 3; ++d)
+      for (int side = -1; side <= 1; side += 2) {
+        std::size_t m;
+        if (!open_face(grid_, labels, i, j, k, d, side, &m)) continue;
+        const double c = geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]);
+        r[0] += c;
+        if (side < 0 && labels.kind[m] == kFluid) r[1 + d] = -c;
+      }
+  });
+  int changed = (!h_->valid_values || std::memcmp(v.data(), h_->values.data(), v.size() * sizeof(double)) != 0);
+  int any = 0;
+  MPI_Allreduce(&changed, &any, 1, MPI_INT, MPI_MAX, comm_);
+  if (!any) return false;
+  h_->values.swap(v);
+  const IndexBox &ob = h_->box;
+  if (!ob.empty()) {
+    int lo[3] = {ob.lo[0], ob.lo[1], ob.lo[2]}, hi[3] = {ob.hi[0], ob.hi[1], ob.hi[2]};
+    int entries[kEntries] = {0, 1, 2, 3};
+    HYPRE_StructMatrixSetBoxValues(h_->A, lo, hi, kEntries, entries, h_->values.data());
+  }
+  HYPRE_StructMatrixAssemble(h_->A);
+  h_->valid_values = true;
+  return true;
+}
+
+void PressureSolver::setup_solver() {
+  Hypre &h = *h_;
+  if (h.pcg) HYPRE_StructPCGDestroy(h.pcg);
+  if (h.precond) {
+    if (settings_.preconditioner == PressureSettings::Preconditioner::PFMG) HYPRE_StructPFMGDestroy(h.precond);
+    if (settings_.preconditioner == PressureSettings::Preconditioner::SMG) HYPRE_StructSMGDestroy(h.precond);
+  }
+  h.pcg = h.precond = nullptr;
+  HYPRE_StructPCGCreate(comm_, &h.pcg);
+  HYPRE_StructPCGSetMaxIter(h.pcg, settings_.max_iterations);
+  HYPRE_StructPCGSetTol(h.pcg, settings_.tolerance);
+  HYPRE_StructPCGSetTwoNorm(h.pcg, 1);
+  HYPRE_StructPCGSetRelChange(h.pcg, 0);
+  HYPRE_StructPCGSetLogging(h.pcg, 1);
+  switch (settings_.preconditioner) {
+    case PressureSettings::Preconditioner::PFMG:
+      // One V-cycle with symmetric red-black Gauss-Seidel keeps the preconditioner
+      // symmetric, as PCG needs.
+      HYPRE_StructPFMGCreate(comm_, &h.precond);
+      HYPRE_StructPFMGSetMaxIter(h.precond, 1);
+      HYPRE_StructPFMGSetTol(h.precond, 0.0);
+      HYPRE_StructPFMGSetZeroGuess(h.precond);
+      HYPRE_StructPFMGSetRelaxType(h.precond, 2);
+      HYPRE_StructPFMGSetNumPreRelax(h.precond, 1);
+      HYPRE_StructPFMGSetNumPostRelax(h.precond, 1);
+      HYPRE_StructPCGSetPrecond(h.pcg, HYPRE_StructPFMGSolve, HYPRE_StructPFMGSetup, h.precond);
+      break;
+    case PressureSettings::Preconditioner::SMG:
+      HYPRE_StructSMGCreate(comm_, &h.precond);
+      HYPRE_StructSMGSetMemoryUse(h.precond, 0);
+      HYPRE_StructSMGSetMaxIter(h.precond, 1);
+      HYPRE_StructSMGSetTol(h.precond, 0.0);
+      HYPRE_StructSMGSetZeroGuess(h.precond);
+      HYPRE_StructSMGSetNumPreRelax(h.precond, 1);
+      HYPRE_StructSMGSetNumPostRelax(h.precond, 1);
+      HYPRE_StructPCGSetPrecond(h.pcg, HYPRE_StructSMGSolve, HYPRE_StructSMGSetup, h.precond);
+      break;
+    case PressureSettings::Preconditioner::None:
+      break;
+  }
+  HYPRE_StructPCGSetup(h.pcg, h.A, h.b, h.x);
+}
+
+PressureResult PressureSolver::solve(const NodeLabels &labels, const double *beta, const double *rhs,
+                                     double *p, const double *p_empty) {
+  PressureResult res;
+  Hypre &h = *h_;
+  const IndexBox &ob = grid_.owned();
+  const double t0 = MPI_Wtime();
+
+  // A new decomposition (load balancing) needs a new hypre grid on every rank.
+  int moved = !h.have_box;
+  for (int d = 0; d < 3 && !moved; ++d) moved = ob.lo[d] != h.box.lo[d] || ob.hi[d] != h.box.hi[d];
+  int any_moved = 0;
+  MPI_Allreduce(&moved, &any_moved, 1, MPI_INT, MPI_MAX, comm_);
+  if (any_moved) build_grid();
+  if (assemble_values(labels, beta) || !h.pcg) {
+    setup_solver();
+    res.rebuilt = true;
+  }
+  const double t1 = MPI_Wtime();
+
+  // Right-hand side of -dx^2 L p = -dx^2 rhs, EMPTY neighbours' values moved over.
+  const double dx2 = grid_.spec().dx * grid_.spec().dx;
+  long counts[2] = {0, 0};  // EMPTY nodes, FLUID nodes
+  double bsum = 0.0;
+  std::size_t row = 0;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    double &b = h.bbuf[row];
+    double &x = h.xbuf[row];
+    ++row;
+    if (labels.kind[n] != kFluid) {
+      if (labels.kind[n] == kEmpty) ++counts[0];
+      b = x = 0.0;
+      return;
+    }
+    ++counts[1];
+    b = -dx2 * rhs[n];
+    if (p_empty)
+      for (int d = 0; d < 3; ++d)
+        for (int side = -1; side <= 1; side += 2) {
+          std::size_t m;
+          if (open_face(grid_, labels, i, j, k, d, side, &m) && labels.kind[m] == kEmpty)
+            b += geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]) * p_empty[m];
+        }
+    bsum += b;
+    x = p[n];
+  });
+  long gcounts[2];
+  MPI_Allreduce(counts, gcounts, 2, MPI_LONG, MPI_SUM, comm_);
+  if (gcounts[0] == 0 && gcounts[1] > 0) {
+    // All-Neumann: only a compatible rhs (orthogonal to the constants) has a solution.
+    double gsum = 0.0;
+    MPI_Allreduce(&bsum, &gsum, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    const double mean = gsum / double(gcounts[1]);
+    row = 0;
+    grid_.for_owned([&](int, int, int, std::size_t n) {
+      if (labels.kind[n] == kFluid) h.bbuf[row] -= mean;
+      ++row;
+    });
+    res.singular = true;
+    res.rhs_mean_removed = -mean / dx2;  // in the units of rhs
+  }
+
+  if (!ob.empty()) {
+    int lo[3] = {ob.lo[0], ob.lo[1], ob.lo[2]}, hi[3] = {ob.hi[0], ob.hi[1], ob.hi[2]};
+    HYPRE_StructVectorSetBoxValues(h.b, lo, hi, h.bbuf.data());
+    HYPRE_StructVectorSetBoxValues(h.x, lo, hi, h.xbuf.data());
+  }
+  HYPRE_StructVectorAssemble(h.b);
+  HYPRE_StructVectorAssemble(h.x);
+  HYPRE_StructPCGSolve(h.pcg, h.A, h.b, h.x);
+  HYPRE_StructPCGGetNumIterations(h.pcg, &res.iterations);
+  HYPRE_StructPCGGetFinalRelativeResidualNorm(h.pcg, &res.relative_residual);
+  HYPRE_ClearAllErrors();  // a non-converged PCG sets hypre's error flag; we report it ourselves
+  if (!ob.empty()) {
+    int lo[3] = {ob.lo[0], ob.lo[1], ob.lo[2]}, hi[3] = {ob.hi[0], ob.hi[1], ob.hi[2]};
+    HYPRE_StructVectorGetBoxValues(h.x, lo, hi, h.xbuf.data());
+  }
+  const double t2 = MPI_Wtime();
+  res.setup_seconds = res.rebuilt ? t1 - t0 : 0.0;
+  res.solve_seconds = t2 - t1;
+
+  if (!(res.relative_residual <= settings_.tolerance)) {
+    std::ostringstream os;
+    os << "pressure solve did not converge: " << res.iterations << " PCG iterations (max_iterations "
+       << settings_.max_iterations << "), relative residual " << res.relative_residual << " (tolerance "
+       << settings_.tolerance << ")";
+    throw PressureSolveError(os.str(), res.iterations, res.relative_residual);
+  }
+
+  double psum = 0.0;
+  row = 0;
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    const double x = h.xbuf[row++];
+    if (labels.kind[n] == kFluid) {
+      p[n] = x;
+      psum += x;
+    } else {
+      p[n] = (labels.kind[n] == kEmpty && p_empty) ? p_empty[n] : 0.0;
+    }
+  });
+  if (res.singular) {
+    double gsum = 0.0;
+    MPI_Allreduce(&psum, &gsum, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    const double mean = gsum / double(gcounts[1]);
+    grid_.for_owned([&](int, int, int, std::size_t n) {
+      if (labels.kind[n] == kFluid) p[n] -= mean;
+    });
+  }
+  grid_.forward(p, 1);
+  return res;
+}
+
+}  // namespace mpm

@@ -1,0 +1,85 @@
+// The pressure equation of the projection, (L p)_n = rhs_n at the FLUID nodes
+// (L of projection_ops.h), solved with hypre's Struct interface on the node
+// lattice: one box per rank (its owned box of the LocalGrid), periodic
+// dimensions as hypre periodicity, the 7-point operator stored symmetric,
+// PCG preconditioned by one PFMG V-cycle (or SMG). EMPTY and SOLID nodes are
+// identity rows with their couplings removed and their known values moved to
+// the right-hand side, so the matrix stays symmetric positive (semi)definite.
+// docs/projection.md has the design and the measurements.
+#pragma once
+#include <mpi.h>
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "mpm/grid.h"
+#include "mpm/projection_ops.h"
+
+namespace mpm {
+
+struct PressureSettings {
+  enum class Preconditioner { PFMG, SMG, None };
+  double tolerance = 1e-8;   // relative residual ||b - A p|| / ||b|| (2-norms) at convergence
+  int max_iterations = 200;  // PCG iterations
+  Preconditioner preconditioner = Preconditioner::PFMG;
+};
+
+struct PressureResult {
+  int iterations = 0;
+  double relative_residual = 0.0;
+  bool rebuilt = false;        // matrix assembled and preconditioner set up in this call
+  bool singular = false;       // no EMPTY node anywhere: p fixed to zero mean over the FLUID nodes
+  double rhs_mean_removed = 0.0;  // singular only: the mean of the rhs made compatible (see solve)
+  double setup_seconds = 0.0;  // matrix assembly + preconditioner setup (rebuilt only)
+  double solve_seconds = 0.0;  // PCG
+};
+
+// Thrown when PCG stops above the tolerance; what() names the iterations and
+// the residual (the fix adds the step).
+class PressureSolveError : public std::runtime_error {
+ public:
+  PressureSolveError(const std::string &msg, int iterations, double residual)
+      : std::runtime_error(msg), iterations(iterations), residual(residual) {}
+  int iterations;
+  double residual;
+};
+
+class PressureSolver {
+ public:
+  // The grid must outlive the solver; collective over comm (the grid's).
+  PressureSolver(LocalGrid &grid, MPI_Comm comm, const PressureSettings &settings,
+                 const ProjectionGeometry &geometry);
+  ~PressureSolver();
+  PressureSolver(const PressureSolver &) = delete;
+  PressureSolver &operator=(const PressureSolver &) = delete;
+
+  /* Collective. labels: valid on owned nodes + one halo layer (NodeLabels::exchange),
+     beta = theta / rho per node (owned + one halo layer), rhs per owned node (pressure_rhs),
+     p: in, the first guess at the owned FLUID nodes (warm start: last step's pressure);
+     out, the pressure on the owned nodes and the halos (forward()): the solution at FLUID
+     nodes, p_empty (0 when null) at EMPTY nodes, 0 at SOLID nodes.
+     The hypre grid is rebuilt when the owned boxes change, the matrix and the
+     preconditioner when labels, beta or the geometry differ from the last call.
+     Without any EMPTY node the operator has the constants as null space: the mean of rhs
+     over the FLUID nodes is removed (reported) and p is returned with zero mean. */
+  PressureResult solve(const NodeLabels &labels, const double *beta, const double *rhs, double *p,
+                       const double *p_empty = nullptr);
+
+  const PressureSettings &settings() const { return settings_; }
+  const ProjectionGeometry &geometry() const { return geo_; }
+
+ private:
+  struct Hypre;
+  void build_grid();
+  bool assemble_values(const NodeLabels &labels, const double *beta);
+  void setup_solver();
+
+  LocalGrid &grid_;
+  MPI_Comm comm_;
+  PressureSettings settings_;
+  ProjectionGeometry geo_;
+  std::unique_ptr<Hypre> h_;
+};
+
+}  // namespace mpm

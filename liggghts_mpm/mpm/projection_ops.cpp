@@ -1,0 +1,195 @@
+#include "mpm/projection_ops.h"
+
+#include <algorithm>
+
+namespace mpm {
+
+namespace {
+
+// One face of an owned node n, towards its neighbour m = n + side e_d.
+struct Face {
+  bool wall = true;       // no neighbour, a SOLID one, or flagged closed
+  std::size_t m = 0;      // neighbour's flat index (valid unless beyond the grid)
+  bool has_m = false;
+  double wall_u = 0.0;    // wall velocity along +d (wall faces)
+  double area = 1.0;      // units of dx^2
+};
+
+Face face_of(const LocalGrid &grid, const NodeLabels &lab, const ProjectionGeometry &geo, int i, int j,
+             int k, std::size_t n, int d, int side) {
+  Face f;
+  // The face's area is the same seen from either node (their other indices agree).
+  f.area = geo.area(d, i, j, k);
+  f.wall = !open_face(grid, lab, i, j, k, d, side, &f.m);
+  int q[3] = {i, j, k};
+  q[d] += side;
+  f.has_m = grid.in_patch(q[0], q[1], q[2]);
+  if (f.wall && f.has_m) {
+    const std::size_t lower = side > 0 ? n : f.m;
+    if (((lab.closed[lower] >> d) & 1u) && !lab.wall_u.empty()) f.wall_u = lab.wall_u[3 * lower + d];
+  }
+  return f;
+}
+
+// Calls fn(n, f, d, side) for the six faces of every owned non-SOLID node.
+template <class Fn>
+void for_faces(const LocalGrid &grid, const NodeLabels &lab, const ProjectionGeometry &geo, Fn &&fn) {
+  grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab.kind[n] == kSolid) return;
+    for (int d = 0; d < 3; ++d)
+      for (int side = -1; side <= 1; side += 2) fn(n, face_of(grid, lab, geo, i, j, k, n, d, side), d, side);
+  });
+}
+
+// Flux theta u along +d through face f of node n (see flux_divergence).
+double face_flux(const NodeLabels &lab, std::size_t n, const Face &f, int d, const double *u,
+                 const double *theta) {
+  if (f.wall) {
+    const bool other = f.has_m && lab.kind[f.m] != kSolid;
+    const double th = other ? 0.5 * (theta[n] + theta[f.m]) : theta[n];
+    return th * f.wall_u;
+  }
+  const double th = 0.5 * (theta[n] + theta[f.m]);
+  const std::uint8_t a = lab.kind[n], b = lab.kind[f.m];
+  double uf;
+  if (a == b)
+    uf = 0.5 * (u[3 * n + d] + u[3 * f.m + d]);
+  else
+    uf = (a == kFluid) ? u[3 * n + d] : u[3 * f.m + d];
+  return th * uf;
+}
+
+}  // namespace
+
+bool open_face(const LocalGrid &grid, const NodeLabels &labels, int i, int j, int k, int d, int side,
+               std::size_t *m) {
+  int q[3] = {i, j, k};
+  q[d] += side;
+  if (!grid.in_patch(q[0], q[1], q[2])) return false;  // beyond the grid: the halo covers all else
+  const std::size_t n = grid.index(i, j, k), nb = grid.index(q[0], q[1], q[2]);
+  *m = nb;
+  const std::size_t lower = side > 0 ? n : nb;
+  return !((labels.closed[lower] >> d) & 1u) && labels.kind[n] != kSolid && labels.kind[nb] != kSolid;
+}
+
+void NodeLabels::reset(const LocalGrid &grid) {
+  const GridSpec &g = grid.spec();
+  kind.assign(grid.size(), kFluid);
+  closed.assign(grid.size(), 0);
+  wall_u.clear();
+  const IndexBox &pb = grid.patch();
+  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
+    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
+        const int idx[3] = {i, j, k};
+        for (int d = 0; d < 3; ++d)
+          if (!g.periodic[d] && (idx[d] < 0 || idx[d] > g.ncell[d])) kind[grid.index(i, j, k)] = kSolid;
+      }
+}
+
+void NodeLabels::close_face(const LocalGrid &grid, int i, int j, int k, int d, double wall_velocity) {
+  const std::size_t n = grid.index(i, j, k);
+  closed[n] |= std::uint8_t(1u << d);
+  if (wall_velocity != 0.0 && wall_u.empty()) wall_u.assign(3 * grid.size(), 0.0);
+  if (!wall_u.empty()) wall_u[3 * n + d] = wall_velocity;
+}
+
+void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm) {
+  // One forward of small integers packed in doubles (exact), and of the wall
+  // velocities when some rank has moving walls.
+  std::vector<double> buf(grid.size());
+  for (std::size_t n = 0; n < buf.size(); ++n) buf[n] = kind[n] + 4.0 * closed[n];
+  grid.forward(buf.data(), 1);
+  for (std::size_t n = 0; n < buf.size(); ++n) {
+    const int v = static_cast<int>(buf[n]);
+    kind[n] = std::uint8_t(v & 3);
+    closed[n] = std::uint8_t(v >> 2);
+  }
+  int moving = wall_u.empty() ? 0 : 1, any = 0;
+  MPI_Allreduce(&moving, &any, 1, MPI_INT, MPI_MAX, comm);
+  if (any) {
+    if (wall_u.empty()) wall_u.assign(3 * grid.size(), 0.0);
+    grid.forward(wall_u.data(), 3);
+  }
+}
+
+void flux_divergence(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                     const double *u, const double *theta, double *div) {
+  const double inv_dx = 1.0 / grid.spec().dx;
+  grid.for_owned([&](int, int, int, std::size_t n) { div[n] = 0.0; });
+  for_faces(grid, labels, geo, [&](std::size_t n, const Face &f, int d, int side) {
+    div[n] += side * f.area * face_flux(labels, n, f, d, u, theta) * inv_dx;
+  });
+}
+
+void pressure_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                  const double *u, const double *theta, const double *theta_prev, double dt, double *rhs) {
+  flux_divergence(grid, labels, geo, u, theta, rhs);
+  grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (labels.kind[n] != kFluid) {
+      rhs[n] = 0.0;
+      return;
+    }
+    double s = rhs[n];
+    if (theta_prev) s += geo.volume(i, j, k) * (theta[n] - theta_prev[n]) / dt;
+    rhs[n] = s / dt;
+  });
+}
+
+void apply_laplacian(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                     const double *beta, const double *p, double *out) {
+  const double inv_dx2 = 1.0 / (grid.spec().dx * grid.spec().dx);
+  grid.for_owned([&](int, int, int, std::size_t n) { out[n] = 0.0; });
+  for_faces(grid, labels, geo, [&](std::size_t n, const Face &f, int, int) {
+    if (labels.kind[n] != kFluid || f.wall) return;
+    out[n] += f.area * 0.5 * (beta[n] + beta[f.m]) * (p[f.m] - p[n]) * inv_dx2;
+  });
+}
+
+void corrected_flux_divergence(const LocalGrid &grid, const NodeLabels &labels,
+                               const ProjectionGeometry &geo, const double *u, const double *theta,
+                               const double *beta, const double *p, double dt, double *div) {
+  const double inv_dx = 1.0 / grid.spec().dx;
+  grid.for_owned([&](int, int, int, std::size_t n) { div[n] = 0.0; });
+  for_faces(grid, labels, geo, [&](std::size_t n, const Face &f, int d, int side) {
+    double flux = face_flux(labels, n, f, d, u, theta);
+    // gradient along +d across the face: (p_upper - p_lower) / dx
+    if (!f.wall) flux -= dt * 0.5 * (beta[n] + beta[f.m]) * side * (p[f.m] - p[n]) * inv_dx;
+    div[n] += side * f.area * flux * inv_dx;
+  });
+}
+
+void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad) {
+  const double inv_dx = 1.0 / grid.spec().dx;
+  // Face areas do not enter a nodal gradient: any geometry will do.
+  ProjectionGeometry geo;
+  geo.spec = grid.spec();
+  geo.half_cells = false;
+  grid.for_owned([&](int, int, int, std::size_t n) {
+    for (int d = 0; d < 3; ++d) grad[3 * n + d] = 0.0;
+  });
+  // for_faces visits the faces of a node in the order (x,-), (x,+), (y,-), ...
+  double sum = 0.0;
+  int open = 0;
+  for_faces(grid, labels, geo, [&](std::size_t n, const Face &f, int d, int side) {
+    if (side < 0) {
+      sum = 0.0;
+      open = 0;
+    }
+    if (!f.wall) {
+      sum += side * (p[f.m] - p[n]) * inv_dx;
+      ++open;
+    }
+    if (side > 0) grad[3 * n + d] = open ? sum / open : 0.0;
+  });
+}
+
+void correct_velocity(const LocalGrid &grid, const NodeLabels &labels, const double *grad,
+                      const double *inv_rho, double dt, double *u) {
+  grid.for_owned([&](int, int, int, std::size_t n) {
+    if (labels.kind[n] == kSolid) return;
+    for (int d = 0; d < 3; ++d) u[3 * n + d] -= dt * inv_rho[n] * grad[3 * n + d];
+  });
+}
+
+}  // namespace mpm

@@ -1,0 +1,120 @@
+// Discrete operators of the pressure projection on the node lattice of the
+// background grid (docs/projection.md): the approximate projection of Almgren,
+// Bell & Szymczak (1996) moved from cells to nodes. Velocities and pressure
+// live at the nodes; the faces of the dual cells, halfway between neighbouring
+// nodes, carry the fluxes theta u of the volume-averaged continuity equation
+//   d(theta)/dt + div(theta u) = 0,   u = u* - (dt / rho) grad p
+// and the compact 7-point operator div(beta grad p), beta = theta / rho.
+// Independent of LIGGGHTS; the hypre solve is in pressure_solver.h.
+//
+// Conventions for every function below: node arrays are indexed by the
+// LocalGrid's flat patch index (vectors: 3 doubles per node); inputs must be
+// valid on the owned nodes and on one halo layer around them (forward() after
+// writing the owned ones); outputs are written on the owned nodes only.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "mpm/grid.h"
+
+namespace mpm {
+
+// FLUID nodes carry an unknown pressure; EMPTY nodes (no fluid: the free
+// surface) hold a known pressure, 0 unless the solve is given other values;
+// SOLID nodes (outside the box, inside obstacles) take part in nothing, and
+// every face that touches one is a wall.
+enum NodeKind : std::uint8_t { kFluid = 0, kEmpty = 1, kSolid = 2 };
+
+// Per patch node: its kind, and which of its three upper faces (towards
+// index + 1 along x, y, z) are walls. A wall face carries no flux relative to
+// the wall: its flux is theta times the wall's velocity along +d, wall_u[3 n + d]
+// (wall_u empty: walls at rest). Faces to SOLID nodes and to nodes beyond the
+// grid are walls at rest unless flagged closed with a velocity.
+struct NodeLabels {
+  std::vector<std::uint8_t> kind;
+  std::vector<std::uint8_t> closed;  // bit d: the face to index + e_d is a wall
+  std::vector<double> wall_u;
+
+  // Every node FLUID with open faces, except the padding nodes behind the box
+  // walls (indices < 0 or > ncell in non-periodic dimensions), which are SOLID.
+  void reset(const LocalGrid &grid);
+  void close_face(const LocalGrid &grid, int i, int j, int k, int d, double wall_velocity = 0.0);
+  // Copies the owned nodes' labels into the halos (collective over the grid's comm).
+  void exchange(LocalGrid &grid, MPI_Comm comm);
+};
+
+// Control volumes of the nodes. The box walls pass through the nodes with index
+// 0 and ncell (non-periodic dimensions): with half_cells the dual cell of a wall
+// node is cut by the wall (volume 1/2, 1/4 on an edge, 1/8 in a corner, in units
+// of dx^3) and so are its faces along the wall (area 1/2 or 1/4 of dx^2). This
+// keeps the Neumann walls second-order accurate and the flux theta u through a
+// wall node's face consistent with its theta, which the fix computes on the
+// half cell (docs/projection.md, the measurement). Without it every dual cell
+// is a full cube, i.e. the wall sits half a cell behind the wall nodes.
+struct ProjectionGeometry {
+  GridSpec spec;
+  bool half_cells = true;
+
+  double h(int d, int i) const {
+    if (!half_cells || spec.periodic[d]) return 1.0;
+    return (i == 0 || i == spec.ncell[d]) ? 0.5 : 1.0;
+  }
+  double volume(int i, int j, int k) const { return h(0, i) * h(1, j) * h(2, k); }
+  // Face between (i, j, k) and (i, j, k) + e_d, in units of dx^2.
+  double area(int d, int i, int j, int k) const {
+    const int idx[3] = {i, j, k};
+    double a = 1.0;
+    for (int e = 0; e < 3; ++e)
+      if (e != d) a *= h(e, idx[e]);
+    return a;
+  }
+};
+
+// True if the face of node (i, j, k) towards (i, j, k) + side e_d (side = -1 or
+// +1) is open: both nodes in the patch, neither SOLID, not flagged closed.
+// *m: the neighbour's flat index when it lies in the patch.
+bool open_face(const LocalGrid &grid, const NodeLabels &labels, int i, int j, int k, int d, int side,
+               std::size_t *m);
+
+// The integrated divergence of theta u at the owned non-SOLID nodes:
+// D_n = sum over the faces of n of (area x outward flux) / dx, per dx^3 (the
+// divergence per volume is D_n / volume(n)). The flux through an open face is
+// theta_f u_f with theta_f the mean of the two nodes' theta and u_f the mean
+// of their velocity components along the face normal; between a FLUID and an
+// EMPTY node u_f is the FLUID node's (the velocity is extended across the
+// free surface, so a falling body of fluid is not squeezed at its surface).
+void flux_divergence(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                     const double *u, const double *theta, double *div);
+
+// Right-hand side of the pressure equation at the owned FLUID nodes (0 elsewhere):
+// rhs_n = (D_n + volume(n) (theta_n - theta_prev_n) / dt) / dt, D_n of
+// flux_divergence; theta_prev null: no d(theta)/dt term.
+void pressure_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                  const double *u, const double *theta, const double *theta_prev, double dt, double *rhs);
+
+// The operator the solver inverts, at the owned FLUID nodes (0 elsewhere):
+// (L p)_n = sum over the open faces f = (n, m) of area_f beta_f (p_m - p_n) / dx^2,
+// beta_f = (beta_n + beta_m) / 2, EMPTY neighbours entering with their p.
+// The solver makes (L p)_n = rhs_n.
+void apply_laplacian(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                     const double *beta, const double *p, double *out);
+
+// The divergence (as flux_divergence) of the corrected face fluxes
+// theta_f u*_f - dt beta_f (p_m - p_n) / dx: the exact projection on the faces,
+// whose D_n + volume(n) d(theta)/dt vanishes to the solver's tolerance.
+void corrected_flux_divergence(const LocalGrid &grid, const NodeLabels &labels,
+                               const ProjectionGeometry &geo, const double *u, const double *theta,
+                               const double *beta, const double *p, double dt, double *div);
+
+// Nodal pressure gradient at the owned non-SOLID nodes (0 at SOLID ones): per
+// direction the mean of the two face gradients (p_m - p_n) / dx, the one of the
+// open face alone next to a wall, 0 between two walls. This is the gradient the
+// fluid's nodes feel and the one to interpolate to grains (the same discrete
+// operator for both: docs/projection.md).
+void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad);
+
+// u -= dt inv_rho grad at the owned non-SOLID nodes (inv_rho per node).
+void correct_velocity(const LocalGrid &grid, const NodeLabels &labels, const double *grad,
+                      const double *inv_rho, double dt, double *u);
+
+}  // namespace mpm
