@@ -1,69 +1,70 @@
 // laser_drill: single-pulse laser drilling model (Yang 2016, Part I).
+// Exit status: 0 finished run (status in summary.json), 2 bad input (nothing
+// written), 1 write failure or internal error (no summary.json).
 #include <chrono>
+#include <cstdlib>
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <memory>
+#include <optional>
 
 #include "laser_model.h"
 #include "laser_output.h"
 #include "laser_params.h"
+#include "laser_timestep.h"
 
 int main(int argc, char** argv) {
   using namespace laser;
-  Config cfg;
-  bool help = false, dump_conduction = false;
+  Invocation inv;
+  std::optional<TimeStepPolicy> policy;
+  std::unique_ptr<OutputDir> out;
   try {
-    cfg = parse_command_line(argc, argv, help, dump_conduction);
-    if (help) {
-      std::cout << usage_text();
-      return 0;
+    inv = parse_command_line(argc, argv);
+    if (inv.exit_now) return 0;
+    if (!inv.dump_conduction) {
+      validate(inv.cfg);
+      policy.emplace(inv.cfg);
     }
-    validate(cfg);
-    const double dt_max = cfg.implicit_melt ? 0.0 : explicit_step_limit(cfg);
-    if (dt_max > 0.0 && cfg.dt > dt_max) {
-      char buf[256];
-      std::snprintf(buf, sizeof buf,
-                    "--dt/--dtau: time step %.4g s is above the explicit stability limit %.4g s of the "
-                    "melt thickness update (4-14) at this intensity; valid range (0, %.4g] s",
-                    cfg.dt, dt_max, dt_max);
-      throw UsageError(buf);
-    }
+    // the output folder is checked, created and locked before any computation
+    out = std::make_unique<OutputDir>(inv.cfg.out, inv.cfg.overwrite);
   } catch (const UsageError& e) {
     std::cerr << "laser_drill: error: " << e.what() << "\n";
     return 2;
   }
+  const Config& cfg = inv.cfg;
   try {
-    if (dump_conduction) {
-      write_conduction_table(cfg.out);
+    if (inv.dump_conduction) {
+      write_conduction_table(*out);
       std::cout << "laser_drill: wrote " << cfg.out << "/conduction_table.csv\n";
       return 0;
     }
     const auto t0 = std::chrono::steady_clock::now();
-    Result r = run_simulation(cfg);
-    // The automatic step is halved (at most 6 times) when the run-time check of
-    // (4-14) fires; a step given by the user is never changed.
-    for (int k = 0; k < 6 && cfg.dt_auto && r.status == "unstable_time_step"; ++k) {
-      cfg.dt *= 0.5;
-      if (!cfg.quiet)
-        std::fprintf(stderr, "laser_drill: automatic step unstable (%s); retrying with dt = %.4g s\n",
-                     r.message.c_str(), cfg.dt);
-      r = run_simulation(cfg);
-    }
-    const double wall =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    Result r = policy->run(cfg, [&] { return out->profiles_sink(); });
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (r.status == "unstable_time_step") {
       // A time step the explicit scheme cannot take is bad input: nothing is written.
-      std::cerr << "laser_drill: error: --dt/--dtau: " << r.message << "\n";
+      std::cerr << "laser_drill: error: " << policy->reason() << ": " << r.message << "\n";
+      out.reset();
       return 2;
     }
-    write_outputs(cfg, r, wall);
+    for (const auto& n : r.notes) std::fprintf(stderr, "laser_drill: note: %s\n", n.c_str());
+    out->write_tables(cfg, r);
+    out->commit(summary_json(cfg, r, wall));
+    out.reset();
     std::printf("status %s; depth %.4g m; volume %.4g m3; rate %.4g m3/s; T_peak %.1f K; "
-                "p_peak %.4g Pa; wall %.3f s\n",
-                r.status.c_str(), r.depth_center, r.volume_removed, r.removal_rate, r.T_peak,
-                r.p_peak, wall);
+                "p_peak %.4g Pa; dt %.3g s (est. error depth %.1e, volume %.1e); wall %.3f s\n",
+                r.status.c_str(), r.depth_center, r.volume_removed, r.removal_rate, r.T_peak, r.p_peak, r.dt,
+                r.step.depth_error, r.step.volume_error, wall);
     std::fflush(stdout);
-    if (!r.message.empty())
-      std::fprintf(stderr, "laser_drill: %s: %s\n", r.status.c_str(), r.message.c_str());
+    if (!r.message.empty()) std::fprintf(stderr, "laser_drill: %s: %s\n", r.status.c_str(), r.message.c_str());
+  } catch (const WriteError& e) {
+    std::cerr << "laser_drill: error: " << e.what() << "\n";
+    out.reset();  // removes the staged files and the lock
+    std::fflush(nullptr);
+    // An HDF5 file whose close failed stays in the library's table and its
+    // exit handler (H5_term_library) then crashes; the files are already gone.
+    std::_Exit(1);
   } catch (const std::exception& e) {
     std::cerr << "laser_drill: internal error: " << e.what() << "\n";
     return 1;

@@ -120,11 +120,64 @@ double interface_residual(const Groups& G, double phi, double xi, double g, doub
   return v + c * (phi - G.theta_m) + G.kprime * b2 * g - gaussian_beam(xi);
 }
 
-InterfaceState solve_interface(const Groups& G, double xi, double g, double b2) {
+double peclet_factor(double Pe) {
+  if (std::fabs(Pe) < 1e-6) return 1.0 + 0.5 * Pe;
+  return Pe / -std::expm1(-Pe);
+}
+
+double flux_recession_rate(const Groups& G, double phi, double* dw) {
+  double dv = 0;
+  const double v = vapour_term(G, phi, dw ? &dv : nullptr);
+  const double p_star = G.p0 * std::exp(G.Hlv * (1.0 - 1.0 / phi)) / G.p_scale;
+  const double sq = std::sqrt(phi);
+  if (dw) *dw = G.Ni * dv - G.Psi * p_star * (G.Hlv / (phi * phi) * sq + 0.5 / sq);
+  return G.Ni * v - G.Psi * p_star * sq;
+}
+
+double advected_residual(const Groups& G, double phi, double xi, double g, double b2, double* dres) {
+  // one exponential for the vapour term, the pressure and the flux velocity
+  const double e = std::exp(G.Hlv * (1.0 - 1.0 / phi));
+  const double sq = std::sqrt(phi);
+  const double v = e * (1.0 + G.Lambda * phi) / (G.Iprime * sq);
+  const double p_star = G.p0 * e / G.p_scale;
+  const double th = (phi - G.theta_m) / (1.0 - G.theta_m);
+  const double w = std::max(G.Ni * v - G.Psi * p_star * sq, 0.0);
+  const double Pe = w * g;
+  const double em = -std::expm1(-Pe);  // 1 - exp(-Pe)
+  const double F = Pe < 1e-6 ? 1.0 + 0.5 * Pe : Pe / em;
+  if (dres) {
+    const double dv = v * (G.Hlv / (phi * phi) + G.Lambda / (1.0 + G.Lambda * phi) - 0.5 / phi);
+    const double dw = w > 0.0 ? G.Ni * dv - G.Psi * p_star * (G.Hlv / (phi * phi) * sq + 0.5 / sq) : 0.0;
+    // F'(Pe) = (1 - e^-Pe (1 + Pe)) / (1 - e^-Pe)^2
+    const double dF = Pe < 1e-6 ? 0.5 : (em - Pe * (1.0 - em)) / (em * em);
+    *dres = dv + G.kprime * (F / (g * (1.0 - G.theta_m)) + th * dF * dw);
+  }
+  return v + G.kprime * (th / g * F + b2 * g) - gaussian_beam(xi);
+}
+
+InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bool advected) {
+  InterfaceState s;
+  s.phi = phi;
+  s.theta_sat = (phi - G.theta_m) / (1.0 - G.theta_m);
+  double F = 1.0;
+  if (advected) {
+    s.w = std::max(flux_recession_rate(G, phi), 0.0);
+    s.peclet = s.w * g;
+    F = peclet_factor(s.peclet);
+  }
+  s.grad_top = s.theta_sat / g * F + b2 * g;
+  s.grad_bottom = s.theta_sat / g * F * std::exp(-s.peclet) - b2 * g;
+  s.p_pa = G.p0 * std::exp(G.Hlv * (1.0 - 1.0 / phi));
+  s.p_star = s.p_pa / G.p_scale;
+  return s;
+}
+
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected) {
   InterfaceState s;
   const double E = gaussian_beam(xi);
   s.phi = G.theta_m;
   s.theta_sat = 0.0;
+  double F = 1.0;
   if (!(g > 0.0)) {
     // Vanishing layer: all that is not evaporated at T_m is conducted through.
     const double q = std::max(E - vapour_term(G, G.theta_m, nullptr), 0.0) / G.kprime;
@@ -135,23 +188,46 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2) 
     if (r0 < 0.0) {
       // Upper bracket: the conduction-only root, where the vapour term is > 0.
       const double hi = G.theta_m + avail * g * (1.0 - G.theta_m) / G.kprime;
-      auto fdf = [&](double phi, double& f, double& df) {
-        f = interface_residual(G, phi, xi, g, b2, &df);
-      };
-      if (interface_residual(G, hi, xi, g, b2) > 0.0) {
-        const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
-        s.phi = rr.x;
-        s.iterations = rr.iterations;
-        s.converged = rr.converged;
+      if (!advected) {
+        auto fdf = [&](double phi, double& f, double& df) {
+          f = interface_residual(G, phi, xi, g, b2, &df);
+        };
+        if (interface_residual(G, hi, xi, g, b2) > 0.0) {
+          const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+          s.phi = rr.x;
+          s.iterations = rr.iterations;
+          s.converged = rr.converged;
+        } else {
+          // hi - theta_m below round-off (very thin layer): the conduction root.
+          s.phi = hi;
+        }
       } else {
-        // hi - theta_m below round-off (very thin layer): the conduction root.
-        s.phi = hi;
+        // vapour + k' (theta_sat/g F(w(phi) g) + b2 g) - beam: every term rises
+        // with phi and F >= 1, so the linear bracket [theta_m, hi] still holds.
+        auto fdf = [&](double phi, double& f, double& df) { f = advected_residual(G, phi, xi, g, b2, &df); };
+        if (advected_residual(G, hi, xi, g, b2, nullptr) > 0.0) {
+          const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+          s.phi = rr.x;
+          s.iterations = rr.iterations;
+          s.converged = rr.converged;
+        } else {
+          s.phi = hi;
+        }
       }
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
-      s.residual = interface_residual(G, s.phi, xi, g, b2) / E;
+      if (advected) {
+        s.w = std::max(flux_recession_rate(G, s.phi), 0.0);
+        s.peclet = s.w * g;
+        F = peclet_factor(s.peclet);
+        const double th = s.theta_sat;
+        s.residual = (vapour_term(G, s.phi, nullptr) + G.kprime * (th / g * F + b2 * g) - E) / E;
+        (void)th;
+      } else {
+        s.residual = interface_residual(G, s.phi, xi, g, b2) / E;
+      }
     }
-    s.grad_top = s.theta_sat / g + b2 * g;
-    s.grad_bottom = s.theta_sat / g - b2 * g;
+    s.grad_top = s.theta_sat / g * F + b2 * g;
+    s.grad_bottom = s.theta_sat / g * F * std::exp(-s.peclet) - b2 * g;
   }
   s.p_pa = G.p0 * std::exp(G.Hlv * (1.0 - 1.0 / s.phi));
   s.p_star = s.p_pa / G.p_scale;

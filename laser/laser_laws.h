@@ -99,6 +99,8 @@ struct InterfaceState {
   double p_pa = 0;       // Pa
   double grad_top = 0;   // d theta_l / d zeta at zeta = g   (4-26)
   double grad_bottom = 0;// d theta_l / d zeta at zeta = 0   (4-26)
+  double w = 0;          // advected layer: liquid velocity through the layer, dS1/dtau
+  double peclet = 0;     // advected layer: w g
   double residual = 0;   // of (4-29), relative to exp(-xi^2)
   int iterations = 0;
   bool converged = true;
@@ -108,10 +110,28 @@ struct InterfaceState {
 // beam. Strictly increasing in phi for phi < 2 H_lv, so its root is unique.
 double interface_residual(const Groups& G, double phi, double xi, double g, double b2,
                           double* dres = nullptr);
+// Peclet factor F(Pe) = Pe / (1 - exp(-Pe)) of the advected melt layer: the
+// surface gradient of the steady-ablation profile over the linear one.
+double peclet_factor(double Pe);
+// Nondimensional recession velocity dS1/dtau carried by the evaporation flux
+// at the surface temperature phi alone: N_i (vapour term) - Psi p* sqrt(phi),
+// which equals (3-25) once the interface balance (4-29) holds.
+double flux_recession_rate(const Groups& G, double phi, double* dw = nullptr);
+// Residual of the interface balance of the advected layer (as interface_residual)
+// and its derivative in phi.
+double advected_residual(const Groups& G, double phi, double xi, double g, double b2, double* dres);
+// Interface state (gradients, pressure) of a layer g at a given phi.
+InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bool advected);
 // Solves (4-28)-(4-30) for the surface temperature of a melt layer of
 // nondimensional thickness g with the quadratic profile (4-25) of coefficient
-// b2; g = 0 is the limit of a vanishing layer (T_sat = T_m).
-InterfaceState solve_interface(const Groups& G, double xi, double g, double b2);
+// b2; g = 0 is the limit of a vanishing layer (T_sat = T_m). With advected =
+// true the layer is quasi-steady advection-diffusion in the frame of the
+// receding surface (liquid moving towards it at w = dS1/dtau): the linear part
+// theta_sat zeta/g becomes the exponential steady-ablation profile, so that the
+// surface gradient is theta_sat/g F(w g) and the bottom one smaller by
+// exp(-w g); their difference w theta_sat heats the vaporized liquid from T_m
+// to T_sat (docs/laser_model.md, "Energy-consistent melt layer").
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected = false);
 // Nondimensional vaporization recession rate dS1/dtau by (3-25).
 double recession_rate(const Groups& G, double xi, const InterfaceState& s);
 // The same rate from the dimensional laws (3-16), (3-17): rho ds1/dt = j_v M.

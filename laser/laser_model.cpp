@@ -16,7 +16,11 @@ struct Node {
   double S1 = 0, S2 = 0, g = 0, b2 = 0, S1flow = 0;
   InterfaceState itf;
   double dS1 = 0, dS2 = 0, v = 0, f = 0;  // rates of the last step, f: u = f zeta
+  double last_dg = 0;  // dg/dtau of the last step
+  int flips = 0;       // consecutive sign changes of dg/dtau with lambda dtau > 2
 };
+
+constexpr int kUnstableFlips = 3;
 
 std::string fmt(double v) {
   std::ostringstream o;
@@ -27,7 +31,9 @@ std::string fmt(double v) {
 
 class Drill {
  public:
-  explicit Drill(const Config& c) : cfg_(c), G_(make_groups(c.mat, c.I0, c.R)) {}
+  Drill(const Config& c, FrameSink* sink)
+      : cfg_(c), G_(make_groups(c.mat, c.I0, c.R)), sink_(sink),
+        advected_(c.melt_energy == MeltEnergy::Advected) {}
   Result run();
 
  private:
@@ -37,13 +43,27 @@ class Drill {
   bool solve_melt_flow();
   void solve_boundary_layer(int& last_bl);
   double solid_gradient_mean(const Node& n, double ta, double tb) const;
+  // phases of advance_interfaces, per node
+  struct Geometry { double J = 1, Cc = 1; };
+  struct Rates { double dS2 = 0, dS1 = 0, drive = 0; };
   void advance_interfaces(double ta, double tb);
+  void book_beam(const Node& n, double ta, double tb);
+  Geometry front_geometry(int i, const std::vector<double>& S2old, double tb);
+  void solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n, double dtn);
+  Rates front_rates(const Node& n, const Geometry& geo, double grad_n, double dtn);
+  void check_stability(Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn, double tb);
+  void book_energy(const Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn);
+  void move_fronts(Node& n, const Rates& r, double dtn);
   void melt_temperature();
   void record(double tau, bool frame);
+  void emit(Frame&& f);
+  void physical_check();
   double node_ta(const Node& n, double ta) const { return std::max(ta, n.tau_m); }
 
   Config cfg_;
   Groups G_;
+  FrameSink* sink_;
+  bool advected_;
   std::unique_ptr<CorrectedConduction> exact_;
   std::vector<Node> nodes_;
   Result res_;
@@ -96,7 +116,7 @@ void Drill::melt_onset(double tb) {
 void Drill::solve_interfaces() {
   for (auto& n : nodes_) {
     if (!n.molten) continue;
-    n.itf = solve_interface(G_, n.xi, n.g, n.b2);
+    n.itf = solve_interface(G_, n.xi, n.g, n.b2, advected_);
     res_.max_interface_residual = std::max(res_.max_interface_residual, std::fabs(n.itf.residual));
   }
 }
@@ -228,120 +248,175 @@ double Drill::solid_gradient_mean(const Node& n, double ta, double tb) const {
   return 0.0;
 }
 
-void Drill::advance_interfaces(double ta, double tb) {
+void Drill::book_beam(const Node& n, double ta, double tb) {
+  const double dt_pre = std::max(0.0, std::min(tb, n.tau_m) - ta);
+  const double beam = cfg_.I0 * gaussian_beam(n.xi) * n.area;  // W
+  res_.energy.laser_nodal += beam * (tb - ta) * G_.t_scale;
+  res_.energy.solid_premelt += beam * dt_pre * G_.t_scale;
+}
+
+// Slope factor J = sqrt(1 + S2'^2) and curvature factor (3-37) of the melting
+// front from the fronts at the start of the step (3-38).
+Drill::Geometry Drill::front_geometry(int i, const std::vector<double>& S2old, double tb) {
   const int N = static_cast<int>(nodes_.size());
   const double h = cfg_.dxi;
+  double s2x = 0.0, s2xx = 0.0;
+  if (i == 0) {
+    s2xx = 2.0 * (S2old[1] - S2old[0]) / (h * h);
+  } else if (i < N - 1) {
+    s2x = (S2old[i + 1] - S2old[i - 1]) / (2 * h);
+    s2xx = (S2old[i + 1] - 2 * S2old[i] + S2old[i - 1]) / (h * h);
+  }
+  Geometry geo;
+  geo.J = std::sqrt(1.0 + s2x * s2x);
+  if (cfg_.curvature) {
+    const double a = -s2xx / (geo.J * geo.J * geo.J);
+    const double d = h * geo.J;
+    if (std::fabs(a * d) >= 2.0 && res_.curvature_clamps++ == 0)
+      first_clamp_ = "first at xi = " + fmt(nodes_[i].xi) + ", t = " + fmt(tb * G_.t_scale) + " s";
+    geo.Cc = curvature_factor(a, d);
+  }
+  return geo;
+}
+
+// Backward Euler in g: g_new = g_old + dtau (dS2 - dS1 + v)(g_new), with the
+// solid gradient, curvature, b2 and flow frozen over the step. The right side
+// decreases with g, so the root is unique and bracketed.
+void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n, double dtn) {
+  auto rate = [&](double g) {
+    const InterfaceState st = solve_interface(G_, n.xi, g, n.b2, advected_);
+    const double d2 =
+        std::max(melting_rate(G_, geo.Cc, grad_n, geo.J, st.grad_bottom, cfg_.moving_origin), 0.0);
+    const double d1 = std::max(recession_rate(G_, n.xi, st), 0.0);
+    return d2 - d1 + n.v;
+  };
+  const double g_old = n.g;
+  auto F = [&](double g) { return g - g_old - dtn * rate(g); };
+  double g_new;
+  const double F0 = F(0.0);
+  if (F0 >= 0.0) {
+    g_new = 0.0;
+  } else {
+    const double R0 = rate(g_old);
+    double hi = R0 > 0.0 ? g_old + dtn * R0 : g_old;
+    double Fhi = F(hi);
+    for (int k = 0; Fhi < 0.0 && k < 60; ++k) { hi = 2.0 * hi + 1e-12; Fhi = F(hi); }
+    g_new = illinois_root(F, 0.0, hi, F0, Fhi, 1e-12 * std::max(hi, 1e-12)).x;
+  }
+  n.itf = solve_interface(G_, n.xi, g_new, n.b2, advected_);
+}
+
+// (3-40) melting and (3-25) recession rates; a negative melting rate is
+// clamped to 0 and the solid demand it leaves undelivered is booked.
+Drill::Rates Drill::front_rates(const Node& n, const Geometry& geo, double grad_n, double dtn) {
+  Rates r;
+  r.drive = geo.Cc * grad_n * geo.J + G_.k * n.itf.grad_bottom;  // right side of (3-40)
+  r.dS2 = melting_rate(G_, geo.Cc, grad_n, geo.J, n.itf.grad_bottom, cfg_.moving_origin);
+  if (r.dS2 < 0.0) {
+    ++res_.melt_rate_clamps;
+    const double qscale_s = cfg_.mat.ks * G_.dT / cfg_.R;
+    res_.energy.clamp_defect += r.drive * qscale_s * n.area * dtn * G_.t_scale;
+    r.dS2 = 0.0;
+  }
+  r.dS1 = std::max(recession_rate(G_, n.xi, n.itf), 0.0);
+  return r;
+}
+
+// Stability of the explicit update (4-14): lambda = -d(dg/dtau)/dg. The text's
+// linear layer has it in closed form; the advected layer by a difference in g.
+void Drill::check_stability(Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn,
+                            double tb) {
+  if (cfg_.implicit_melt || !(n.itf.theta_sat > 0.0) || !(n.g > 0.0)) return;
+  double lambda;
+  if (!advected_) {
+    const double L = (1.0 / (G_.Ste * G_.Nc) - geo.Cc * (cfg_.moving_origin ? G_.theta_i : 0.0)) / G_.Na;
+    double dres;
+    interface_residual(G_, n.itf.phi, n.xi, n.g, n.b2, &dres);
+    const double dres_dg =
+        -G_.kprime * (n.itf.phi - G_.theta_m) / (n.g * n.g * (1.0 - G_.theta_m)) + G_.kprime * n.b2;
+    const double dtheta_dg = -dres_dg / dres / (1.0 - G_.theta_m);
+    const double dq = n.itf.theta_sat / (n.g * n.g) - dtheta_dg / n.g;  // -d(theta/g)/dg
+    lambda = (G_.k / L + G_.hls_hlv * G_.Ste) * dq;
+  } else {
+    // one Newton step from the current root gives phi(g + dg) to O(dg^2)
+    const double dg = 1e-6 * n.g;
+    double dres;
+    const double res = advected_residual(G_, n.itf.phi, n.xi, n.g + dg, n.b2, &dres);
+    const InterfaceState st = interface_at(G_, n.itf.phi - res / dres, n.g + dg, n.b2, true);
+    const double r0 = melting_rate(G_, geo.Cc, grad_n, geo.J, n.itf.grad_bottom, cfg_.moving_origin) -
+                      recession_rate(G_, n.xi, n.itf);
+    const double r1 = melting_rate(G_, geo.Cc, grad_n, geo.J, st.grad_bottom, cfg_.moving_origin) -
+                      recession_rate(G_, n.xi, st);
+    lambda = -(r1 - r0) / dg;
+  }
+  lambda_max_ = std::max(lambda_max_, lambda);
+  // lambda dtau > 2 makes the update overshoot; it is an instability once g
+  // oscillates (a layer only steps old, lambda ~ 1/g^2, may overshoot once)
+  const double dg = r.dS2 - r.dS1 + n.v;
+  n.flips = (lambda * dtn > 2.0 && dg * n.last_dg < 0.0) ? n.flips + 1 : 0;
+  n.last_dg = dg;
+  if (n.flips >= kUnstableFlips && !res_.unstable) {
+    res_.unstable = true;
+    res_.message = "melt thickness update (4-14) unstable at xi = " + fmt(n.xi) + ", t = " +
+                   fmt(tb * G_.t_scale) + " s: lambda*dtau = " + fmt(lambda * dtn) + " > 2";
+  }
+}
+
+// Energy terms [J] of the model's own balance (L3 of CASES.md).
+void Drill::book_energy(const Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn) {
+  Energy& E = res_.energy;
+  const Material& m = cfg_.mat;
+  const double qscale_l = m.kl * G_.dT / cfg_.R;  // W/m2 per unit nondim gradient
+  const double qscale_s = m.ks * G_.dT / cfg_.R;
+  const double dts = dtn * G_.t_scale;
+  const double theta_mo = cfg_.moving_origin ? G_.theta_i : 0.0;
+  E.solid_conduction += -geo.Cc * grad_n * geo.J * qscale_s * n.area * dts;
+  E.solid_preheat += -geo.Cc * theta_mo * G_.dT * m.rho * m.cps * r.dS2 * G_.v_scale * n.area * dts;
+  E.melt_latent += m.rho * m.hls * r.dS2 * G_.v_scale * n.area * dts;
+  const double T = n.itf.phi * m.Tsat0;
+  const double jv = evaporation_molar_flux(n.itf.p_pa, T, m.M);
+  E.vapour_latent += jv * m.M * m.hlv * n.area * dts;
+  const double Vv = vapour_velocity(T, m.M);
+  E.vapour_kinetic += 0.5 * jv * m.M * Vv * Vv * n.area * dts;
+  // what the advected layer absorbs between its faces, w theta_sat, heats the
+  // liquid on its way to the surface; the rest is carried sideways by the flow
+  const double sensible = advected_ ? n.itf.w * n.itf.theta_sat : 0.0;
+  E.melt_sensible += sensible * qscale_l * n.area * dts;
+  E.flow_advected += (n.itf.grad_top - n.itf.grad_bottom - sensible) * qscale_l * n.area * dts;
+}
+
+// (3-40), (3-25), (4-14), (4-15)
+void Drill::move_fronts(Node& n, const Rates& r, double dtn) {
+  n.dS2 = r.dS2;
+  n.dS1 = r.dS1;
+  n.S2 += r.dS2 * dtn;
+  n.S1 += r.dS1 * dtn;
+  n.S1flow += -n.v * dtn;
+  n.g += (r.dS2 - r.dS1 + n.v) * dtn;
+  if (n.g < 0.0) {
+    ++res_.melt_clamps;
+    n.g = 0.0;
+  }
+}
+
+void Drill::advance_interfaces(double ta, double tb) {
+  const int N = static_cast<int>(nodes_.size());
   std::vector<double> S2old(N);
   for (int i = 0; i < N; ++i) S2old[i] = nodes_[i].S2;
-  const double qscale_l = cfg_.mat.kl * G_.dT / cfg_.R;  // W/m2 per unit nondim gradient
-  const double qscale_s = cfg_.mat.ks * G_.dT / cfg_.R;
-  const double vscale = G_.v_scale;
-  Energy& E = res_.energy;
   for (int i = 0; i < N; ++i) {
     Node& n = nodes_[i];
-    const double t0 = n.molten ? node_ta(n, ta) : tb;
-    const double dt_pre = std::max(0.0, std::min(tb, n.tau_m) - ta);
-    const double beam = cfg_.I0 * gaussian_beam(n.xi) * n.area;  // W
-    E.laser_nodal += beam * (tb - ta) * G_.t_scale;
-    E.solid_premelt += beam * dt_pre * G_.t_scale;
+    book_beam(n, ta, tb);
     if (!n.molten) continue;
+    const double t0 = node_ta(n, ta);
     const double dtn = tb - t0;
     if (!(dtn > 0.0)) continue;
-    // slope and curvature of the melting front (3-38)
-    double s2x = 0.0, s2xx = 0.0;
-    if (i == 0) {
-      s2xx = 2.0 * (S2old[1] - S2old[0]) / (h * h);
-    } else if (i < N - 1) {
-      s2x = (S2old[i + 1] - S2old[i - 1]) / (2 * h);
-      s2xx = (S2old[i + 1] - 2 * S2old[i] + S2old[i - 1]) / (h * h);
-    }
-    const double J = std::sqrt(1.0 + s2x * s2x);
-    double Cc = 1.0;
-    if (cfg_.curvature) {
-      const double a = -s2xx / (J * J * J);
-      const double d = h * J;
-      if (std::fabs(a * d) >= 2.0) {
-        if (res_.curvature_clamps++ == 0)
-          first_clamp_ = "first at xi = " + fmt(n.xi) + ", t = " + fmt(tb * G_.t_scale) + " s";
-      }
-      Cc = curvature_factor(a, d);
-    }
+    const Geometry geo = front_geometry(i, S2old, tb);
     const double grad_n = solid_gradient_mean(n, t0, tb);
-    const double theta_mo = cfg_.moving_origin ? G_.theta_i : 0.0;
-    const double L = (1.0 / (G_.Ste * G_.Nc) - Cc * theta_mo) / G_.Na;
-    if (cfg_.implicit_melt) {
-      // Backward Euler in g: g_new = g_old + dtau (dS2 - dS1 + v)(g_new), with
-      // the solid gradient, curvature, b2 and flow frozen over the step. The
-      // right side decreases with g, so the root is unique and bracketed.
-      auto rate = [&](double g) {
-        const InterfaceState st = solve_interface(G_, n.xi, g, n.b2);
-        const double d2 = std::max(melting_rate(G_, Cc, grad_n, J, st.grad_bottom, cfg_.moving_origin), 0.0);
-        const double d1 = std::max(recession_rate(G_, n.xi, st), 0.0);
-        return d2 - d1 + n.v;
-      };
-      const double g_old = n.g;
-      auto F = [&](double g) { return g - g_old - dtn * rate(g); };
-      double g_new;
-      const double F0 = F(0.0);
-      if (F0 >= 0.0) {
-        g_new = 0.0;
-      } else {
-        const double R0 = rate(g_old);
-        double hi = R0 > 0.0 ? g_old + dtn * R0 : g_old;
-        double Fhi = F(hi);
-        for (int k = 0; Fhi < 0.0 && k < 60; ++k) { hi = 2.0 * hi + 1e-12; Fhi = F(hi); }
-        g_new = illinois_root(F, 0.0, hi, F0, Fhi, 1e-12 * std::max(hi, 1e-12)).x;
-      }
-      n.itf = solve_interface(G_, n.xi, g_new, n.b2);
-    }
-    const double drive = Cc * grad_n * J + G_.k * n.itf.grad_bottom;  // right side of (3-40)
-    double dS2 = melting_rate(G_, Cc, grad_n, J, n.itf.grad_bottom, cfg_.moving_origin);
-    if (dS2 < 0.0) {
-      ++res_.melt_rate_clamps;
-      // the solid demand booked below exceeds what the melt delivers by -drive
-      E.clamp_defect += drive * qscale_s * n.area * dtn * G_.t_scale;
-      dS2 = 0.0;
-    }
-    double dS1 = recession_rate(G_, n.xi, n.itf);
-    dS1 = std::max(dS1, 0.0);
-    n.dS2 = dS2;
-    n.dS1 = dS1;
-    // stability of the explicit update (4-14): d(dg/dtau)/dg
-    if (!cfg_.implicit_melt && n.itf.theta_sat > 0.0 && n.g > 0.0) {
-      double dres;
-      interface_residual(G_, n.itf.phi, n.xi, n.g, n.b2, &dres);
-      const double dres_dg =
-          -G_.kprime * (n.itf.phi - G_.theta_m) / (n.g * n.g * (1.0 - G_.theta_m)) + G_.kprime * n.b2;
-      const double dtheta_dg = -dres_dg / dres / (1.0 - G_.theta_m);
-      const double dq = n.itf.theta_sat / (n.g * n.g) - dtheta_dg / n.g;  // -d(theta/g)/dg
-      const double lambda = (G_.k / L + G_.hls_hlv * G_.Ste) * dq;
-      lambda_max_ = std::max(lambda_max_, lambda);
-      if (lambda * dtn > 2.0 && !res_.unstable) {
-        res_.unstable = true;
-        res_.message = "melt thickness update (4-14) unstable at xi = " + fmt(n.xi) + ", t = " +
-                       fmt(tb * G_.t_scale) + " s: lambda*dtau = " + fmt(lambda * dtn) + " > 2";
-      }
-    }
-    // energy terms [J]
-    const double dts = dtn * G_.t_scale;
-    E.solid_conduction += -Cc * grad_n * J * qscale_s * n.area * dts;
-    E.solid_preheat += -Cc * theta_mo * G_.dT * cfg_.mat.rho * cfg_.mat.cps * dS2 * vscale * n.area * dts;
-    E.melt_latent += cfg_.mat.rho * cfg_.mat.hls * dS2 * vscale * n.area * dts;
-    const double T = n.itf.phi * cfg_.mat.Tsat0;
-    const double jv = evaporation_molar_flux(n.itf.p_pa, T, cfg_.mat.M);
-    E.vapour_latent += jv * cfg_.mat.M * cfg_.mat.hlv * n.area * dts;
-    const double Vv = vapour_velocity(T, cfg_.mat.M);
-    E.vapour_kinetic += 0.5 * jv * cfg_.mat.M * Vv * Vv * n.area * dts;
-    E.flow_advected += (n.itf.grad_top - n.itf.grad_bottom) * qscale_l * n.area * dts;
-    // (3-40), (3-25), (4-14)
-    n.S2 += dS2 * dtn;
-    n.S1 += dS1 * dtn;
-    n.S1flow += -n.v * dtn;
-    n.g += (dS2 - dS1 + n.v) * dtn;
-    if (n.g < 0.0) {
-      ++res_.melt_clamps;
-      n.g = 0.0;
-    }
+    if (cfg_.implicit_melt) solve_implicit_thickness(n, geo, grad_n, dtn);
+    const Rates r = front_rates(n, geo, grad_n, dtn);
+    check_stability(n, geo, grad_n, r, dtn, tb);
+    book_energy(n, geo, grad_n, r, dtn);
+    move_fronts(n, r, dtn);
   }
 }
 
@@ -409,7 +484,53 @@ void Drill::record(double tau, bool frame) {
     f.flow_v.push_back(n.v * vs);
     f.b2.push_back(n.b2);
   }
-  res_.frames.push_back(std::move(f));
+  emit(std::move(f));
+}
+
+void Drill::emit(Frame&& f) {
+  ++res_.frames_written;
+  if (sink_) sink_->frame(f);
+  else res_.frames.push_back(f);
+  res_.final_frame = std::move(f);
+}
+
+void Drill::physical_check() {
+  PhysicalCheck& pc = res_.check;
+  const Material& m = cfg_.mat;
+  const double R = cfg_.R;
+  auto H = [&](double Ts) { return m.cps * (m.Tm - m.Ti) + m.hls + m.cpl * (Ts - m.Tm) + m.hlv; };
+  pc.Ts = res_.T_center;
+  pc.H = H(std::max(pc.Ts, m.Tm));
+  pc.H0 = H(m.Tsat0);
+  const double melt_heat = m.cps * (m.Tm - m.Ti) + m.hls;  // J/kg of melt still in place
+  double beam = 0, demand = 0, demand0 = 0;
+  pc.worst_node_ratio = 0;
+  const double t_end = res_.t_end;
+  for (const auto& n : nodes_) {
+    const double absorbed = cfg_.I0 * gaussian_beam(n.xi) * t_end;  // J/m2
+    beam += absorbed * n.area;
+    const double removed = (n.S2 - n.g) * R, melt = n.g * R;
+    if (!n.molten) continue;
+    const double Ts = n.itf.phi * m.Tsat0;
+    const double need = m.rho * (H(Ts) * removed + melt_heat * melt);
+    demand += m.rho * pc.H * removed * n.area;
+    demand0 += m.rho * pc.H0 * removed * n.area;
+    const double ratio = need / absorbed;
+    if (ratio > pc.worst_node_ratio) { pc.worst_node_ratio = ratio; pc.worst_node_xi = n.xi; }
+  }
+  pc.removed_over_beam = beam > 0 ? demand / beam : 0.0;
+  pc.removed_over_beam_H0 = beam > 0 ? demand0 / beam : 0.0;
+  // net centre recession over the last 10 % of the pulse
+  const auto& c = res_.centre;
+  if (c.size() >= 2 && res_.t_melt_center >= 0) {
+    const double ta = c.back().t - 0.1 * (c.back().t - res_.t_melt_center);
+    size_t k = c.size() - 1;
+    while (k > 0 && c[k].t > ta) --k;
+    if (c.back().t > c[k].t) pc.centre_velocity = (c.back().depth - c[k].depth) / (c.back().t - c[k].t);
+  }
+  pc.centre_bound = cfg_.I0 / (m.rho * pc.H);
+  pc.centre_velocity_ratio = pc.centre_velocity / pc.centre_bound;
+  pc.holds = pc.removed_over_beam < 1.0 && pc.worst_node_ratio < 1.0 && pc.centre_velocity_ratio < 1.0;
 }
 
 Result Drill::run() {
@@ -417,7 +538,13 @@ Result Drill::run() {
   const double tau_p = res_.tau_p;
   const long nsteps = static_cast<long>(std::ceil(tau_p / dtau_ - 1e-9));
   const long centre_every = std::max(1L, nsteps / 20000);
-  const int nframes = std::max(2, cfg_.frames);
+  int nframes = std::max(2, cfg_.frames);
+  if (nframes > nsteps + 1) {
+    res_.notes.push_back("--frames " + std::to_string(cfg_.frames) + " clipped to " + std::to_string(nsteps + 1) +
+                         " (the run has " + std::to_string(nsteps) + " time steps)");
+    nframes = static_cast<int>(nsteps + 1);
+  }
+  if (sink_) sink_->begin(res_.xi, res_.tau_m_s);
   int next_frame = 1;
   record(0.0, true);
   long next_progress = nsteps / 10;
@@ -469,8 +596,10 @@ Result Drill::run() {
       next_progress += nsteps / 10;
     }
   }
-  if (res_.frames.empty() || res_.frames.back().t < tau * G_.t_scale) record(tau, true);
+  if (res_.frames_written == 0 || res_.final_frame.t < tau * G_.t_scale) record(tau, true);
+  if (sink_) sink_->finish();
   res_.t_end = tau * G_.t_scale;
+  res_.dt = cfg_.dt;
   res_.max_stable_dt = lambda_max_ > 0 ? 2.0 / lambda_max_ * G_.t_scale : 0.0;
   if (res_.unstable)
     res_.message += "; use --dt below about " + fmt(res_.max_stable_dt) + " s (--dtau " +
@@ -482,6 +611,7 @@ Result Drill::run() {
   res_.depth_center = (c.S2 - c.g) * R;
   res_.S2_center = c.S2 * R;
   res_.g_center = c.g * R;
+  res_.T_center = res_.centre.back().T;
   for (const auto& n : nodes_) {
     res_.volume_removed += (n.S2 - n.g) * R * n.area;
     res_.volume_vaporized += n.S1 * R * n.area;
@@ -489,6 +619,7 @@ Result Drill::run() {
     res_.volume_melted += n.S2 * R * n.area;
   }
   res_.removal_rate = res_.t_end > 0 ? res_.volume_removed / res_.t_end : 0.0;
+  physical_check();
   if (res_.status == "ok" && c.tau_m >= tau_p) {
     res_.status = "no_melt";
     res_.message = "the surface does not reach T_m within the pulse: melt onset at the centre would be at t = " +
@@ -521,8 +652,31 @@ Result Drill::run() {
 
 }  // namespace
 
+namespace {
+// Advected layer: the quasi-steady centre state dS2 = dS1 (solid gradient
+// decayed) is found numerically in g, and lambda by a difference in g.
+double advected_step_limit(const Config& cfg, const Groups& G) {
+  auto rate = [&](double g) {
+    const InterfaceState st = solve_interface(G, 0.0, g, 0.0, true);
+    return melting_rate(G, 1.0, 0.0, 1.0, st.grad_bottom, cfg.moving_origin) - recession_rate(G, 0.0, st);
+  };
+  double lo = 1e-8, hi = 1e-8;
+  if (!(rate(lo) > 0.0)) return 0.0;
+  for (int k = 0; k < 200 && rate(hi) > 0.0; ++k) hi *= 1.5;
+  if (rate(hi) > 0.0) return 0.0;
+  for (int k = 0; k < 200 && hi - lo > 1e-10 * hi; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (rate(mid) > 0.0 ? lo : hi) = mid;
+  }
+  const double g = 0.5 * (lo + hi), dg = 1e-6 * g;
+  const double lambda = -(rate(g + dg) - rate(g)) / dg;
+  return lambda > 0.0 ? 2.0 / lambda * G.t_scale : 0.0;
+}
+}  // namespace
+
 double explicit_step_limit(const Config& cfg) {
   const Groups G = make_groups(cfg.mat, cfg.I0, cfg.R);
+  if (cfg.melt_energy == MeltEnergy::Advected) return advected_step_limit(cfg, G);
   const double L0 = 1.0 / (G.Ste * G.Nc) - G.theta_i;
   // surface state for a conduction gradient q into the melt: vapour term = 1 - k' q
   auto phi_of_q = [&](double q) {
@@ -561,8 +715,8 @@ double explicit_step_limit(const Config& cfg) {
   return 2.0 / lambda * G.t_scale;
 }
 
-Result run_simulation(const Config& cfg) {
-  Drill d(cfg);
+Result run_simulation(const Config& cfg, FrameSink* sink) {
+  Drill d(cfg, sink);
   return d.run();
 }
 

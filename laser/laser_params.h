@@ -1,6 +1,7 @@
-// Case description of laser_drill: every parameter declared once (name, unit,
-// range, default, help), read from defaults < material preset < config file
-// < command line, and validated before anything is written.
+// Case description of laser_drill: every parameter declared once (name, TOML
+// section, unit, range, default, help), read from defaults < material preset <
+// config file (TOML, toml++) < command line (CLI11), and validated before
+// anything is computed or written.
 #pragma once
 
 #include <stdexcept>
@@ -11,11 +12,18 @@
 
 namespace laser {
 
+constexpr const char* kVersion = "2.0.0";
+
 enum class FlowModel { Conduction, Rising, RisingFall, Boundary };
 enum class SolidModel { Exact, Shifted, Stefan };
+// Melt layer energy: Advected = quasi-steady advection-diffusion in the frame of
+// the vaporizing surface (exponential profile; the vaporized mass carries
+// c_pl (T_s - T_m)); Text = the linear conduction layer of the dissertation.
+enum class MeltEnergy { Advected, Text };
 
 const char* to_string(FlowModel m);
 const char* to_string(SolidModel m);
+const char* to_string(MeltEnergy m);
 
 struct Config {
   Material mat;
@@ -26,17 +34,19 @@ struct Config {
   double m = 2.0;
   double xi_p = 1.0;
   SolidModel solid = SolidModel::Exact;
+  MeltEnergy melt_energy = MeltEnergy::Advected;
   double shift = 3.0 / (4.0 * kPi);  // (3-36): shift of the Stefan solution in tau_m
   bool curvature = true;
   bool moving_origin = true;
   bool implicit_melt = false;  // backward Euler for g instead of (4-14)
   double dxi = 0.0125;
   double xi_max = 0.0;     // 0: just beyond the last node that melts within the pulse
-  double dt = 0.0;         // s; 0: 5e-7 s * min(1, (7.5e10 W/m2 / I0)^2)
+  double dt = 0.0;         // s; 0: chosen by the time-step policy (laser_timestep.h)
   double dtau = 0.0;       // nondimensional; overrides dt when > 0
-  bool dt_auto = false;    // dt chosen by the program: halved on instability
+  double tol = 1e-3;       // relative depth/volume error the time-step policy aims at
   int frames = 200;        // HDF5 frames
   std::string out = "laser_out";
+  bool overwrite = false;
   bool quiet = false;
   std::string config_file;
   std::string material = "superalloy";
@@ -46,13 +56,25 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Parses argv (and the config file named by --config). Throws UsageError with
-// a message naming the option and its valid range. Sets help=true for --help.
-Config parse_command_line(int argc, const char* const* argv, bool& help, bool& dump_conduction);
-// Checks ranges and cross-parameter conditions; throws UsageError.
+struct Invocation {
+  Config cfg;
+  bool exit_now = false;        // --help or --version printed
+  bool dump_conduction = false;
+};
+
+// Parses argv with CLI11 and the file named by --config with toml++. Throws
+// UsageError naming the option (or file:line and key), its unit and range.
+// Prints --help / --version to stdout and sets exit_now.
+Invocation parse_command_line(int argc, const char* const* argv);
+// Reads one TOML config into cfg (sections [laser], [model], [numerics],
+// [output], [material]); throws UsageError. Exposed for the tests.
+void read_config_file(Config& cfg, const std::string& path);
+// Cross-parameter checks (T_i < T_m < T_sat0, grid, step versus pulse);
+// throws UsageError.
 void validate(Config& c);
-std::string usage_text();
 // The material presets built in (Table 5.1 of the dissertation).
 std::vector<std::string> material_presets();
+// Keys of each TOML section, for documentation and tests.
+std::vector<std::pair<std::string, std::string>> config_keys();
 
 }  // namespace laser

@@ -1,0 +1,145 @@
+#include "laser_timestep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace laser {
+
+namespace {
+std::string fmt(double v) {
+  std::ostringstream o;
+  o.precision(4);
+  o << v;
+  return o.str();
+}
+double rel_diff(double a, double b) {
+  const double s = std::max(std::fabs(a), std::fabs(b));
+  return s > 0.0 ? std::fabs(a - b) / s : 0.0;
+}
+// Steps per pulse and per melting time (onset at the centre to the pulse end)
+// of the automatic step; the stability limit is kept at a factor 4 so that
+// the companion run at twice the step is stable as well.
+constexpr double kStepsPerPulse = 100.0;
+constexpr double kStepsPerMelting = 200.0;
+constexpr double kStableFraction = 0.25;
+}  // namespace
+
+TimeStepPolicy::TimeStepPolicy(const Config& cfg) {
+  dt_stable_ = cfg.implicit_melt ? 0.0 : explicit_step_limit(cfg);
+  const Groups G = make_groups(cfg.mat, cfg.I0, cfg.R);
+  const double t_melt = melt_onset_tau(G, 0.0) * G.t_scale;
+  if (cfg.dt > 0.0) {
+    dt_ = cfg.dt;
+    reason_ = cfg.dtau > 0.0 ? "--dtau" : "--dt";
+    if (dt_stable_ > 0.0 && dt_ > dt_stable_) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "%s: time step %.4g s is above the explicit stability limit %.4g s of the melt thickness "
+                    "update (4-14) at this intensity; valid range (0, %.4g] s (or --melt-update implicit)",
+                    reason_.c_str(), dt_, dt_stable_, dt_stable_);
+      throw UsageError(buf);
+    }
+    if (cfg.tp / dt_ > kMaxSteps / 3)
+      throw UsageError(reason_ + ": " + fmt(cfg.tp / dt_) + " steps of " + fmt(dt_) + " s over the pulse " +
+                       fmt(cfg.tp) + " s; at most " + fmt(kMaxSteps / 3) + " allowed (valid range [" +
+                       fmt(3 * cfg.tp / kMaxSteps) + ", " + fmt(cfg.tp) + ") s)");
+    return;
+  }
+  automatic_ = true;
+  dt_ = cfg.tp / kStepsPerPulse;
+  reason_ = "pulse / " + fmt(kStepsPerPulse);
+  if (t_melt < cfg.tp && (cfg.tp - t_melt) / kStepsPerMelting < dt_) {
+    dt_ = (cfg.tp - t_melt) / kStepsPerMelting;
+    reason_ = "melting time / " + fmt(kStepsPerMelting);
+  }
+  if (dt_stable_ > 0.0 && kStableFraction * dt_stable_ < dt_) {
+    dt_ = kStableFraction * dt_stable_;
+    reason_ = "explicit limit (4-14) x " + fmt(kStableFraction);
+  }
+}
+
+Result TimeStepPolicy::run_at(Config cfg, double dt, const SinkFactory& make_sink, bool reported,
+                              long& steps) const {
+  cfg.dt = dt;
+  std::unique_ptr<FrameSink> sink;
+  if (reported && make_sink) sink = make_sink();
+  if (!reported) {
+    cfg.quiet = true;
+    cfg.frames = 2;
+  }
+  Result r = run_simulation(cfg, sink.get());
+  steps += r.steps;
+  return r;
+}
+
+Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) const {
+  long steps = 0;
+  int runs = 0;
+  double dt = dt_;
+  Result fine = run_at(cfg, dt, make_sink, true, steps);
+  ++runs;
+  // the run-time check of (4-14) may still fire: an automatic step is halved
+  for (int k = 0; k < 6 && automatic_ && fine.status == "unstable_time_step"; ++k) {
+    dt *= 0.5;
+    if (!cfg.quiet)
+      std::fprintf(stderr, "laser_drill: automatic step unstable (%s); retrying with dt = %.4g s\n",
+                   fine.message.c_str(), dt);
+    fine = run_at(cfg, dt, make_sink, true, steps);
+    ++runs;
+  }
+  if (fine.status == "unstable_time_step") return fine;
+  // companion at 2 dt: err(dt) ~ D(dt) - D(2 dt); at dt/2 when 2 dt is not
+  // stable or not shorter than the pulse: err(dt) ~ 2 (D(dt) - D(dt/2))
+  double companion = 2.0 * dt, factor = 1.0;
+  Result coarse;
+  bool have = false;
+  if (companion < cfg.tp && (dt_stable_ == 0.0 || companion <= dt_stable_)) {
+    coarse = run_at(cfg, companion, nullptr, false, steps);
+    ++runs;
+    have = coarse.status != "unstable_time_step";
+  }
+  if (!have) {
+    companion = 0.5 * dt;
+    factor = 2.0;
+    coarse = run_at(cfg, companion, nullptr, false, steps);
+    ++runs;
+  }
+  double ed = factor * rel_diff(fine.depth_center, coarse.depth_center);
+  double ev = factor * rel_diff(fine.volume_removed, coarse.volume_removed);
+  while (automatic_ && std::max(ed, ev) > cfg.tol && double(steps) + 2.0 * cfg.tp / dt <= kMaxSteps) {
+    // halve: the reported run becomes the companion of the next one
+    coarse = std::move(fine);
+    companion = dt;
+    factor = 1.0;
+    dt *= 0.5;
+    if (!cfg.quiet)
+      std::fprintf(stderr, "laser_drill: estimated error %.2e above --tol %.2e; refining to dt = %.4g s\n",
+                   std::max(ed, ev), cfg.tol, dt);
+    fine = run_at(cfg, dt, make_sink, true, steps);
+    ++runs;
+    if (fine.status == "unstable_time_step") return fine;
+    ed = rel_diff(fine.depth_center, coarse.depth_center);
+    ev = rel_diff(fine.volume_removed, coarse.volume_removed);
+  }
+  StepReport& s = fine.step;
+  s.automatic = automatic_;
+  s.companion_dt = companion;
+  s.depth_error = ed;
+  s.volume_error = ev;
+  s.runs = runs;
+  s.steps_total = steps;
+  s.reason = reason_ + (dt < dt_ ? ", refined to meet --tol" : "");
+  if (std::max(ed, ev) > cfg.tol && (fine.status == "ok" || fine.status == "inaccurate")) {
+    const std::string m = "estimated error of the time step: depth " + fmt(ed) + ", volume " + fmt(ev) +
+                          " (step doubling, dt = " + fmt(dt) + " s against " + fmt(companion) +
+                          " s) above --tol " + fmt(cfg.tol) +
+                          (automatic_ ? " after refining to the step budget" : "; use a smaller --dt or leave it automatic");
+    fine.message = fine.status == "ok" ? m : fine.message + "; " + m;
+    fine.status = "inaccurate";
+  }
+  return fine;
+}
+
+}  // namespace laser
