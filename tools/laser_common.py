@@ -17,7 +17,8 @@ def find_exe(exe=None):
 
 def run_case(exe, out, args, quiet=True):
     """Runs laser_drill into directory out; returns (exit code, summary dict or None, stderr)."""
-    cmd = [exe, "--out", out] + [str(a) for a in args] + (["--quiet"] if quiet else [])
+    # --overwrite: the tools re-run cases into their own folders
+    cmd = [exe, "--out", out, "--overwrite"] + [str(a) for a in args] + (["--quiet"] if quiet else [])
     p = subprocess.run(cmd, capture_output=True, text=True)
     summary = None
     path = os.path.join(out, "summary.json")
