@@ -3,6 +3,7 @@
 #include <HYPRE_struct_ls.h>
 #include <HYPRE_utilities.h>
 
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <sstream>
@@ -39,6 +40,7 @@ struct PressureSolver::Hypre {
   std::vector<double> values;  // kEntries per owned node, box order (i fastest)
   bool valid_values = false;
   std::vector<double> bbuf, xbuf;
+  long pin = -1;  // all-Neumann: global key of the FLUID node held at p = 0, else -1
 
   void destroy_all(PressureSettings::Preconditioner kind) {
     if (pcg) HYPRE_StructPCGDestroy(pcg);
@@ -110,12 +112,27 @@ void PressureSolver::build_grid() {
    each FLUID neighbour; EMPTY neighbours stay on the diagonal only (their value
    goes to the rhs); EMPTY and SOLID rows are the identity. Returns true if the
    values differ from those hypre holds. */
+long PressureSolver::node_key(int i, int j, int k) const {
+  const GridSpec &g = grid_.spec();
+  int idx[3] = {i, j, k};
+  long key = 0;
+  for (int d = 2; d >= 0; --d) {
+    if (g.periodic[d]) idx[d] = ((idx[d] % g.ncell[d]) + g.ncell[d]) % g.ncell[d];
+    key = key * (g.node_hi(d) - g.node_lo(d) + 1) + (idx[d] - g.node_lo(d));
+  }
+  return key;
+}
+
+bool PressureSolver::unknown(const NodeLabels &labels, int i, int j, int k, std::size_t n) const {
+  return labels.kind[n] == kFluid && (h_->pin < 0 || node_key(i, j, k) != h_->pin);
+}
+
 bool PressureSolver::assemble_values(const NodeLabels &labels, const double *beta) {
   std::vector<double> v(h_->values.size(), 0.0);
   std::size_t row = 0;
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     double *r = &v[kEntries * row++];
-    if (labels.kind[n] != kFluid) {
+    if (!unknown(labels, i, j, k, n)) {
       r[0] = 1.0;
       return;
     }
@@ -125,7 +142,9 @@ bool PressureSolver::assemble_values(const NodeLabels &labels, const double *bet
         if (!open_face(grid_, labels, i, j, k, d, side, &m)) continue;
         const double c = geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]);
         r[0] += c;
-        if (side < 0 && labels.kind[m] == kFluid) r[1 + d] = -c;
+        int q[3] = {i, j, k};
+        q[d] += side;
+        if (side < 0 && unknown(labels, q[0], q[1], q[2], m)) r[1 + d] = -c;
       }
   });
   int changed = (!h_->valid_values || std::memcmp(v.data(), h_->values.data(), v.size() * sizeof(double)) != 0);
@@ -200,6 +219,27 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
   int any_moved = 0;
   MPI_Allreduce(&moved, &any_moved, 1, MPI_INT, MPI_MAX, comm_);
   if (any_moved) build_grid();
+
+  // Without any EMPTY node the constants are the operator's null space: the rhs is made
+  // compatible (mean removed) and the FLUID node of smallest global key is held at 0,
+  // which keeps the matrix definite (PCG + PFMG stalls on the semidefinite one) without
+  // changing the solution of the compatible system up to its constant.
+  long counts[2] = {0, 0}, gcounts[2];  // EMPTY nodes, FLUID nodes
+  long first = -1;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (labels.kind[n] == kEmpty) ++counts[0];
+    if (labels.kind[n] != kFluid) return;
+    ++counts[1];
+    const long key = node_key(i, j, k);
+    if (first < 0 || key < first) first = key;
+  });
+  MPI_Allreduce(counts, gcounts, 2, MPI_LONG, MPI_SUM, comm_);
+  res.singular = gcounts[0] == 0 && gcounts[1] > 0;
+  h.pin = -1;
+  if (res.singular) {
+    long mine = first < 0 ? LONG_MAX : first;
+    MPI_Allreduce(&mine, &h.pin, 1, MPI_LONG, MPI_MIN, comm_);
+  }
   if (assemble_values(labels, beta) || !h.pcg) {
     setup_solver();
     res.rebuilt = true;
@@ -208,19 +248,14 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
 
   // Right-hand side of -dx^2 L p = -dx^2 rhs, EMPTY neighbours' values moved over.
   const double dx2 = grid_.spec().dx * grid_.spec().dx;
-  long counts[2] = {0, 0};  // EMPTY nodes, FLUID nodes
   double bsum = 0.0;
   std::size_t row = 0;
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     double &b = h.bbuf[row];
     double &x = h.xbuf[row];
     ++row;
-    if (labels.kind[n] != kFluid) {
-      if (labels.kind[n] == kEmpty) ++counts[0];
-      b = x = 0.0;
-      return;
-    }
-    ++counts[1];
+    b = x = 0.0;
+    if (labels.kind[n] != kFluid) return;
     b = -dx2 * rhs[n];
     if (p_empty)
       for (int d = 0; d < 3; ++d)
@@ -232,19 +267,18 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
     bsum += b;
     x = p[n];
   });
-  long gcounts[2];
-  MPI_Allreduce(counts, gcounts, 2, MPI_LONG, MPI_SUM, comm_);
-  if (gcounts[0] == 0 && gcounts[1] > 0) {
-    // All-Neumann: only a compatible rhs (orthogonal to the constants) has a solution.
+  if (res.singular) {
     double gsum = 0.0;
     MPI_Allreduce(&bsum, &gsum, 1, MPI_DOUBLE, MPI_SUM, comm_);
     const double mean = gsum / double(gcounts[1]);
     row = 0;
-    grid_.for_owned([&](int, int, int, std::size_t n) {
-      if (labels.kind[n] == kFluid) h.bbuf[row] -= mean;
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+      double &b = h.bbuf[row], &x = h.xbuf[row];
       ++row;
+      if (labels.kind[n] != kFluid) return;
+      b -= mean;
+      if (!unknown(labels, i, j, k, n)) b = x = 0.0;  // the pinned node
     });
-    res.singular = true;
     res.rhs_mean_removed = -mean / dx2;  // in the units of rhs
   }
 

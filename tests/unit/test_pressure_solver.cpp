@@ -501,6 +501,41 @@ TEST(PressureSolver, CheckerboardIsTheStiffestModeNotANullMode) {
   EXPECT_EQ(dmax, 0.0);
 }
 
+TEST(PressureSolver, ClosedBoxFullOfFluid) {
+  // No EMPTY node: the constants are the null space. A random source is made
+  // compatible (its mean removed) and the answer has zero mean; L p then equals
+  // the compatible source.
+  Problem P(cube(10, 7, 9, 0.1), MPI_COMM_WORLD, 0.45);
+  P.each_patch([&](int i, int j, int k, std::size_t n) { P.beta[n] = (0.4 + 0.6 * hash01(i, j, k, 8)) / 1000.0; });
+  double vs[2] = {0, 0}, VS[2];
+  P.grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (P.lab.kind[n] != kFluid) return;
+    P.rhs[n] = hash01(i, j, k, 9) - 0.3;
+    vs[0] += P.rhs[n];
+    vs[1] += 1.0;
+  });
+  MPI_Allreduce(vs, VS, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  mpm::PressureSolver solver(P.grid, MPI_COMM_WORLD, tight(1e-10), P.geo);
+  const mpm::PressureResult r = solver.solve(P.lab, P.beta.data(), P.rhs.data(), P.p.data());
+  std::vector<double> Lp(P.grid.size());
+  mpm::apply_laplacian(P.grid, P.lab, P.geo, P.beta.data(), P.p.data(), Lp.data());
+  const double mean = VS[0] / VS[1];
+  const double err = P.max_owned([&](int, int, int, std::size_t n) {
+    return P.lab.kind[n] == kFluid ? std::fabs(Lp[n] - (P.rhs[n] - mean)) : 0.0;
+  });
+  double ps = 0, PS;
+  P.grid.for_owned([&](int, int, int, std::size_t n) { ps += P.lab.kind[n] == kFluid ? P.p[n] : 0.0; });
+  MPI_Allreduce(&ps, &PS, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  if (root())
+    std::printf("[ neumann  ] closed box full of fluid, random beta and source: %d PCG iterations, mean removed %.4f "
+                "(expected %.4f), max |L p - compatible source| %.1e\n",
+                r.iterations, r.rhs_mean_removed, mean, err);
+  EXPECT_TRUE(r.singular);
+  EXPECT_NEAR(r.rhs_mean_removed, mean, 1e-12);
+  EXPECT_LT(err, 1e-7);
+  EXPECT_LT(std::fabs(PS) / VS[1], 1e-12);
+}
+
 // ---- 6. Two ranks against one --------------------------------------------------------------------
 
 TEST(PressureSolver, TwoRanksMatchOne) {
