@@ -42,13 +42,16 @@ struct PressureSolver::Hypre {
   std::vector<double> bbuf, xbuf;
   long pin = -1;  // all-Neumann: global key of the FLUID node held at p = 0, else -1
 
-  void destroy_all(PressureSettings::Preconditioner kind) {
+  void destroy_solver(PressureSettings::Preconditioner kind) {
     if (pcg) HYPRE_StructPCGDestroy(pcg);
     if (precond) {
       if (kind == PressureSettings::Preconditioner::PFMG) HYPRE_StructPFMGDestroy(precond);
       if (kind == PressureSettings::Preconditioner::SMG) HYPRE_StructSMGDestroy(precond);
     }
     pcg = precond = nullptr;
+  }
+  void destroy_all(PressureSettings::Preconditioner kind) {
+    destroy_solver(kind);
     if (A) HYPRE_StructMatrixDestroy(A);
     if (b) HYPRE_StructVectorDestroy(b);
     if (x) HYPRE_StructVectorDestroy(x);
@@ -165,12 +168,7 @@ bool PressureSolver::assemble_values(const NodeLabels &labels, const double *bet
 
 void PressureSolver::setup_solver() {
   Hypre &h = *h_;
-  if (h.pcg) HYPRE_StructPCGDestroy(h.pcg);
-  if (h.precond) {
-    if (settings_.preconditioner == PressureSettings::Preconditioner::PFMG) HYPRE_StructPFMGDestroy(h.precond);
-    if (settings_.preconditioner == PressureSettings::Preconditioner::SMG) HYPRE_StructSMGDestroy(h.precond);
-  }
-  h.pcg = h.precond = nullptr;
+  h.destroy_solver(settings_.preconditioner);
   HYPRE_StructPCGCreate(comm_, &h.pcg);
   HYPRE_StructPCGSetMaxIter(h.pcg, settings_.max_iterations);
   HYPRE_StructPCGSetTol(h.pcg, settings_.tolerance);
