@@ -405,19 +405,19 @@ void FixMpmFluid::parse_args(int narg, char **arg) {
       ms.side = mpm::SIDE_AUTO;
       const char *k = arg[iarg + 2];
       iarg += 3;
-      if (strcmp(k, "noslip") == 0) ms.kind = 0;
-      else if (strcmp(k, "freeslip") == 0) ms.kind = 1;
+      if (strcmp(k, "noslip") == 0) ms.kind = mpm::WALL_NOSLIP;
+      else if (strcmp(k, "freeslip") == 0) ms.kind = mpm::WALL_FREESLIP;
       else if (strcmp(k, "partial") == 0 || strcmp(k, "sticky") == 0) {
         const bool sticky_kind = strcmp(k, "sticky") == 0;
         const char *kwname = sticky_kind ? "mesh_wall sticky" : "mesh_wall partial";
         need(iarg - 1, 1, kwname, "a sticky fraction");
-        ms.kind = sticky_kind ? 3 : 2;
+        ms.kind = sticky_kind ? mpm::WALL_STICKY : mpm::WALL_PARTIAL;
         if (!parse_double(arg[iarg], ms.sticky)) bad_arg(kwname, "a sticky fraction in [0,1]", arg[iarg]);
         ++iarg;
       } else if (strcmp(k, "shear") == 0) {
         // wall shear stress mu (f w_t - v_t) / delta: an unresolved viscous layer of thickness delta
         need(iarg - 1, 2, "mesh_wall shear", "a wall layer thickness delta (length) and a fraction f in [0,1]");
-        ms.kind = 4;
+        ms.kind = mpm::WALL_SHEAR;
         if (!parse_double(arg[iarg], ms.delta) || !(ms.delta > 0.0))
           bad_arg("mesh_wall shear", "a positive wall layer thickness delta (length)", arg[iarg]);
         if (!parse_double(arg[iarg + 1], ms.sticky) || ms.sticky < 0.0 || ms.sticky > 1.0)

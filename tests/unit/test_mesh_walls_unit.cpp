@@ -109,7 +109,7 @@ class MeshWallsTest : public ::testing::Test {
 
 const double kAll[2][3] = {{-0.5, -0.5, -0.5}, {1.5, 1.5, 1.5}};
 
-MeshWallSpec spec(const char *id, int kind, double sticky = 1.0, int side = mpm::SIDE_NORMAL) {
+MeshWallSpec spec(const char *id, mpm::WallKind kind, double sticky = 1.0, int side = mpm::SIDE_NORMAL) {
   MeshWallSpec s;
   s.fix_id = id;
   s.kind = kind;
@@ -139,20 +139,20 @@ TEST_F(MeshWallsTest, BadSpecsNameTheFix) {
     }
     return "";
   };
-  std::string m = msg({spec("nosuch", 0)});
+  std::string m = msg({spec("nosuch", mpm::WALL_NOSLIP)});
   EXPECT_NE(m.find("'nosuch'"), std::string::npos) << m;
   EXPECT_NE(m.find("no such fix"), std::string::npos) << m;
-  m = msg({spec("grav", 0)});
+  m = msg({spec("grav", mpm::WALL_NOSLIP)});
   EXPECT_NE(m.find("'grav'"), std::string::npos) << m;
   EXPECT_NE(m.find("not a fix mesh/surface"), std::string::npos) << m;
-  m = msg({spec("plate", 2, 1.5)});
+  m = msg({spec("plate", mpm::WALL_PARTIAL, 1.5)});
   EXPECT_NE(m.find("'plate'"), std::string::npos) << m;
   EXPECT_NE(m.find("[0,1]"), std::string::npos) << m;
-  m = msg({spec("plate", 7)});
+  m = msg({spec("plate", static_cast<mpm::WallKind>(7))});
   EXPECT_NE(m.find("unknown wall kind"), std::string::npos) << m;
-  m = msg({spec("plate", 0), spec("plate", 1)});
+  m = msg({spec("plate", mpm::WALL_NOSLIP), spec("plate", mpm::WALL_FREESLIP)});
   EXPECT_NE(m.find("given twice"), std::string::npos) << m;
-  EXPECT_EQ(msg({spec("plate", 2, 0.5)}), "");
+  EXPECT_EQ(msg({spec("plate", mpm::WALL_PARTIAL, 0.5)}), "");
 }
 
 TEST_F(MeshWallsTest, StaticPlateNoslipFreeslipPartial) {
@@ -160,9 +160,9 @@ TEST_F(MeshWallsTest, StaticPlateNoslipFreeslipPartial) {
   make_box();
   mesh("plate", "plate.stl");
   cmd("run 1");
-  MeshWalls noslip(lmp.get(), {spec("plate", 0)});
-  MeshWalls freeslip(lmp.get(), {spec("plate", 1)});
-  MeshWalls partial(lmp.get(), {spec("plate", 2, 0.25)});
+  MeshWalls noslip(lmp.get(), {spec("plate", mpm::WALL_NOSLIP)});
+  MeshWalls freeslip(lmp.get(), {spec("plate", mpm::WALL_FREESLIP)});
+  MeshWalls partial(lmp.get(), {spec("plate", mpm::WALL_PARTIAL, 0.25)});
   for (MeshWalls *w : {&noslip, &freeslip, &partial}) w->refresh(kAll[0], kAll[1], 0.1);
   EXPECT_EQ(noslip.global_triangles(), 2);
   EXPECT_EQ(noslip.gathered(), 2);  // every rank's patch covers the plate
@@ -211,8 +211,8 @@ TEST_F(MeshWallsTest, TwoSidedAndOppositeSides) {
   make_box();
   mesh("plate", "plate.stl");
   cmd("run 1");
-  MeshWalls both(lmp.get(), {spec("plate", 1, 0, mpm::SIDE_BOTH)});
-  MeshWalls opp(lmp.get(), {spec("plate", 1, 0, mpm::SIDE_OPPOSITE)});
+  MeshWalls both(lmp.get(), {spec("plate", mpm::WALL_FREESLIP, 0, mpm::SIDE_BOTH)});
+  MeshWalls opp(lmp.get(), {spec("plate", mpm::WALL_FREESLIP, 0, mpm::SIDE_OPPOSITE)});
   both.refresh(kAll[0], kAll[1], 0.1);
   opp.refresh(kAll[0], kAll[1], 0.1);
   const double below[3] = {0.3, 0.6, 0.46}, above[3] = {0.3, 0.6, 0.54};
@@ -246,8 +246,8 @@ TEST_F(MeshWallsTest, MovingWallImposesItsVelocity) {
   mesh("plate", "plate.stl");
   cmd("fix lift all move/mesh mesh plate linear 0.5 0 2.0");
   cmd("run 1");  // plate at z = 0.502, wall velocity (0.5, 0, 2)
-  MeshWalls noslip(lmp.get(), {spec("plate", 0)});
-  MeshWalls freeslip(lmp.get(), {spec("plate", 1)});
+  MeshWalls noslip(lmp.get(), {spec("plate", mpm::WALL_NOSLIP)});
+  MeshWalls freeslip(lmp.get(), {spec("plate", mpm::WALL_FREESLIP)});
   noslip.refresh(kAll[0], kAll[1], 0.1);
   freeslip.refresh(kAll[0], kAll[1], 0.1);
   const double x[3] = {0.3, 0.6, 0.55};
@@ -281,7 +281,7 @@ TEST_F(MeshWallsTest, ShearWallRelaxesTowardsAFractionOfTheWallVelocity) {
   mesh("plate", "plate.stl");
   cmd("fix slide all move/mesh mesh plate linear 0.5 0 2.0");
   cmd("run 1");  // wall velocity (0.5, 0, 2)
-  MeshWallSpec s = spec("plate", 4, 0.5);
+  MeshWallSpec s = spec("plate", mpm::WALL_SHEAR, 0.5);
   s.delta = 1e-3;
   MeshWalls shear(lmp.get(), {s});
   const double nu = 1e-6, reach = 0.075, h = 2e-3;
@@ -322,7 +322,7 @@ TEST_F(MeshWallsTest, CrossingOfTwoSidedWallIsUndone) {
   make_box();
   mesh("plate", "plate.stl");
   cmd("run 1");
-  MeshWalls w(lmp.get(), {spec("plate", 1, 0, mpm::SIDE_BOTH)});
+  MeshWalls w(lmp.get(), {spec("plate", mpm::WALL_FREESLIP, 0, mpm::SIDE_BOTH)});
   w.refresh(kAll[0], kAll[1], 0.1);
   const double xo[3] = {0.4, 0.4, 0.52};
   double x[3] = {0.42, 0.4, 0.48}, v[3] = {1, 0, -2};
@@ -345,7 +345,7 @@ TEST_F(MeshWallsTest, ClosedBoxCornersAndInferredSide) {
   make_box();
   mesh("walls", "box.stl");
   cmd("run 1");
-  MeshWalls w(lmp.get(), {spec("walls", 1, 0, mpm::SIDE_AUTO)});
+  MeshWalls w(lmp.get(), {spec("walls", mpm::WALL_FREESLIP, 0, mpm::SIDE_AUTO)});
   w.refresh(kAll[0], kAll[1], 0.1);
   EXPECT_EQ(w.global_triangles(), 12);
   EXPECT_EQ(w.gathered(), 12);
@@ -419,7 +419,7 @@ TEST_F(MeshWallsTest, NoAutoVoteIsAnError) {
   make_box();
   mesh("plate", "plate.stl");
   cmd("run 1");
-  MeshWalls w(lmp.get(), {spec("plate", 0, 1, mpm::SIDE_AUTO)});
+  MeshWalls w(lmp.get(), {spec("plate", mpm::WALL_NOSLIP, 1, mpm::SIDE_AUTO)});
   w.refresh(kAll[0], kAll[1], 0.1);
   const double far[3] = {0.5, 0.5, 1.2};
   const double *ptr[1] = {far};
@@ -434,7 +434,7 @@ TEST_F(MeshWallsTest, BinsAgreeWithBruteForce) {
   mesh("tilt", "plate.stl");
   cmd("fix spin all move/mesh mesh walls rotate origin 0.5 0.5 0.5 axis 0 0 1 period 2.0");
   cmd("run 1");
-  std::vector<MeshWallSpec> s = {spec("walls", 2, 0.3, mpm::SIDE_OPPOSITE), spec("tilt", 1, 0, mpm::SIDE_BOTH)};
+  std::vector<MeshWallSpec> s = {spec("walls", mpm::WALL_PARTIAL, 0.3, mpm::SIDE_OPPOSITE), spec("tilt", mpm::WALL_FREESLIP, 0, mpm::SIDE_BOTH)};
   MeshWalls a(lmp.get(), s), b(lmp.get(), s);
   const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
   a.refresh(lo, hi, 0.08);
@@ -454,7 +454,7 @@ TEST_F(MeshWallsTest, BinsAgreeWithBruteForce) {
   EXPECT_GT(touched, 1000);
   // the rotating box's wall velocity is omega x r: at the centre of the face x = 0.9 (r = 0.4),
   // |w| = 0.4 * pi; noslip on a node there gives it that velocity
-  MeshWalls ns(lmp.get(), {spec("walls", 0, 1, mpm::SIDE_OPPOSITE)});
+  MeshWalls ns(lmp.get(), {spec("walls", mpm::WALL_NOSLIP, 1, mpm::SIDE_OPPOSITE)});
   ns.refresh(lo, hi, 0.08);
   double x[3] = {0.85, 0.5, 0.5}, v[3] = {0, 0, 0};
   // the box turned by 2 pi dt / T = pi/1000: find the node on the same radius as the face centre
@@ -477,7 +477,7 @@ TEST_F(MeshWallsTest, PatchesAwayFromTheMeshOwnerAndPeriodicImages) {
   mesh("plate", "plate.stl");
   mesh("side", "side.stl");
   cmd("run 1");
-  MeshWalls w(lmp.get(), {spec("plate", 0), spec("side", 0, 1, mpm::SIDE_BOTH)});
+  MeshWalls w(lmp.get(), {spec("plate", mpm::WALL_NOSLIP), spec("side", mpm::WALL_NOSLIP, 1, mpm::SIDE_BOTH)});
   int me = 0, np = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &me);
   MPI_Comm_size(MPI_COMM_WORLD, &np);

@@ -1,0 +1,207 @@
+// Fluid wall conditions on triangle walls: the geometry alone (no LIGGGHTS, no MPI). The triangles
+// (node positions and velocities) are handed in by liggghts_mpm/mesh_walls.h, which reads them from
+// LIGGGHTS meshes and gathers them over the ranks; docs/mesh_walls.md.
+//
+// At a grid node the wall condition acts in the wall's frame:
+//   relative velocity r = v - w (w = wall velocity at the closest point),
+//   normal part   r.n -> max(0, r.n) on the fluid side, 0 behind the wall,
+//   tangential    r_t -> (1 - sticky) r_t;
+// kinds 'sticky f' and 'shear delta f' work on the tangential velocity relative to f times the
+// wall's tangential velocity instead (imposed, or relaxed by the wall shear stress; see impose()).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace mpm {
+
+// Wall condition of a mesh (keyword mesh_wall of fix mpm/fluid).
+enum WallKind : int {
+  WALL_NOSLIP = 0,    // no relative velocity
+  WALL_FREESLIP = 1,  // no relative normal velocity into the wall
+  WALL_PARTIAL = 2,   // freeslip, and a fraction 'sticky' of the relative tangential velocity removed
+  WALL_STICKY = 3,    // tangential velocity imposed: 'sticky' times the wall's
+  WALL_SHEAR = 4      // tangential velocity relaxed towards 'sticky' times the wall's by the stress
+                      // mu (f w_t - v_t) / delta of an unresolved viscous layer of thickness delta
+};
+
+// Fluid side of a mesh, relative to the triangles' normals (right-hand rule on the STL winding
+// n0 -> n1 -> n2, i.e. the normals LIGGGHTS computes).
+enum MeshSide : int {
+  SIDE_NORMAL = 1,     // the fluid is on the side the normals point to
+  SIDE_OPPOSITE = -1,  // the fluid is on the other side
+  SIDE_AUTO = 0,       // decided from where the material points are (side votes)
+  SIDE_BOTH = 2        // thin two-sided wall (a plate): no "behind"; only crossings are undone
+};
+
+// The condition of one wall mesh.
+struct WallSpec {
+  WallKind kind = WALL_NOSLIP;
+  double sticky = 1.0;  // tangential damping in [0,1]; forced to 1 (noslip) or 0 (freeslip);
+                        // sticky and shear: the fraction f of the wall's tangential velocity
+  double delta = 0.0;   // shear: thickness of the (unresolved) viscous wall layer, > 0 (length)
+  int side = SIDE_NORMAL;  // MeshSide
+};
+
+// Checks s (kind and side known, sticky in [0,1], delta > 0 for shear) and forces sticky of the
+// noslip and freeslip kinds. Returns "" if valid, else the problem in words.
+std::string check_wall(WallSpec &s);
+
+// One wall condition at a grid node: wall velocity w at the closest point, unit normal n towards
+// the fluid, whether the node is behind the wall, the tangential fraction (sticky) and whether it
+// is imposed (sticky kind) rather than damped; rate > 0 (shear kind): the relaxation rate (1/time)
+// of the tangential velocity towards sticky times the wall's, from the wall shear stress.
+struct WallConstraint {
+  double w[3];
+  double n[3];
+  double sticky;
+  double rate;
+  bool behind;
+  bool imposed;
+};
+
+// Relaxation rate (1/time) of the tangential slip of the fluid within 'depth' of a wall whose
+// unresolved viscous layer of thickness delta carries the stress mu v_slip / delta: the law of the
+// shear kinds of mesh walls and grid faces (docs/mesh_walls.md).
+inline double wall_layer_rate(double nu, double delta, double depth) { return nu / (delta * depth); }
+
+// Fraction of the tangential slip (v_t - f w_t) left after a time h at relaxation rate 'rate': the
+// exact solution of dv_t/dt = -rate (v_t - f w_t) over h. The decay law of the shear walls (mesh
+// walls and grid faces).
+inline double wall_slip_decay(double rate, double h) { return std::exp(-rate * h); }
+
+class WallGeometry {
+ public:
+  struct Tri {
+    double p[3][3];   // node positions
+    double w[3][3];   // node velocities
+    double n[3];      // unit normal of the winding (not yet oriented)
+    double lo[3], hi[3];
+    int mesh;         // index of the wall (WallSpec) the triangle belongs to
+    long long key;    // e.g. 27 * global triangle ID + periodic image code (the order of application)
+  };
+  // Closest point of a triangle to a point.
+  struct Hit {
+    double p[3];      // closest point
+    double b[3];      // barycentric weights of p
+    double dist2;
+    bool face;        // p lies strictly inside the triangle (face region)
+  };
+  static constexpr int kMaxConstraints = 16;
+
+  // Throws std::invalid_argument if a wall fails check_wall().
+  explicit WallGeometry(std::vector<WallSpec> walls = {});
+
+  // Completes t from its node positions p: the unit normal n and the bounding box. False if t is
+  // degenerate (zero area), which then must not be added. Inline (below) on purpose: compiled in
+  // the loop that fills the triangles, the normals round as they did before the geometry had a
+  // file of its own (FMA contraction of the cross product depends on the context).
+  static bool finish_tri(Tri &t);
+  // Replaces the triangles (finished, t.mesh < number of walls). Queries within 'margin' of the
+  // box [box[0..2], box[3..5]] use bins (an empty box, lo > hi in some dimension: no bins, every
+  // query scans all triangles).
+  void set_triangles(std::vector<Tri> tris, const double box[6], double margin);
+
+  // Applies the wall condition to the velocity vel of a grid node at x, for every triangle within
+  // 'reach' of x on its fluid side, or within 'reach_behind' (default: reach) of x behind it
+  // (one-sided meshes only). Both reaches <= margin, else the query scans all triangles. Returns
+  // true if touched.
+  bool apply(const double x[3], double vel[3], double reach, double reach_behind = -1.0,
+             double h = 0.0) const;
+
+  // apply() in two halves, for a node whose velocity is constrained more than once between two
+  // set_triangles() calls (the fix's grid update and MUSL remap): collect() writes the constraints
+  // apply() would impose at x (at most kMaxConstraints) and returns their number; impose() applies
+  // them, in the same order, to vel.
+  // near (optional): whether any triangle comes within max(reach, reach_behind) of x (false: no
+  // wall condition, contact or crossing can concern anything that close to x).
+  // A shear wall acts on the fluid mass within 'reach' of it: rate = nu / (delta reach)
+  // (set_kinematic_viscosity() first).
+  int collect(const double x[3], double reach, double reach_behind, WallConstraint *out,
+              bool *near = nullptr) const;
+  // h: the time over which a shear wall's stress acts (the grid update's step); h = 0 applies only
+  // its normal condition (a second pass over the same velocities, e.g. the MUSL remap, must not
+  // apply the stress again).
+  static void impose(const WallConstraint *c, int n, double vel[3], double h = 0.0);
+  // Kinematic viscosity of the fluid, for the shear walls.
+  void set_kinematic_viscosity(double nu) { nu_ = nu; }
+
+  // Nearest triangle face to x within 'reach' (the closest point inside a triangle, not on an edge
+  // or vertex only): q = that point, n = unit normal towards x's side (the fluid side of a
+  // one-sided mesh; false if x is behind it). For the wall traction of the fix. reach <= margin.
+  bool nearest_face(const double x[3], double reach, double q[3], double n[3]) const;
+
+  // Material points. Undoes a crossing: (a) if x_old is given and the segment x_old -> x crosses a
+  // triangle, x goes back to x_old's side of it; (b) for one-sided meshes, a point behind a
+  // triangle (closest point inside the face, depth < reach) is put back on the fluid side. The
+  // corrected point sits 1e-3 * reach off the plane, and its normal velocity relative to the wall
+  // is zeroed. Returns true if x was changed.
+  bool push_back(double x[3], double v[3], double reach, const double *x_old = nullptr) const;
+
+  // Side votes of the n points x[i] for every wall with side SIDE_AUTO: each point votes with the
+  // sign of its normal distance to the closest triangle face within 'reach'. Adds to
+  // votes[2 k] (normal side) and votes[2 k + 1] (opposite side), k < walls().
+  void side_votes(const double *const *x, int n, double reach, long *votes) const;
+
+  int walls() const { return static_cast<int>(walls_.size()); }
+  const WallSpec &wall(int k) const { return walls_[k]; }
+  // Fluid side of wall k (a MeshSide other than SIDE_AUTO).
+  void set_side(int k, int side) { walls_[k].side = side; }
+  // Triangles of the last set_triangles() (sorted by wall, then key).
+  int gathered() const { return static_cast<int>(tris_.size()); }
+  const std::vector<Tri> &triangles() const { return tris_; }
+  // Testing: false = every query scans all triangles (no bins).
+  void set_use_bins(bool on) { use_bins_ = on; }
+
+  // Closest point of triangle t to x, with barycentric weights; a point whose projection falls on
+  // the triangle's boundary (within 1e-9 in barycentric weights) counts as a face hit.
+  static void closest_point(const Tri &t, const double x[3], Hit &h);
+
+ private:
+  void bins_build(const double box[6]);
+  // Candidate triangles for a query ball (x, r); returns null if x lies outside the bins (then
+  // every triangle is a candidate).
+  const std::vector<int> *candidates(const double x[3]) const;
+
+  std::vector<WallSpec> walls_;
+  std::vector<Tri> tris_;
+  bool use_bins_ = true;
+  double margin_ = 0.0;
+  double nu_ = 0.0;  // kinematic viscosity (shear walls)
+  // uniform bins over [blo_, blo_ + nb_*bsize_]
+  double blo_[3] = {0, 0, 0}, bsize_ = 1.0;
+  int nb_[3] = {0, 0, 0};
+  std::vector<std::vector<int>> bins_;
+};
+
+// Small vector helpers of the geometry (inlined into the callers).
+namespace geom {
+inline double dot3(const double *a, const double *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+inline void sub3(const double *a, const double *b, double *c) {
+  c[0] = a[0] - b[0];
+  c[1] = a[1] - b[1];
+  c[2] = a[2] - b[2];
+}
+}  // namespace geom
+
+inline bool WallGeometry::finish_tri(Tri &t) {
+  double e1[3], e2[3];
+  geom::sub3(t.p[1], t.p[0], e1);
+  geom::sub3(t.p[2], t.p[0], e2);
+  t.n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+  t.n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+  t.n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+  const double a2 = std::sqrt(geom::dot3(t.n, t.n));
+  const double l2 = std::max(geom::dot3(e1, e1), geom::dot3(e2, e2));
+  if (!(a2 > 1e-12 * l2) || l2 <= 0.0) return false;  // degenerate (zero area) triangle
+  for (int d = 0; d < 3; ++d) {
+    t.n[d] /= a2;
+    t.lo[d] = std::min({t.p[0][d], t.p[1][d], t.p[2][d]});
+    t.hi[d] = std::max({t.p[0][d], t.p[1][d], t.p[2][d]});
+  }
+  return true;
+}
+
+}  // namespace mpm

@@ -1,0 +1,361 @@
+// Unit tests of mpm::WallGeometry (liggghts_mpm/mpm/wall_geometry.h) without LIGGGHTS: closest
+// points against a dense sampling of the triangle, the five wall kinds on a plate against the
+// formulas of docs/mesh_walls.md, undoing a crossing, and the bins against a scan of every triangle.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include "mpm/wall_geometry.h"
+
+using mpm::WallConstraint;
+using mpm::WallGeometry;
+using mpm::WallSpec;
+using Tri = WallGeometry::Tri;
+
+namespace {
+
+Tri make_tri(const double a[3], const double b[3], const double c[3], int mesh = 0, long long key = 0,
+             const double w[3] = nullptr) {
+  Tri t;
+  for (int d = 0; d < 3; ++d) {
+    t.p[0][d] = a[d];
+    t.p[1][d] = b[d];
+    t.p[2][d] = c[d];
+    for (int j = 0; j < 3; ++j) t.w[j][d] = w ? w[d] : 0.0;
+  }
+  t.mesh = mesh;
+  t.key = key;
+  EXPECT_TRUE(WallGeometry::finish_tri(t));
+  return t;
+}
+
+// The plate z = z0 over [0,1]^2 as two triangles, normals +z, moving at w.
+std::vector<Tri> plate(double z0, const double w[3], int mesh = 0) {
+  const double p00[3] = {0, 0, z0}, p10[3] = {1, 0, z0}, p11[3] = {1, 1, z0}, p01[3] = {0, 1, z0};
+  return {make_tri(p00, p10, p11, mesh, 0, w), make_tri(p00, p11, p01, mesh, 27, w)};
+}
+
+WallSpec wall(mpm::WallKind kind, double sticky = 1.0, int side = mpm::SIDE_NORMAL, double delta = 0.0) {
+  WallSpec s;
+  s.kind = kind;
+  s.sticky = sticky;
+  s.side = side;
+  s.delta = delta;
+  return s;
+}
+
+const double kBox[6] = {-0.5, -0.5, -0.5, 1.5, 1.5, 1.5};
+
+WallGeometry plate_geometry(const WallSpec &s, const double w[3]) {
+  WallGeometry g({s});
+  g.set_triangles(plate(0.5, w), kBox, 0.1);
+  return g;
+}
+
+void expect_v(const double *v, double a, double b, double c, double tol = 1e-14) {
+  EXPECT_NEAR(v[0], a, tol);
+  EXPECT_NEAR(v[1], b, tol);
+  EXPECT_NEAR(v[2], c, tol);
+}
+
+}  // namespace
+
+TEST(WallGeometry, ClosestPointRegions) {
+  const double a[3] = {0, 0, 0}, b[3] = {1, 0, 0}, c[3] = {0, 1, 0};
+  const Tri t = make_tri(a, b, c);
+  expect_v(t.n, 0, 0, 1);
+  WallGeometry::Hit h;
+  // face
+  const double xf[3] = {0.2, 0.3, 0.5};
+  WallGeometry::closest_point(t, xf, h);
+  EXPECT_TRUE(h.face);
+  expect_v(h.p, 0.2, 0.3, 0.0);
+  expect_v(h.b, 0.5, 0.2, 0.3);
+  EXPECT_NEAR(h.dist2, 0.25, 1e-15);
+  // edges ab and bc
+  const double xe[3] = {0.5, -0.5, 0.2};
+  WallGeometry::closest_point(t, xe, h);
+  EXPECT_FALSE(h.face);
+  expect_v(h.p, 0.5, 0.0, 0.0);
+  expect_v(h.b, 0.5, 0.5, 0.0);
+  EXPECT_NEAR(h.dist2, 0.29, 1e-15);
+  const double xh[3] = {1, 1, 0};
+  WallGeometry::closest_point(t, xh, h);
+  EXPECT_FALSE(h.face);
+  expect_v(h.p, 0.5, 0.5, 0.0);
+  expect_v(h.b, 0.0, 0.5, 0.5);
+  // vertices a and b
+  const double xa[3] = {-1, -1, 0.3};
+  WallGeometry::closest_point(t, xa, h);
+  EXPECT_FALSE(h.face);
+  expect_v(h.p, 0, 0, 0);
+  expect_v(h.b, 1, 0, 0);
+  const double xb[3] = {2, -0.5, 0};
+  WallGeometry::closest_point(t, xb, h);
+  EXPECT_FALSE(h.face);
+  expect_v(h.p, 1, 0, 0);
+  // a point above an edge (projection on the boundary) faces the triangle
+  const double xo[3] = {0.5, 0, 0.4};
+  WallGeometry::closest_point(t, xo, h);
+  EXPECT_TRUE(h.face);
+  expect_v(h.p, 0.5, 0, 0);
+}
+
+TEST(WallGeometry, ClosestPointIsNearestOfDenseSampling) {
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int ns = 200;  // samples per barycentric direction
+  for (int trial = 0; trial < 50; ++trial) {
+    double p[3][3], x[3];
+    for (auto &q : p)
+      for (double &v : q) v = u(gen);
+    for (double &v : x) v = 2.0 * u(gen);
+    const Tri t = make_tri(p[0], p[1], p[2]);
+    WallGeometry::Hit h;
+    WallGeometry::closest_point(t, x, h);
+    // p is the point of the weights b, which are a convex combination
+    EXPECT_NEAR(h.b[0] + h.b[1] + h.b[2], 1.0, 1e-14);
+    for (int d = 0; d < 3; ++d) {
+      EXPECT_GE(h.b[d], 0.0);
+      EXPECT_NEAR(h.p[d], h.b[0] * p[0][d] + h.b[1] * p[1][d] + h.b[2] * p[2][d], 1e-14);
+    }
+    double best = 1e300;
+    for (int i = 0; i <= ns; ++i)
+      for (int j = 0; i + j <= ns; ++j) {
+        const double bv = double(i) / ns, bw = double(j) / ns, bu = 1.0 - bv - bw;
+        double d2 = 0.0;
+        for (int d = 0; d < 3; ++d) {
+          const double q = bu * p[0][d] + bv * p[1][d] + bw * p[2][d] - x[d];
+          d2 += q * q;
+        }
+        best = std::min(best, d2);
+      }
+    // no sample is nearer; the nearest sample is within the sampling's spacing
+    EXPECT_LE(h.dist2, best * (1 + 1e-12)) << trial;
+    EXPECT_LE(std::sqrt(best) - std::sqrt(h.dist2), 2.0 * 2.0 * std::sqrt(3.0) / ns) << trial;
+  }
+}
+
+TEST(WallGeometry, WallSpecsChecked) {
+  WallSpec s = wall(mpm::WALL_NOSLIP, 0.3);
+  EXPECT_EQ(mpm::check_wall(s), "");
+  EXPECT_EQ(s.sticky, 1.0);
+  s = wall(mpm::WALL_FREESLIP, 0.3);
+  EXPECT_EQ(mpm::check_wall(s), "");
+  EXPECT_EQ(s.sticky, 0.0);
+  s = wall(mpm::WALL_PARTIAL, 1.5);
+  EXPECT_NE(mpm::check_wall(s).find("[0,1]"), std::string::npos);
+  s = wall(mpm::WALL_SHEAR, 0.5, mpm::SIDE_NORMAL, 0.0);
+  EXPECT_NE(mpm::check_wall(s).find("positive"), std::string::npos);
+  s = wall(static_cast<mpm::WallKind>(5));
+  EXPECT_NE(mpm::check_wall(s).find("unknown wall kind"), std::string::npos);
+  s = wall(mpm::WALL_NOSLIP, 1.0, 3);
+  EXPECT_NE(mpm::check_wall(s).find("unknown fluid side"), std::string::npos);
+  EXPECT_THROW(WallGeometry({wall(mpm::WALL_STICKY, -0.1)}), std::invalid_argument);
+  // degenerate triangles are refused
+  Tri t;
+  const double a[3] = {0, 0, 0}, b[3] = {1, 1, 1};
+  std::memcpy(t.p[0], a, sizeof a);
+  std::memcpy(t.p[1], b, sizeof b);
+  std::memcpy(t.p[2], b, sizeof b);
+  EXPECT_FALSE(WallGeometry::finish_tri(t));
+}
+
+TEST(WallGeometry, PlateKinds) {
+  const double still[3] = {0, 0, 0}, moving[3] = {0.4, -0.2, 0.0};
+  const double x[3] = {0.3, 0.6, 0.55};  // 0.05 in front of the plate
+  const double reach = 0.075;
+  {
+    const WallGeometry g = plate_geometry(wall(mpm::WALL_NOSLIP), still);
+    double v[3] = {1, 2, -3}, u[3] = {1, 2, 3};
+    EXPECT_TRUE(g.apply(x, v, reach));
+    expect_v(v, 0, 0, 0);
+    g.apply(x, u, reach);
+    expect_v(u, 0, 0, 3);  // leaving the wall is free
+    const double far[3] = {0.3, 0.6, 0.7};
+    double q[3] = {1, 2, -3};
+    EXPECT_FALSE(g.apply(far, q, reach));
+    expect_v(q, 1, 2, -3);
+  }
+  {
+    const WallGeometry g = plate_geometry(wall(mpm::WALL_FREESLIP), still);
+    double v[3] = {1, 2, -3};
+    g.apply(x, v, reach);
+    expect_v(v, 1, 2, 0);
+    // behind the one-sided plate: no normal motion either way
+    const double xb[3] = {0.3, 0.6, 0.45};
+    double a[3] = {1, 2, -3}, b[3] = {1, 2, 3};
+    g.apply(xb, a, reach);
+    g.apply(xb, b, reach);
+    expect_v(a, 1, 2, 0);
+    expect_v(b, 1, 2, 0);
+  }
+  {
+    const WallGeometry g = plate_geometry(wall(mpm::WALL_PARTIAL, 0.25), moving);
+    double v[3] = {1, 2, -3};
+    g.apply(x, v, reach);
+    // relative tangential velocity kept at 75 %
+    expect_v(v, 0.4 + 0.75 * 0.6, -0.2 + 0.75 * 2.2, 0);
+  }
+  {
+    const WallGeometry g = plate_geometry(wall(mpm::WALL_STICKY, 0.5), moving);
+    for (double vx : {1.0, -7.0}) {
+      double v[3] = {vx, 2, -3};
+      g.apply(x, v, reach);
+      expect_v(v, 0.2, -0.1, 0);  // half the wall's tangential velocity, whatever it was
+    }
+  }
+  {
+    const double nu = 1e-6, delta = 1e-3, f = 0.5, h = 2e-3;
+    WallGeometry g = plate_geometry(wall(mpm::WALL_SHEAR, f, mpm::SIDE_NORMAL, delta), moving);
+    g.set_kinematic_viscosity(nu);
+    const double rate = nu / (delta * reach);
+    EXPECT_EQ(mpm::wall_layer_rate(nu, delta, reach), rate);
+    EXPECT_EQ(mpm::wall_slip_decay(rate, h), std::exp(-rate * h));
+    WallConstraint c[WallGeometry::kMaxConstraints];
+    const int nc = g.collect(x, reach, reach, c);
+    ASSERT_EQ(nc, 1);
+    EXPECT_EQ(c[0].rate, rate);
+    EXPECT_FALSE(c[0].imposed);
+    const double keep = std::exp(-rate * h);
+    double v[3] = {1, 2, -3};
+    WallGeometry::impose(c, nc, v, h);
+    expect_v(v, f * 0.4 + keep * (1 - f * 0.4), f * -0.2 + keep * (2 + f * 0.2), 0);
+    // two steps of h are one of 2h; h = 0 applies the normal condition only
+    double a[3] = {1, 2, -3}, b[3] = {1, 2, -3}, z[3] = {1, 2, -3};
+    WallGeometry::impose(c, nc, a, h);
+    WallGeometry::impose(c, nc, a, h);
+    WallGeometry::impose(c, nc, b, 2 * h);
+    expect_v(a, b[0], b[1], b[2], 1e-14);
+    WallGeometry::impose(c, nc, z, 0.0);
+    expect_v(z, 1, 2, 0);
+  }
+}
+
+TEST(WallGeometry, PushBackUndoesCrossing) {
+  const double w[3] = {0.1, 0.0, 0.2};
+  for (int side : {mpm::SIDE_NORMAL, mpm::SIDE_BOTH}) {
+    const WallGeometry g = plate_geometry(wall(mpm::WALL_FREESLIP, 0, side), w);
+    const double reach = 0.075;
+    const double xo[3] = {0.3, 0.4, 0.6};
+    double x[3] = {0.3, 0.4, 0.4}, v[3] = {0.5, 0.5, -2.0};
+    EXPECT_TRUE(g.push_back(x, v, reach, xo)) << side;
+    expect_v(x, 0.3, 0.4, 0.5 + 1e-3 * reach);
+    expect_v(v, 0.5, 0.5, 0.2);  // normal velocity relative to the wall zeroed
+    // a segment that stops short of the plate, and one beside it
+    double y[3] = {0.3, 0.4, 0.52}, vy[3] = {0, 0, -1};
+    EXPECT_FALSE(g.push_back(y, vy, reach, xo));
+    expect_v(y, 0.3, 0.4, 0.52);
+    const double xo2[3] = {1.5, 0.4, 0.6};
+    double z[3] = {1.5, 0.4, 0.4}, vz[3] = {0, 0, -1};
+    EXPECT_FALSE(g.push_back(z, vz, reach, xo2));
+  }
+  // one-sided: a point just behind the plate (no old position) goes back to the fluid side
+  const WallGeometry g = plate_geometry(wall(mpm::WALL_NOSLIP), w);
+  double p[3] = {0.3, 0.4, 0.47}, u[3] = {0, 0, -1};
+  EXPECT_TRUE(g.push_back(p, u, 0.075));
+  expect_v(p, 0.3, 0.4, 0.5 + 7.5e-5);
+  expect_v(u, 0, 0, 0.2);
+}
+
+TEST(WallGeometry, NearestFace) {
+  const double still[3] = {0, 0, 0};
+  const WallGeometry g = plate_geometry(wall(mpm::WALL_NOSLIP), still);
+  double q[3], n[3];
+  const double x[3] = {0.3, 0.6, 0.55};
+  ASSERT_TRUE(g.nearest_face(x, 0.075, q, n));
+  expect_v(q, 0.3, 0.6, 0.5);
+  expect_v(n, 0, 0, 1);
+  const double xb[3] = {0.3, 0.6, 0.45};
+  EXPECT_FALSE(g.nearest_face(xb, 0.075, q, n));  // behind a one-sided wall
+  const double xf[3] = {0.3, 0.6, 0.6};
+  EXPECT_FALSE(g.nearest_face(xf, 0.075, q, n));  // beyond reach
+}
+
+TEST(WallGeometry, TrianglesSortedByWallAndKey) {
+  const double w[3] = {0, 0, 0};
+  std::vector<Tri> t = plate(0.5, w, 1);
+  std::vector<Tri> t0 = plate(0.2, w, 0);
+  t[0].key = 5;
+  t[1].key = 3;
+  t.insert(t.end(), t0.begin(), t0.end());
+  WallGeometry g({wall(mpm::WALL_NOSLIP), wall(mpm::WALL_FREESLIP)});
+  g.set_triangles(t, kBox, 0.1);
+  ASSERT_EQ(g.gathered(), 4);
+  const auto &s = g.triangles();
+  EXPECT_EQ(s[0].mesh, 0);
+  EXPECT_EQ(s[1].mesh, 0);
+  EXPECT_LT(s[0].key, s[1].key);
+  EXPECT_EQ(s[2].key, 3);
+  EXPECT_EQ(s[3].key, 5);
+}
+
+// The bins only choose which triangles a query looks at: the results must be those of a scan of
+// all triangles, bit for bit.
+TEST(WallGeometry, BinsMatchBruteForce) {
+  std::mt19937 gen(12345);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Tri> tris;
+  for (int i = 0; i < 300; ++i) {
+    double c[3], p[3][3], w[3];
+    for (double &v : c) v = u(gen);
+    for (auto &q : p)
+      for (int d = 0; d < 3; ++d) q[d] = c[d] + 0.3 * (u(gen) - 0.5);
+    for (double &v : w) v = u(gen) - 0.5;
+    Tri t = make_tri(p[0], p[1], p[2], i % 3, 27LL * i, w);
+    tris.push_back(t);
+  }
+  const std::vector<WallSpec> walls = {wall(mpm::WALL_PARTIAL, 0.3, mpm::SIDE_NORMAL),
+                                       wall(mpm::WALL_SHEAR, 0.5, mpm::SIDE_OPPOSITE, 1e-3),
+                                       wall(mpm::WALL_FREESLIP, 0, mpm::SIDE_BOTH)};
+  const double box[6] = {0.0, 0.0, 0.0, 1.0, 1.0, 1.0}, margin = 0.1;
+  WallGeometry a(walls), b(walls);
+  a.set_triangles(tris, box, margin);
+  b.set_triangles(tris, box, margin);
+  a.set_kinematic_viscosity(1e-6);
+  b.set_kinematic_viscosity(1e-6);
+  b.set_use_bins(false);
+  int touched = 0, faces = 0, moved = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const double x[3] = {u(gen), u(gen), u(gen)};
+    WallConstraint ca[WallGeometry::kMaxConstraints], cb[WallGeometry::kMaxConstraints];
+    const int na = a.collect(x, 0.05, 0.1, ca), nb = b.collect(x, 0.05, 0.1, cb);
+    ASSERT_EQ(na, nb) << i;
+    for (int k = 0; k < na; ++k) {
+      EXPECT_EQ(0, std::memcmp(ca[k].w, cb[k].w, sizeof ca[k].w)) << i;
+      EXPECT_EQ(0, std::memcmp(ca[k].n, cb[k].n, sizeof ca[k].n)) << i;
+      EXPECT_EQ(ca[k].sticky, cb[k].sticky);
+      EXPECT_EQ(ca[k].rate, cb[k].rate);
+      EXPECT_EQ(ca[k].behind, cb[k].behind);
+      EXPECT_EQ(ca[k].imposed, cb[k].imposed);
+    }
+    touched += na > 0;
+    double qa[3], qb[3], na3[3], nb3[3];
+    const bool fa = a.nearest_face(x, 0.1, qa, na3), fb = b.nearest_face(x, 0.1, qb, nb3);
+    ASSERT_EQ(fa, fb) << i;
+    if (fa) {
+      EXPECT_EQ(0, std::memcmp(qa, qb, sizeof qa)) << i;
+      EXPECT_EQ(0, std::memcmp(na3, nb3, sizeof na3)) << i;
+      ++faces;
+    }
+    const double xo[3] = {x[0], x[1], x[2]};
+    double xa[3], xb[3], va[3] = {0.1, 0.2, 0.3}, vb[3] = {0.1, 0.2, 0.3};
+    for (int d = 0; d < 3; ++d) xa[d] = xb[d] = x[d] + 0.08 * (u(gen) - 0.5);
+    const bool ma = a.push_back(xa, va, 0.05, xo), mb = b.push_back(xb, vb, 0.05, xo);
+    ASSERT_EQ(ma, mb) << i;
+    EXPECT_EQ(0, std::memcmp(xa, xb, sizeof xa)) << i;
+    EXPECT_EQ(0, std::memcmp(va, vb, sizeof va)) << i;
+    moved += ma;
+  }
+  // the comparison covered every kind of answer
+  EXPECT_GT(touched, 200);
+  EXPECT_GT(faces, 200);
+  EXPECT_GT(moved, 50);
+  std::printf("  %d of 2000 nodes constrained, %d nearest faces, %d points pushed back\n", touched, faces,
+              moved);
+}
