@@ -224,7 +224,39 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
   for (int k = 1; k < P; ++k) cut[k] = std::min(std::max(cut[k], cut[k - 1] + minw), hi - (P - k) * minw);
 }
 
+/* ----------------------------------------------------------------------
+   The cuts are found from the total weight times up to P (find_cuts), so
+   that product must stay finite: atoms and volume may each bring half of
+   DBL_MAX / P. Checked at every balance, as the number of atoms of a run is
+   known only at its setup (and may change between balances).
+------------------------------------------------------------------------- */
+
+void FixBalanceMpm::check_weights() {
+  const int P = comm->procgrid[dim_];
+  const double limit = std::numeric_limits<double>::max() / (2.0 * P);
+  const double natoms = static_cast<double>(atom->natoms);
+  for (double w : wvalues_)
+    if (natoms > 0.0 && !(w * natoms <= limit)) {
+      std::ostringstream m;
+      m << "Fix balance/mpm: keyword 'weight' expects a weight per atom (dimensionless, the fix group's "
+           "atoms weigh 1) in [0, "
+        << limit / natoms << "] for the " << atom->natoms << " atoms and " << P
+        << (P == 1 ? " slab" : " slabs") << " of this run (the total weight times the slabs must stay finite), got " << w;
+      error->all(FLERR, m.str().c_str());
+    }
+  double volume = 1.0;
+  for (int d = 0; d < domain->dimension; ++d) volume *= domain->prd[d];
+  if (!(wvol_ * volume <= limit)) {
+    std::ostringstream m;
+    m << "Fix balance/mpm: keyword 'volume' expects a weight per unit volume (1/length^3) in [0, "
+      << limit / volume << "] for the box volume " << volume << " and " << P
+      << (P == 1 ? " slab" : " slabs") << " of this run (the total weight times the slabs must stay finite), got " << wvol_;
+    error->all(FLERR, m.str().c_str());
+  }
+}
+
 void FixBalanceMpm::balance() {
+  check_weights();  // on one rank too: the input is as wrong there
   const int P = comm->procgrid[dim_];
   if (P < 2) return;
   imb_before_ = imbalance();

@@ -29,6 +29,7 @@ class FixBalanceMpm : public Fix {
 
  private:
   void bad_arg(const char *keyword, const char *expected, const char *given);
+  void check_weights();                     // the total weight stays finite (collective)
   double weight(int i) const;
   double volume_below(double c) const;      // weight of the box volume below c along dim_
   double imbalance() const;                 // max rank weight / mean rank weight (collective)

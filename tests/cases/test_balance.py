@@ -76,6 +76,9 @@ run 0
         ("dim x volume -1", "Fix balance/mpm: keyword 'volume' expects a weight per unit volume >= 0"),
         ("dim x volume", "Fix balance/mpm: keyword 'volume' expects a weight per unit volume >= 0"),
         ("dim x every 100", "Fix balance/mpm: keyword 'every' > 0 cannot be used with fix mpm/fluid"),
+        ("dim x every 4294967296", "Fix balance/mpm: keyword 'every' expects a number of steps >= 0"),
+        ("dim x weight all 1e308", "Fix balance/mpm: keyword 'weight' expects a weight per atom (dimensionless"),
+        ("dim x volume 1e308", "Fix balance/mpm: keyword 'volume' expects a weight per unit volume (1/length^3) in"),
     ]
     for i, (args, expect) in enumerate(bad):
         r.expect_error(f"balance_bad_input/{i}", tmpl.format(args=args), (expect,), f"'{args}' -> \"{expect}\"")
