@@ -34,7 +34,7 @@ SCENES = {
 }
 
 # log lines that carry wall-clock time (they differ between any two runs)
-TIMING = re.compile(r"Loop time|wall time|CPU|Performance|timesteps/s|Pair +\||Neigh +\||Comm +\||"
+TIMING = re.compile(r"Loop time|wall time|CPU|Performance|timesteps/s|Setting up run at|time \(%\) =|Pair +\||Neigh +\||Comm +\||"
                     r"Output +\||Modify +\||Other +\||Nlocal|Histogram|Neighbor list|Total wall|"
                     r"^ *[0-9.]+ +[0-9.]+ +[0-9.]+ +[0-9.]+ *$|Memory usage|Total # of neighbors|"
                     r"Ave neighs|Neighbor list builds|Dangerous builds|MPI task timing|^Section|^---")
