@@ -68,9 +68,10 @@ def read_key_values(path, numbers=False, missing_ok=False):
     return info
 
 
-def read_dump_frames(path):
+def read_dump_frames(path, box=False):
     """Every frame of a LIGGGHTS/LAMMPS 'dump custom' text file: a list of (timestep, {column:
-    array}); an empty frame has empty columns."""
+    array}), or with box=True of (timestep, {column: array}, [[xlo, xhi], [ylo, yhi], [zlo, zhi]]);
+    an empty frame has empty columns."""
     with open(path) as f:
         lines = f.read().splitlines()
     frames = []
@@ -90,7 +91,13 @@ def read_dump_frames(path):
         else:
             data = np.loadtxt(lines[j + 1:j + 1 + n], ndmin=2)
             cols = {c: data[:, m] for m, c in enumerate(names)}
-        frames.append((step, cols))
+        if box:  # 'ITEM: BOX BOUNDS ...' follows the atom count, then one line 'lo hi' per axis
+            bounds = None
+            if lines[k + 2].startswith("ITEM: BOX BOUNDS"):
+                bounds = [[float(v) for v in lines[k + 3 + m].split()[:2]] for m in range(3)]
+            frames.append((step, cols, bounds))
+        else:
+            frames.append((step, cols))
         i = j + 1 + n
     return frames
 
