@@ -1,0 +1,195 @@
+#include "mpm/boundaries.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "mpm/grid_fields.h"
+#include "mpm/shape_functions.h"
+
+namespace mpm {
+
+void Boundaries::walls_moved() {
+  if (!walls_) return;
+  ++epoch_;
+  cache_.clear();
+  if (stamp_.size() != grid_->size()) {
+    stamp_.assign(grid_->size(), -1);
+    first_.assign(grid_->size(), 0);
+    count_.assign(grid_->size(), 0);
+    near_.assign(grid_->size(), 1);
+  }
+}
+
+void Boundaries::apply(double *vel, int i, int j, int k, double h) {
+  const GridSpec &gs = opt_->grid;
+  const int idx[3] = {i, j, k};
+  for (int d = 0; d < 3; ++d) {
+    if (gs.periodic[d]) continue;
+    int fc = -1;
+    if (idx[d] <= 0)
+      fc = 2 * d;
+    else if (idx[d] >= gs.ncell[d])
+      fc = 2 * d + 1;
+    if (fc < 0) continue;
+    // normal component: no penetration; tangential: keep (1 - sticky) of it, or for a shear
+    // face the exact decay over h under the wall stress mu v_t / delta on the fluid within a cell
+    // of the face, rate nu / (delta dx) (as mesh_wall ... shear, docs/mesh_walls.md)
+    const Face &f = opt_->face[fc];
+    const double keep = f.kind == BcKind::Shear
+                            ? std::exp(-h * wall_layer_rate(opt_->viscosity / opt_->eos.rho0, f.delta, gs.dx))
+                            : 1.0 - f.sticky;
+    for (int e = 0; e < 3; ++e) vel[e] = (e == d) ? 0.0 : keep * vel[e];
+  }
+  if (walls_) {
+    // The triangles near a node and the closest points do not change between two wall moves (one
+    // per fluid step): the grid update and the MUSL remap, and every sub-step, reuse the node's
+    // constraints (node_walls).
+    const std::size_t n = node_walls(i, j, k);
+    WallGeometry::impose(cache_.data() + first_[n], count_[n], vel, h);
+  }
+  const Gate &g = opt_->gate;
+  if (g.active) {
+    const int d = g.dim;
+    const double xn = gs.origin[d] + idx[d] * gs.dx;
+    if (g.fluid_below && xn >= g.pos - 1e-9 * gs.dx) vel[d] = std::min(vel[d], 0.0);
+    if (!g.fluid_below && xn <= g.pos + 1e-9 * gs.dx) vel[d] = std::max(vel[d], 0.0);
+  }
+}
+
+/* The mesh-wall constraints of node (i, j, k) (in the patch) for the wall positions of the last
+   move, collected at the node's first use after it, and near_[n] = some triangle within 2 cells of
+   the node. Returns the flat index. */
+std::size_t Boundaries::node_walls(int i, int j, int k) {
+  const std::size_t n = grid_->index(i, j, k);
+  if (stamp_[n] != epoch_) {
+    const GridSpec &gs = opt_->grid;
+    const double xn[3] = {gs.origin[0] + i * gs.dx, gs.origin[1] + j * gs.dx, gs.origin[2] + k * gs.dx};
+    WallConstraint c[WallGeometry::kMaxConstraints];
+    bool near = true;
+    const int nc = walls_->collect(xn, 1.0 * gs.dx, 2.0 * gs.dx, c, &near);
+    stamp_[n] = epoch_;
+    first_[n] = static_cast<int>(cache_.size());
+    count_[n] = nc;
+    near_[n] = near ? 1 : 0;
+    cache_.insert(cache_.end(), c, c + nc);
+  }
+  return n;
+}
+
+/* False if no triangle comes within 2 cells of the node nearest to x, which then lies more than
+   1.1 cells from every wall: no wall traction (reach 1 cell) and, for a point that moved less than
+   half a cell (the acoustic limit), no crossing to undo. True if unsure (outside the patch). */
+bool Boundaries::near_wall(const double *x) {
+  const GridSpec &gs = opt_->grid;
+  int c[3];
+  for (int d = 0; d < 3; ++d) c[d] = static_cast<int>(std::floor((x[d] - gs.origin[d]) / gs.dx + 0.5));
+  if (!grid_->in_patch(c[0], c[1], c[2])) return true;
+  return near_[node_walls(c[0], c[1], c[2])] != 0;
+}
+
+void Boundaries::add_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g) {
+  add_face_traction(ps, xp, V, p, p2g);
+  if (walls_) add_mesh_traction(xp, V, p, p2g);
+}
+
+/* Wall traction, the boundary term (8-23) f_j = int_wall S_j sigma n ds, for the quadratic
+   B-spline. Its shape function of the first node inside a wall is 1/8 on the wall, so that node
+   must carry 1/8 of the wall's pressure push; the internal force (8-24) alone pulls it towards the
+   wall by exactly that much (in a uniformly pressurised box the fluid would be drawn to the
+   walls). The wall and padding nodes get their share from the velocity condition anyway.
+   Quadrature: the points of the cell next to the wall, each standing for the wall area V_p / dx,
+   with their in-plane weights. */
+void Boundaries::add_face_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g) {
+  const GridSpec &gs = opt_->grid;
+  const double inv = 1.0 / gs.dx;
+  for (int d = 0; d < 3; ++d) {
+    if (gs.periodic[d]) continue;
+    const double xi = (xp[d] - gs.origin[d]) * inv;
+    int node, dir;
+    if (xi < 1.0) {
+      node = 1;
+      dir = 1;  // the low wall pushes towards +d
+    } else if (xi > gs.ncell[d] - 1.0) {
+      node = gs.ncell[d] - 1;
+      dir = -1;
+    } else
+      continue;
+    const int e = (d + 1) % 3, f = (d + 2) % 3;
+    const double push = face_traction_push(dir, p, V, inv);
+    for (int b = 0; b < 3; ++b)
+      for (int c = 0; c < 3; ++c) {
+        int idx[3];
+        idx[d] = node;
+        idx[e] = ps.base[e] + b;
+        idx[f] = ps.base[f] + c;
+        p2g[P2gRec::N * grid_->index(idx[0], idx[1], idx[2]) + P2gRec::F + d] += push * ps.w[e][b] * ps.w[f][c];
+      }
+  }
+}
+
+/* The same boundary term (8-23) at mesh walls: a point closer than one cell to a triangle face
+   stands for the wall area V_p / dx at its nearest point q on the face (the points of the layer
+   next to the wall tile it), and the wall pushes the fluid with p V_p / dx along the face normal
+   towards the fluid, shared among the nodes by their weights at q. Nodes behind the wall take
+   their share out again through the velocity condition; the nodes in front get the push that the
+   internal force (8-24) alone lacks there (without it a curved mesh wall draws the fluid in:
+   docs/mesh_walls.md). */
+void Boundaries::add_mesh_traction(const double *xp, double V, double p, double *p2g) {
+  const GridSpec &gs = opt_->grid;
+  double q[3], nrm[3];
+  if (p == 0.0 || !near_wall(xp) || !walls_->nearest_face(xp, gs.dx, q, nrm)) return;
+  const double inv = 1.0 / gs.dx;
+  const IndexBox &pb = grid_->patch();
+  int base[3];
+  double w[3][3];
+  for (int d = 0; d < 3; ++d) {
+    double xi = (q[d] - gs.origin[d]) * inv;
+    if (!gs.periodic[d]) xi = std::min(std::max(xi, 0.0), static_cast<double>(gs.ncell[d]));
+    Shape1D sh;
+    shape_eval(opt_->shape, xi, sh);
+    if (sh.base < pb.lo[d] || sh.base + 2 > pb.hi[d]) return;
+    base[d] = sh.base;
+    for (int a = 0; a < 3; ++a) w[d][a] = sh.w[a];
+  }
+  const double push = p * V * inv;
+  for (int c = 0; c < 3; ++c)
+    for (int b = 0; b < 3; ++b)
+      for (int a = 0; a < 3; ++a) {
+        const double wt = push * w[0][a] * w[1][b] * w[2][c];
+        double *g = &p2g[P2gRec::N * grid_->index(base[0] + a, base[1] + b, base[2] + c) + P2gRec::F];
+        for (int d = 0; d < 3; ++d) g[d] += wt * nrm[d];
+      }
+}
+
+int Boundaries::put_back(double x[3], double v[3], const double xold[3]) {
+  const GridSpec &gs = opt_->grid;
+  const double eps = 1e-6 * gs.dx;
+  int n = 0;
+  if (walls_ && near_wall(x) && walls_->push_back(x, v, 1.0 * gs.dx, xold)) ++n;
+  for (int d = 0; d < 3; ++d) {
+    if (gs.periodic[d]) continue;
+    const double lo = gs.origin[d], hi = gs.upper(d);
+    if (x[d] < lo || x[d] > hi) {
+      if (x[d] < lo - gs.dx || x[d] > hi + gs.dx) continue;  // the shape functions report it
+      x[d] = x[d] < lo ? lo + eps : hi - eps;
+      v[d] = 0.0;
+      ++n;
+    }
+  }
+  const Gate &g = opt_->gate;
+  if (g.active) {
+    const int d = g.dim;
+    if (g.fluid_below && x[d] > g.pos) {
+      x[d] = g.pos - eps;
+      v[d] = std::min(v[d], 0.0);
+      ++n;
+    } else if (!g.fluid_below && x[d] < g.pos) {
+      x[d] = g.pos + eps;
+      v[d] = std::max(v[d], 0.0);
+      ++n;
+    }
+  }
+  return n;
+}
+
+}  // namespace mpm

@@ -1,0 +1,60 @@
+// Boundary conditions of the fluid: grid faces (keyword boundary), the gate, mesh walls, the
+// (8-23) wall traction and putting back points that crossed a wall. One component, used by the
+// grid update and the MUSL remap (node velocities), P2G (traction) and the advection (points).
+#pragma once
+#include <cstddef>
+#include <vector>
+
+#include "mpm/grid.h"
+#include "mpm/options.h"
+#include "mpm/stencil.h"
+#include "mpm/wall_geometry.h"
+
+namespace mpm {
+
+// (8-23) at a grid face for the quadratic B-spline: the first node inside the wall has the shape
+// function 1/8 on it, so it carries 1/8 of the wall's push p V / dx of a point of the next cell
+// (dir = +1 at the low face, -1 at the high one; inv = 1 / dx).
+inline double face_traction_push(int dir, double p, double V, double inv) { return dir * 0.125 * p * V * inv; }
+
+class Boundaries {
+ public:
+  void setup(const Options *opt, const LocalGrid *grid) {
+    opt_ = opt;
+    grid_ = grid;
+  }
+  // the mesh walls (none: null); the host moves their triangles, then calls walls_moved()
+  void set_walls(const WallGeometry *w) { walls_ = w; }
+  bool has_walls() const { return walls_ != nullptr; }
+  // after the mesh walls moved (once per fluid step): node constraints are collected anew
+  void walls_moved();
+
+  // Velocity of node (i, j, k) after the momentum update; h: the update's time step (the stress
+  // of shear walls acts over it).
+  void apply(double *vel, int i, int j, int k, double h);
+  // (8-23) of one point (P2G, after its own scatter so that each node sums in point order):
+  // grid faces and mesh walls, into the force rows of the P2G records.
+  void add_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g);
+  // A point moved from xold to x: put back on the fluid side of a mesh wall, a grid face or the
+  // closed gate. Returns the number of corrections.
+  int put_back(double x[3], double v[3], const double xold[3]);
+
+ private:
+  void add_face_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g);
+  void add_mesh_traction(const double *xp, double V, double p, double *p2g);
+  std::size_t node_walls(int i, int j, int k);
+  bool near_wall(const double *x);
+
+  const Options *opt_ = nullptr;
+  const LocalGrid *grid_ = nullptr;
+  const WallGeometry *walls_ = nullptr;
+  // per node: the mesh-wall constraints of the current wall positions (entries first_ .. + count_
+  // of cache_, collected at the node's first use after a move: stamp_ == epoch_)
+  std::vector<WallConstraint> cache_;
+  long epoch_ = 0;
+  std::vector<long> stamp_;
+  std::vector<int> first_, count_;
+  std::vector<char> near_;
+};
+
+}  // namespace mpm

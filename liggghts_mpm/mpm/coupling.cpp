@@ -1,0 +1,425 @@
+// The coupling phases of the solver (chapter 7.2, 8.1-8.2): fluid fraction, its smoothing, the
+// pressure fit at the nodes and the drag exchange with the grains (solver.h, coupling.h).
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+
+#include "mpm/coupling.h"
+#include "mpm/solver.h"
+
+namespace mpm {
+
+bool fit_linear_pressure(const double *c, double dx, double out[4]) {
+  Eigen::Matrix4d M;
+  for (int r = 0; r < 4; ++r)
+    for (int q = 0; q < 4; ++q) M(r, q) = c[PfitRec::MAT + 4 * r + q];
+  const Eigen::Vector4d r(c[0], c[1], c[2], c[3]);
+  // scale the offsets by the cell so that the system is well conditioned
+  const double s = 1.0 / dx;
+  const Eigen::Vector4d D(1.0, s, s, s);
+  const Eigen::Matrix4d Ms = D.asDiagonal() * M * D.asDiagonal();
+  Eigen::LDLT<Eigen::Matrix4d> ldlt(Ms);
+  if (ldlt.info() != Eigen::Success || !(ldlt.rcond() > 1e-6)) return false;
+  const Eigen::Vector4d sol = D.asDiagonal() * ldlt.solve(D.asDiagonal() * r);
+  if (!(std::isfinite(sol[0]) && std::isfinite(sol[1]) && std::isfinite(sol[2]) && std::isfinite(sol[3])))
+    return false;
+  for (int q = 0; q < 4; ++q) out[q] = sol[q];
+  return true;
+}
+
+int smoothing_passes(double L, double dx) { return static_cast<int>(std::ceil(2.0 * L * L / (dx * dx) - 1e-9)); }
+
+// fn(n, w) for the nodes a stencil reaches (the solver's shape functions)
+template <class Fn>
+void FluidSolver::for_nodes(const Stencil &ps, Fn &&fn) const {
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  auto body = [&](std::size_t n, int, int, int, double w, double, double, double) { fn(n, w); };
+  if (opt.shape == ShapeKind::QuadraticBSpline)
+    for_stencil<3>(ps, sy, sz, body);
+  else
+    for_stencil<2>(ps, sy, sz, body);
+}
+
+// Node volume for the grains' volume fraction (8-13) with shape functions reflected at the grid
+// faces: half a cell on a wall, a full cell inside, none outside (the text's (8-13) integrates
+// the unreflected shape function over the inside, which leaves the padding node 1/48 of a cell).
+double FluidSolver::solid_node_volume(int i, int j, int k) const {
+  const GridSpec &gs = opt.grid;
+  const int idx[3] = {i, j, k};
+  double v = gs.dx * gs.dx * gs.dx;
+  for (int d = 0; d < 3; ++d) {
+    if (gs.periodic[d]) continue;
+    if (idx[d] < 0 || idx[d] > gs.ncell[d]) return 0.0;
+    if (idx[d] == 0 || idx[d] == gs.ncell[d]) v *= 0.5;
+  }
+  return v;
+}
+
+void FluidSolver::setup_coupling() {
+  if (!opt.coupled) return;
+  if (!state.theta_initialized) {
+    init_theta();
+  } else if (opt.theta_transport) {
+    // the nodes' fraction of the grains' present positions, from which the next sub-step's
+    // change is taken (the points keep their own theta, also across a restart)
+    compute_shapes();
+    fluid_fraction();
+    refresh_pressure();
+  }
+}
+
+// At the first run with grains: the fluid present in a point's volume is theta of it, so its
+// mass is reduced once to theta rho0 V (8-3): otherwise the grains' volume would be counted as
+// compressed fluid.
+void FluidSolver::init_theta() {
+  compute_shapes();
+  fluid_fraction();
+  for (int i = 0; i < pts.nlocal; ++i) {
+    if (!is_point(i)) continue;
+    double *s = pts.state[i];
+    pts.rmass[i] *= s[C_THETA];
+    s[C_RHO] = pts.rmass[i] / (s[C_THETA] * s[C_VOL]);
+  }
+  state.theta_initialized = true;
+}
+
+/* Fluid fraction (8-11)-(8-14) at the nodes from the grains' volumes (with the optional
+   smoothing) and at the points (8-16). Done at the start of each sub-step, before the
+   particles-to-grid map and the forces on the grains, so that the pressure with which the fluid
+   and the grains push each other belongs to the grains' present positions (refresh_pressure):
+   with the pressure of the previous sub-step the restoring force of the fluid on a grain lags
+   one step behind its displacement, which feeds energy into the grain-fluid oscillation (stiff:
+   K / theta per unit volume change) and made the moving dense bed of C3 blow up. */
+void FluidSolver::fluid_fraction() {
+  const GridSpec &gs = opt.grid;
+  const int nlocal = pts.nlocal;
+  double **x = pts.x;
+  const double *radius = pts.radius;
+  if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
+  std::fill(g_.sol.begin(), g_.sol.end(), 0.0);
+  std::fill(g_.need.begin(), g_.need.end(), 0.0);
+  for (int k = 0; k < nlocal; ++k) {
+    if (!is_grain(k)) continue;
+    Stencil &ps = grain_shapes_[k];
+    if (!shape_of(x[k], ps)) {
+      ps.base[0] = INT_MIN;  // outside the grid: no fluid there
+      continue;
+    }
+    const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
+    for_nodes(ps, [&](std::size_t n, double w) {
+      g_.sol[n] += w * Vk;
+      g_.need[n] = 1.0;
+    });
+  }
+  grid_.reverse_sum(g_.need.data(), 1);  // nodes some grain reads (fit of the pressure only there)
+  // Walls: the solid volume mapped to a node outside a grid face is folded onto its mirror node
+  // inside (reflected shape functions), so that no node has the sliver volume that (8-13) gives
+  // the padding nodes (1/48 of a cell for the B-spline: one grain near the wall would swing its
+  // theta by tens of per cent, and the pressure of the points next to the wall with it, by
+  // K dtheta/theta). Node volumes: half a cell on the wall, full inside; a padding node takes the
+  // fraction of its mirror.
+  auto mirror = [&](int c, int d) {
+    if (gs.periodic[d]) return c;
+    return c < 0 ? -c : (c > gs.ncell[d] ? 2 * gs.ncell[d] - c : c);
+  };
+  const IndexBox &pb = grid_.patch();
+  for (int d = 0; d < 3; ++d) {
+    if (gs.periodic[d]) continue;
+    // only the patch's padding layers outside the low and the high face
+    const int layers[2][2] = {{pb.lo[d], std::min(pb.hi[d], -1)}, {std::max(pb.lo[d], gs.ncell[d] + 1), pb.hi[d]}};
+    for (const auto &L : layers) {
+      IndexBox b = pb;
+      b.lo[d] = L[0];
+      b.hi[d] = L[1];
+      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+          for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
+            const std::size_t n = grid_.index(i, j, k);
+            int idx[3] = {i, j, k};
+            idx[d] = mirror(idx[d], d);
+            if (g_.sol[n] != 0.0 && grid_.in_patch(idx[0], idx[1], idx[2])) {
+              g_.sol[grid_.index(idx[0], idx[1], idx[2])] += g_.sol[n];
+              g_.sol[n] = 0.0;
+            }
+          }
+    }
+  }
+  grid_.reverse_sum(g_.sol.data(), 1);
+  if (opt.theta_smooth > 0.0) smooth_solid_volume();
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    const int mi[3] = {mirror(i, 0), mirror(j, 1), mirror(k, 2)};
+    const double Vj = solid_node_volume(mi[0], mi[1], mi[2]);
+    const std::size_t m = grid_.in_patch(mi[0], mi[1], mi[2]) ? grid_.index(mi[0], mi[1], mi[2]) : n;
+    g_.th[n] = std::min(1.0, std::max(opt.theta_min, 1.0 - g_.sol[m] / Vj));  // (8-11), (8-14)
+  });
+  grid_.forward(g_.th.data(), 1);
+  const double *const gth = g_.th.data();
+  if (!opt.theta_transport || !state.theta_initialized) {
+    for (const int i : plist_) {
+      double th = 0.0;
+      for_nodes(shapes_[i], [&](std::size_t n, double w) { th += w * gth[n]; });
+      pts.state[i][C_THETA] = th;
+    }
+  } else if (th_prev_valid_) {
+    // theta_transport: the point keeps its own fluid fraction; here it takes the change of the
+    // nodes' fraction since the last sub-step (the grains moved), the fluid's motion enters in
+    // update_stress through the divergence of theta u (docs/fix_mpm_fluid.md)
+    const double *const gprev = g_.th_prev.data();
+    for (const int i : plist_) {
+      double dth = 0.0;
+      for_nodes(shapes_[i], [&](std::size_t n, double w) { dth += w * (gth[n] - gprev[n]); });
+      double *s = pts.state[i];
+      s[C_THETA] = std::min(1.0, std::max(opt.theta_min, s[C_THETA] + dth));
+    }
+  }
+  if (opt.theta_transport) {
+    g_.th_prev = g_.th;
+    th_prev_valid_ = true;
+  }
+}
+
+// The points' density and pressure for the new fluid fraction (their volume is unchanged).
+void FluidSolver::refresh_pressure() { update_stress(0.0, true); }
+
+/* Smoothing of the grains' volume at the owned nodes by a discrete diffusion of the solid
+   fraction phi_j = S_j / V_j (smoothing_step along each direction, smoothing_passes passes). */
+void FluidSolver::smooth_solid_volume() {
+  const GridSpec &gs = opt.grid;
+  const int passes = smoothing_passes(opt.theta_smooth, gs.dx);
+  if (passes <= 0) return;
+  std::vector<double> &phi = g_.phi, &phi_new = g_.phi_new;
+  phi.assign(2 * grid_.size(), 0.0);  // phi, node volume
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    const double V = solid_node_volume(i, j, k);
+    phi[2 * n] = V > 0.0 ? g_.sol[n] / V : 0.0;
+    phi[2 * n + 1] = V;
+  });
+  grid_.forward(phi.data(), 2);
+  phi_new.resize(grid_.size());
+  for (int pass = 0; pass < passes; ++pass)
+    for (int d = 0; d < 3; ++d) {
+      if (!gs.periodic[d] && gs.ncell[d] < 2) continue;
+      grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+        double Vn[2] = {0, 0}, phin[2] = {0, 0};
+        bool has[2] = {false, false};
+        for (int q = 0; q < 2; ++q) {
+          int idx[3] = {i, j, k};
+          idx[d] += 2 * q - 1;
+          if (!grid_.in_patch(idx[0], idx[1], idx[2])) continue;
+          const std::size_t m = grid_.index(idx[0], idx[1], idx[2]);
+          has[q] = true;
+          Vn[q] = phi[2 * m + 1];
+          phin[q] = phi[2 * m];
+        }
+        phi_new[n] = smoothing_step(phi[2 * n + 1], phi[2 * n], Vn, phin, has);
+      });
+      grid_.for_owned([&](int, int, int, std::size_t n) { phi[2 * n] = phi_new[n]; });
+      grid_.forward(phi.data(), 2);
+    }
+  grid_.for_owned([&](int, int, int, std::size_t n) { g_.sol[n] = phi[2 * n] * phi[2 * n + 1]; });
+}
+
+/* Moments of the points' pressures for the linear least-squares fit at each node: with
+   e = (1, x_s - x_j) for the point's sample position x_s, the node collects r = sum S V p e and
+   the normal matrix M = sum S V e e^T (PfitRec). */
+template <int NS>
+void FluidSolver::pressure_moments() {
+  const GridSpec &gs = opt.grid;
+  double **x = pts.x;
+  double *const g = g_.pfit.data();
+  const double *const need = g_.need.data();
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  for (const int i : plist_) {
+    const Stencil &ps = shapes_[i];
+    const double V = pts.state[i][C_VOL], p = pts.state[i][C_P];
+    if (!opt.grad_p_fit) {
+      // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
+      for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+        double *cn = g + PfitRec::N * n;
+        cn[PfitRec::R] += w * V * p;
+        cn[PfitRec::MAT] += w * V;
+      });
+      continue;
+    }
+    const double *xp = x[i];
+    // With anti-locking the pressure is the cell's (its mean density): it belongs to the cell's
+    // centre, not to the point (a fit to the points' own positions sees a staircase and, near a
+    // wall, a flat one).
+    double dn[3][3];  // x_s - x_j per direction, for the stencil's node planes
+    for (int a = 0; a < 3; ++a) {
+      double xs = xp[a];
+      if (opt.antilock) {
+        int c = static_cast<int>(std::floor((xp[a] - gs.origin[a]) / gs.dx));
+        if (!gs.periodic[a]) c = std::min(std::max(c, 0), gs.ncell[a] - 1);
+        xs = gs.origin[a] + (c + 0.5) * gs.dx;
+      }
+      for (int q = 0; q < 3; ++q) dn[a][q] = xs - (gs.origin[a] + (ps.base[a] + q) * gs.dx);
+    }
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
+      if (need[n] == 0.0) return;
+      const Row4 e = {1.0, dn[0][a], dn[1][b], dn[2][c]};
+      const Row4 we = (w * V) * e;
+      double *cn = g + PfitRec::N * n;
+      row4(cn + PfitRec::R) += p * we;
+      row4(cn + PfitRec::MAT) += we;
+      row4(cn + PfitRec::MAT + 4) += e[1] * we;
+      row4(cn + PfitRec::MAT + 8) += e[2] * we;
+      row4(cn + PfitRec::MAT + 12) += e[3] * we;
+    });
+  }
+}
+
+/* Two-way coupling with the DEM grains (chapter 7.2, 8.1-8.2): fluid velocity, fraction and
+   pressure gradient at each grain; drag (7-7) exchanged over the sub-step for the two-body system
+   grain + fluid seen by it (stable for any stiffness) and the pressure-gradient force -V grad p
+   (7-15); the reaction of both goes to the nodes with the same shape functions (8-25), (8-26), so
+   momentum is kept. */
+void FluidSolver::couple_fluid_grains(double h) {
+  with_stencil(opt.shape, [&](auto ns) { couple_kernel<decltype(ns)::value>(h); });
+}
+
+template <int NS>
+void FluidSolver::couple_kernel(double h) {
+  const int nlocal = pts.nlocal;
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const double *const gst = g_.st.data();
+  double *const gdr = g_.dr.data();
+  double **v = pts.v;
+  const double *radius = pts.radius, *rmass = pts.rmass;
+  const int nsub = state.nsub;
+  if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
+
+  // pressure at the nodes for the force on the grains (fit_linear_pressure)
+  std::fill(g_.pfit.begin(), g_.pfit.end(), 0.0);
+  pressure_moments<NS>();
+  grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
+
+  const double mmin = mass_min();
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    const double *c = &g_.pfit[PfitRec::N * n];
+    const double *g = &g_.p2g[P2gRec::N * n];
+    double *st = &g_.st[StRec::N * n];
+    for (int q = 0; q < StRec::N; ++q) st[q] = 0.0;
+    st[StRec::TH] = g_.th[n];
+    st[StRec::P] = c[PfitRec::MAT] > 0.0 ? c[PfitRec::R] / c[PfitRec::MAT] : 0.0;
+    double fit[4];
+    if (opt.grad_p_fit && c[PfitRec::MAT] > 0.0 && g_.need[n] > 0.0 && fit_linear_pressure(c, opt.grid.dx, fit)) {
+      st[StRec::P] = fit[0];
+      for (int a = 0; a < 3; ++a) st[StRec::FIT + a] = fit[1 + a];
+      st[StRec::FIT + 3] = 1.0;  // the fit (value and gradient) is determined
+    }
+    st[StRec::M] = g[P2gRec::M];
+    if (g[P2gRec::M] > mmin) {  // only nodes that hold fluid carry its velocity
+      for (int d = 0; d < 3; ++d) st[StRec::U + d] = g[P2gRec::MV + d] / g[P2gRec::M];
+      st[StRec::U + 3] = 1.0;
+    }
+  });
+  grid_.forward(g_.st.data(), StRec::N);
+
+  // Drag, exchanged node by node. Each grain k has the coefficient K_k (frozen over the sub-step)
+  // and touches node j with weight S_jk. At every node the fluid (mass M_j, velocity u_j) and the
+  // grains' share of it (coefficient K_j = sum_k S_jk K_k, mass sum_k S_jk m_k, K-weighted mean
+  // velocity) exchange the backward-Euler two-body impulse J_j over h: the slip decays without
+  // overshoot however many grains share the node (a dense bed) and however stiff the drag, the
+  // fluid loses exactly what the grains gain, and a grain advanced by LIGGGHTS' velocity Verlet
+  // keeps the right terminal slip (see mpm::drag_implicit_impulse). Grain k receives the share
+  // S_jk K_k / K_j of J_j. The pressure-gradient force (7-15) is explicit (not stiff); its
+  // reaction goes to the nodes too.
+  const double mu = opt.viscosity, rho_f = opt.eos.rho0;
+  std::vector<double> Kgrain(static_cast<std::size_t>(nlocal), 0.0);
+  std::fill(g_.dr.begin(), g_.dr.end(), 0.0);
+  for (int k = 0; k < nlocal; ++k) {
+    if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
+    const Stencil &ps = grain_shapes_[k];
+    // one pass over the stencil: velocity of the wet nodes (and their total weight, the record's
+    // 4th entry), fitted gradients of the determined nodes (and their weight), fluid fraction,
+    // gradient of the nodal pressures
+    Row4 uw = {0, 0, 0, 0}, fw = {0, 0, 0, 0};
+    double th = 0.0, gradp[3] = {0, 0, 0};
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double gx, double gy, double gz) {
+      const double *st = gst + StRec::N * n;
+      uw += w * row4(st + StRec::U);
+      fw += w * row4(st + StRec::FIT);
+      th += w * st[StRec::TH];
+      gradp[0] += st[StRec::P] * gx;
+      gradp[1] += st[StRec::P] * gy;
+      gradp[2] += st[StRec::P] * gz;
+    });
+    const double wet = uw[3], wfit = fw[3];
+    double u[3] = {uw[0], uw[1], uw[2]};
+    // Pressure gradient at the grain: the fitted nodal gradients interpolated (exact for a linear
+    // pressure field, also next to walls where a node's own fit is undetermined: all its points
+    // in one layer); the gradient of the interpolated nodal pressures where no fit is determined.
+    if (wfit > 0.5)
+      for (int d = 0; d < 3; ++d) gradp[d] = fw[d] / wfit;
+    const double d_k = 2.0 * radius[k];
+    const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
+    double K = 0.0;
+    if (wet > 0.0) {
+      for (int d = 0; d < 3; ++d) u[d] /= wet;
+      const double urel = std::sqrt((u[0] - v[k][0]) * (u[0] - v[k][0]) + (u[1] - v[k][1]) * (u[1] - v[k][1]) +
+                                    (u[2] - v[k][2]) * (u[2] - v[k][2]));
+      K = drag_coefficient(opt.drag_law, opt.drag_form, rho_f, mu, d_k, Vk, th, urel, opt.theta_min);
+    }
+    Kgrain[k] = K;
+    double Fp[3];
+    pressure_gradient_force(Vk, gradp, Fp);
+    if (wet <= 0.0) Fp[0] = Fp[1] = Fp[2] = 0.0;
+    for (int d = 0; d < 3; ++d) grain_force_[3 * static_cast<std::size_t>(k) + d] += Fp[d] / nsub;
+    // the grain's other accelerations (contacts, gravity: its force so far, and the pressure
+    // force), held over the step in the exchange
+    double ak[3];
+    for (int d = 0; d < 3; ++d) ak[d] = (pts.f[k][d] + Fp[d]) / rmass[k];
+    // a grain no integrator moves (a fixed bed) has, for the exchange, infinite mass
+    const bool mobile = (pts.mask[k] & pts.integrated_bits) != 0;
+    if (!mobile) ak[0] = ak[1] = ak[2] = 0.0;
+    const Row4 r0 = {K, K * v[k][0], K * v[k][1], K * v[k][2]};
+    const Row4 r1 = {rmass[k], -Fp[0], -Fp[1], -Fp[2]};
+    const Row4 r2 = {K * ak[0], K * ak[1], K * ak[2], mobile ? 0.0 : K};
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+      double *q = gdr + DrRec::N * n;
+      row4(q + DrRec::K) += w * r0;
+      row4(q + DrRec::M) += w * r1;
+      row4(q + DrRec::KA) += w * r2;
+    });
+  }
+  grid_.reverse_sum(g_.dr.data(), DrRec::N);
+
+  // node-wise exchange; the fluid's share of it stays on the owner
+  std::fill(g_.rx.begin(), g_.rx.end(), 0.0);
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    double *q = &g_.dr[DrRec::N * n];
+    const double *st = &g_.st[StRec::N * n];
+    double *rx = &g_.rx[3 * n];
+    double J[3] = {0, 0, 0};
+    if (q[DrRec::K] > 0.0 && st[StRec::M] > mmin) {
+      const double K = q[DrRec::K];
+      const double vg[3] = {q[DrRec::KV] / K, q[DrRec::KV + 1] / K, q[DrRec::KV + 2] / K};
+      const double ag[3] = {q[DrRec::KA] / K, q[DrRec::KA + 1] / K, q[DrRec::KA + 2] / K};
+      const double *f = &g_.p2g[P2gRec::N * n + P2gRec::F];
+      const double mf = st[StRec::M];
+      const double af[3] = {(f[0] + q[DrRec::FP]) / mf, (f[1] + q[DrRec::FP + 1]) / mf, (f[2] + q[DrRec::FP + 2]) / mf};
+      const double mg = q[DrRec::KFIX] > 0.0 ? HUGE_VAL : q[DrRec::M];
+      drag_implicit_impulse(vg, st + StRec::U, mg, mf, K, h, J, ag, af);
+    }
+    for (int d = 0; d < 3; ++d) {
+      rx[d] = q[DrRec::FP + d] - J[d] / h;                          // force on the fluid
+      q[DrRec::J + d] = q[DrRec::K] > 0.0 ? J[d] / q[DrRec::K] : 0.0;  // impulse per unit K, to the grains
+    }
+  });
+  grid_.forward(g_.dr.data(), DrRec::N);
+  for (int k = 0; k < nlocal; ++k) {
+    if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
+    const Stencil &ps = grain_shapes_[k];
+    Row4 J = {0, 0, 0, 0};  // J[1..3]: the impulse per unit K of the nodes, weighted
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+      J += w * row4(gdr + DrRec::N * n);
+    });
+    for (int d = 0; d < 3; ++d)
+      grain_force_[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
+  }
+}
+
+}  // namespace mpm

@@ -1,0 +1,142 @@
+// The settings of fix mpm/fluid and the one table of its keywords.
+//
+// Every keyword of the fix command is one row of keywords(): name, type, unit, range, default and
+// help (the help is what an error message says the keyword expects). The rows drive the parser,
+// fix_modify, the end of the 'output' field lists (a word that is a keyword ends them) and the
+// keyword table of docs/fix_mpm_fluid.md (a unit test checks the page lists exactly these rows).
+// A numeric keyword is one row with its target member and bounds; words and lists have a parse
+// function. Adding a numeric keyword: one row here plus its use.
+#pragma once
+#include <cmath>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "mpm/args.h"
+#include "mpm/drag_laws.h"
+#include "mpm/fluid_laws.h"
+#include "mpm/grid.h"
+#include "mpm/shape_functions.h"
+
+namespace mpm {
+
+enum class BcKind { NoSlip, FreeSlip, Partial, Shear };
+// Shear: wall stress mu v_t / delta of an unresolved wall layer delta (docs/mesh_walls.md)
+struct Face {
+  BcKind kind = BcKind::NoSlip;
+  double sticky = 1.0;
+  double delta = 0.0;
+};
+struct Gate {
+  bool active = false;
+  int dim = 0;
+  double pos = 0.0;
+  bool fluid_below = true;   // fluid held on the low-coordinate side
+  double release_time = -1;  // simulation time of removal; < 0 = only by fix_modify
+};
+enum class Transfer { Apic, Pic, Flip };
+
+struct Options {
+  // fluid and grid
+  double cell_size = 0.0, rho0 = 1000.0, bulk = 2.2e9;  // copied into grid / eos
+  GridSpec grid;
+  bool grid_bounds_given = false;
+  double gbounds[6] = {0, 0, 0, 0, 0, 0};
+  ShapeKind shape = ShapeKind::QuadraticBSpline;
+  Eos eos;
+  double viscosity = 0.0;
+  double pmin = -HUGE_VAL;          // cavitation pressure: no tension below it
+  Transfer transfer = Transfer::Flip;  // the text's MUSL: FLIP velocity (8-40), grid velocity for x (8-41)
+  double flip_alpha = 1.0;          // FLIP fraction of a FLIP/PIC blend
+  bool musl = true;
+  bool antilock = true;
+  bool wall_traction = true;        // (8-23) at grid-face walls for bspline2
+  bool grad_p_fit = true;           // grad p at the grains: fitted nodal gradients (fit) or of the nodal means (nodal)
+  bool theta_transport = false;     // points carry theta (updated by div(theta u)) instead of re-interpolating it
+  Face face[6];
+  Gate gate;
+  double damping = 0.0;
+  double cfl = 0.5;
+  bool subcycle = false;
+  int max_subcycle = 1000;
+  int fluid_every = 1;              // the fluid advances every N-th time step, by N dt (keyword every)
+  double mass_threshold = 1e-5;
+  // reports
+  int front_axis = 0;
+  int height_axis = 2, wall_axis = 0;
+  double wall_pos = 0.0;
+  bool wall_pos_given = false;
+  // filling
+  std::string fill_region;
+  int fill_ppc[3] = {2, 2, 2};
+  int fill_type = 1;
+  bool hydrostatic = false;
+  int hydro_axis = 2;
+  double hydro_surface = 0.0, hydro_g = 9.81;
+  int dimension = 3;                // of the host's simulation (viscous time-step limit)
+  // two-way coupling with DEM grains (keyword couple)
+  bool coupled = false;
+  std::string couple_group;
+  DragLaw drag_law = DragLaw::ErgunWenYu;
+  DragForm drag_form = DragForm::Consistent;
+  double theta_min = kDragThetaMin;
+  double theta_smooth = 0.0;        // standard deviation of the smoothing of the solid fraction (0: none)
+  bool cell_check = true;
+  // output
+  int out_every = 0;
+  std::string out_prefix;
+  std::vector<std::string> out_point_fields, out_grid_fields;
+};
+
+// What the parser needs to know of the simulation around it (LIGGGHTS' box, groups, types).
+struct ParseEnv {
+  int ntypes = 1;
+  double boxlo[3] = {0, 0, 0}, boxhi[3] = {1, 1, 1};
+  bool periodic[3] = {false, false, false};
+  int dimension = 3;
+  std::function<bool(const char *)> group_exists;
+  // keyword mesh_wall (LIGGGHTS meshes, parsed by the adapter): returns the index after its arguments
+  std::function<int(int narg, char **arg, int iarg)> mesh_wall;
+};
+
+// The arguments being parsed and the position in them.
+struct Args {
+  int narg;
+  char **arg;
+  int iarg;
+  // throws the "expects <what>, got nothing" error if fewer than n values follow the keyword
+  void need(int n, const char *kw, const char *what) const;
+  const char *at(int k) const { return arg[iarg + k]; }
+};
+
+struct Keyword {
+  const char *name;
+  const char *type;   // real, integer, yes/no, or the argument pattern
+  const char *unit;   // of the value ("-": none)
+  const char *range;
+  const char *deflt;
+  const char *help;   // what the keyword expects (error messages)
+  double Options::*real;  // numeric keywords: target and bounds (open: bound excluded)
+  double lo, hi;
+  bool open_lo, open_hi;
+  bool Options::*flag;    // yes/no keywords
+  void (*parse)(Options &, Args &, const ParseEnv &);  // other keywords: from the keyword on
+  bool modifiable;        // accepted by fix_modify
+};
+
+const std::vector<Keyword> &keywords();
+const Keyword *find_keyword(const char *name);
+
+// Point and grid fields of keyword output.
+extern const char *const kPointFields[10];
+extern const char *const kGridFields[2];
+
+// "Fix mpm/fluid: keyword 'kw' expects <expected>, got 'given'" (given null: "got nothing").
+[[noreturn]] void bad_arg(const char *keyword, const char *expected, const char *given);
+
+// fix ID group mpm/fluid keyword value ...: arg[3..narg). Throws mpm::Error.
+Options parse_options(int narg, char **arg, const ParseEnv &env);
+// fix_modify keyword value ...: returns the number of words used, 0 if not a keyword of the fix.
+int modify_option(Options &o, int narg, char **arg);
+
+}  // namespace mpm

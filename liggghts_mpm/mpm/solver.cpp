@@ -1,0 +1,299 @@
+// The solver's step (substep) and the phases that are neither transfer (transfer.cpp) nor
+// coupling (coupling.cpp): shape functions, grid update, stress update, advection.
+#include "mpm/solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "mpm/error.h"
+#include "mpm/hdf5_series.h"
+
+namespace mpm {
+
+namespace {
+// wall time of a phase, added to acc (f_ID[14], f_ID[15])
+template <class Fn>
+inline void timed(double &acc, Fn &&fn) {
+  const double t0 = MPI_Wtime();
+  fn();
+  acc += MPI_Wtime() - t0;
+}
+}  // namespace
+
+FluidSolver::FluidSolver(const Options &o, MPI_Comm comm) : opt(o), comm_(comm) {
+  MPI_Comm_rank(comm_, &me_);
+  MPI_Comm_size(comm_, &nprocs_);
+  bc.setup(&opt, &grid_);
+}
+
+FluidSolver::~FluidSolver() = default;
+
+std::string FluidSolver::check_points() {
+  int bad = 0, anybad = 0;
+  for (int i = 0; i < pts.nlocal; ++i)
+    if (is_point(i) && pts.state[i][C_FLAG] != 1.0) bad = 1;
+  MPI_Allreduce(&bad, &anybad, 1, MPI_INT, MPI_MAX, comm_);
+  if (anybad)
+    throw Error("Fix mpm/fluid: the fix group contains atoms that are not material points of this fix "
+                "(use a group of the fill type only)");
+  if (opt.theta_transport && !opt.coupled)
+    throw Error("Fix mpm/fluid: keyword 'theta_transport yes' needs keyword 'couple' (there is no "
+                "fluid fraction to transport without grains)");
+  if (opt.theta_transport && !opt.musl)
+    throw Error("Fix mpm/fluid: keyword 'theta_transport yes' needs 'update musl' (the divergence of "
+                "theta u is taken in the MUSL remap)");
+  if (!opt.coupled) return "";
+  double dmax = 0.0, gd = 0.0;
+  int overlap = 0, go = 0;
+  for (int i = 0; i < pts.nlocal; ++i) {
+    if (!(pts.mask[i] & pts.grain_bit)) continue;
+    if (is_point(i)) overlap = 1;
+    dmax = std::max(dmax, 2.0 * pts.radius[i]);
+  }
+  MPI_Allreduce(&dmax, &gd, 1, MPI_DOUBLE, MPI_MAX, comm_);
+  MPI_Allreduce(&overlap, &go, 1, MPI_INT, MPI_MAX, comm_);
+  if (go) throw Error("Fix mpm/fluid: keyword 'couple' expects a grain group without material points");
+  if (!(gd > opt.grid.dx)) return "";
+  std::ostringstream os;
+  os << "Fix mpm/fluid: keyword 'cell' (" << opt.grid.dx << ") is smaller than the largest grain of group '"
+     << opt.couple_group << "' (diameter " << gd << "); the volume fraction (8-11) needs cells that hold grains";
+  if (!opt.cell_check) return os.str();
+  os << " (keyword 'cell_check no' overrides)";
+  throw Error(os.str());
+}
+
+double FluidSolver::init_point(const double x[3], double vol, double *s) const {
+  const Eos &eos = opt.eos;
+  double rho = eos.rho0, p = 0.0;
+  if (opt.hydrostatic) {
+    p = std::max(0.0, eos.rho0 * opt.hydro_g * (opt.hydro_surface - x[opt.hydro_axis]));
+    rho = eos.density(p);
+  }
+  // The point keeps the reference mass; a pre-compressed point is smaller.
+  const double m = eos.rho0 * vol;
+  std::fill(s, s + NCOL, 0.0);
+  s[C_VOL] = m / rho;
+  s[C_RHO] = rho;
+  s[C_P] = p;
+  s[C_THETA] = 1.0;
+  s[C_FLAG] = 1.0;
+  return m;
+}
+
+void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], double skin) {
+  const int halo = support(opt.shape) + static_cast<int>(std::ceil(skin / opt.grid.dx)) + 1;
+  grid_.setup(opt.grid, comm_, sublo, subhi, halo);
+  g_.assign(grid_.size(), opt.musl, opt.coupled, opt.theta_transport);
+  th_prev_valid_ = false;
+  grid_ready_ = true;
+}
+
+void FluidSolver::step() {
+  const double h = opt.fluid_every * clock.dt / state.nsub;
+  if (opt.coupled) grain_force_.assign(3 * static_cast<std::size_t>(pts.nlocal), 0.0);
+  for (int s = 0; s < state.nsub; ++s) substep(h);
+  if (!opt.coupled) return;
+  // fluid force on the grains (mean over the sub-steps), for the host's integrator. With every N
+  // the grains get the impulse of the N steps, N h F, in this step (force N F): velocity Verlet
+  // then advances them as one symplectic step of N dt. Keeping F for N steps instead spreads the
+  // kick over the drift and makes every undamped coupled oscillation grow
+  // (docs/coupled_stability.md, "every N").
+  for (int k = 0; k < pts.nlocal; ++k) {
+    if (!is_grain(k)) continue;
+    for (int d = 0; d < 3; ++d) {
+      pts.f[k][d] += opt.fluid_every * grain_force_[3 * k + d];
+      pts.state[k][C_FGRAIN + d] = grain_force_[3 * k + d];
+    }
+  }
+}
+
+// One sub-step of chapter 8, phase by phase.
+void FluidSolver::substep(double h) {
+  timed(time_fluid, [&] { compute_shapes(); });
+  if (opt.coupled)
+    timed(time_couple, [&] {
+      fluid_fraction();
+      if (state.theta_initialized) refresh_pressure();
+    });
+  timed(time_fluid, [&] { particles_to_grid(); });
+  if (opt.coupled) timed(time_couple, [&] { couple_fluid_grains(h); });
+  timed(time_fluid, [&] {
+    update_grid(h);
+    grid_to_particles();
+    if (opt.musl) remap_velocity_musl(h);
+    update_stress(h);
+    advance_positions(h);
+  });
+}
+
+void FluidSolver::compute_shapes() {
+  const int nlocal = pts.nlocal;
+  if (static_cast<int>(shapes_.size()) < nlocal) {
+    shapes_.resize(nlocal);
+    vpic_.resize(3 * static_cast<std::size_t>(nlocal));
+    velgrad_.resize(9 * static_cast<std::size_t>(nlocal));
+  }
+  plist_.clear();
+  double **x = pts.x;
+  const GridSpec &gs = opt.grid;
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    plist_.push_back(i);
+    if (!shape_of(x[i], shapes_[i])) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: material point " << pts.tag[i] << " at (" << x[i][0] << ", " << x[i][1] << ", "
+         << x[i][2] << ") left the grid [" << gs.origin[0] << ", " << gs.upper(0) << "] x [" << gs.origin[1]
+         << ", " << gs.upper(1) << "] x [" << gs.origin[2] << ", " << gs.upper(2) << "] at step " << clock.step
+         << " (enlarge 'grid' or check for an unstable run)";
+      throw LocalError(os.str());
+    }
+  }
+}
+
+// Weights and gradients of the nodes around x; false if x is outside the grid.
+bool FluidSolver::shape_of(const double *x, Stencil &ps) {
+  const GridSpec &gs = opt.grid;
+  const int ns = support(opt.shape);
+  const double inv = 1.0 / gs.dx;
+  const IndexBox &pb = grid_.patch();
+  for (int d = 0; d < 3; ++d) {
+    const double xi = (x[d] - gs.origin[d]) * inv;
+    if (!gs.periodic[d] && (xi < 0.0 || xi > gs.ncell[d])) return false;
+    Shape1D s;
+    shape_eval(opt.shape, xi, s);
+    ps.base[d] = s.base;
+    for (int a = 0; a < 3; ++a) {
+      ps.w[d][a] = s.w[a];
+      ps.dw[d][a] = s.dw[a] * inv;
+    }
+    if (s.base < pb.lo[d] || s.base + ns - 1 > pb.hi[d]) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: atom at (" << x[0] << ", " << x[1] << ", " << x[2] << ") is outside the grid patch of rank "
+         << me_ << "; it moved too far between re-neighbourings (use neigh_modify every 1 check yes)";
+      throw LocalError(os.str());
+    }
+  }
+  ps.n0 = grid_.index(ps.base[0], ps.base[1], ps.base[2]);
+  return true;
+}
+
+/* grid momentum update (8-35), velocity (8-36), boundary conditions */
+void FluidSolver::update_grid(double h) {
+  const double mmin = mass_min();
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    const double *g = &g_.p2g[P2gRec::N * n];
+    double *gv = &g_.vel[VelRec::N * n];
+    for (int c = 0; c < VelRec::N; ++c) gv[c] = 0.0;
+    // Nearly empty node at the free surface: its velocity would be a ratio of two
+    // round-off-sized numbers; it carries no information.
+    if (g[P2gRec::M] <= mmin || g[P2gRec::M] <= 0.0) return;
+    const double inv = 1.0 / g[P2gRec::M];
+    double vnew[3];
+    for (int d = 0; d < 3; ++d) {
+      gv[VelRec::V_OLD + d] = g[P2gRec::MV + d] * inv;
+      const double f = g[P2gRec::F + d] + (opt.coupled ? g_.rx[3 * n + d] : 0.0);
+      // damping is implicit in time so that any rate is stable
+      vnew[d] = (gv[VelRec::V_OLD + d] + h * f * inv) / (1.0 + h * opt.damping);
+    }
+    bc.apply(vnew, i, j, k, h);
+    for (int d = 0; d < 3; ++d) gv[VelRec::V_NEW + d] = vnew[d];
+  });
+  grid_.forward(g_.vel.data(), VelRec::N);
+}
+
+/* Continuity (7-21) as a volume update, equation of state (7-23) or Tait, Navier-Poisson (7-24).
+   Anti-locking: the dilatation rate is averaged over each grid cell and the cell's pressure
+   follows from the cell's mean density, so all points of a cell carry one pressure (Mast et al.
+   2012). theta_only: the fluid fraction changed, the volume did not (refresh_pressure). */
+void FluidSolver::update_stress(double h, bool theta_only) {
+  const GridSpec &gs = opt.grid;
+  const int nlocal = pts.nlocal;
+  double **x = pts.x;
+  const double *rmass = pts.rmass;
+  const double inv = 1.0 / gs.dx;
+  // theta_transport: the fluid volume theta V changes by h V div(theta u) (grid operators), so
+  // that flow through a fixed irregular bed keeps it; else theta stays, V changes by h V div u
+  const bool transport = opt.coupled && opt.theta_transport && state.theta_initialized && !theta_only;
+  auto cell_node = [&](int i) {
+    int c[3];
+    for (int d = 0; d < 3; ++d) c[d] = static_cast<int>(std::floor((x[i][d] - gs.origin[d]) * inv));
+    for (int d = 0; d < 3; ++d)
+      if (!gs.periodic[d]) c[d] = std::min(std::max(c[d], 0), gs.ncell[d] - 1);
+    return grid_.index(c[0], c[1], c[2]);
+  };
+  if (opt.antilock) {
+    std::fill(g_.cell.begin(), g_.cell.end(), 0.0);
+    for (int i = 0; i < nlocal; ++i) {
+      if (!is_point(i)) continue;
+      const double *s = pts.state[i];
+      double *c = &g_.cell[CellRec::N * cell_node(i)];
+      const double V = s[C_VOL];
+      c[CellRec::V] += V;
+      if (!theta_only) {
+        const double *L = &velgrad_[9 * static_cast<std::size_t>(i)];
+        c[CellRec::VDIV] += V * (L[0] + L[4] + L[8]);
+        if (transport) c[CellRec::VDIVTHU] += V * divthu_[i];
+      }
+      c[CellRec::THV] += s[C_THETA] * V;
+      c[CellRec::M] += rmass[i];
+    }
+    grid_.reverse_sum(g_.cell.data(), CellRec::N);
+    grid_.forward(g_.cell.data(), CellRec::N);
+  }
+  for (int i = 0; i < nlocal; ++i) {
+    if (!is_point(i)) continue;
+    double *s = pts.state[i];
+    // theta_only: velgrad belongs to the last step's atom order then and is not read
+    const double *L = theta_only ? nullptr : &velgrad_[9 * static_cast<std::size_t>(i)];
+    double div = theta_only ? 0.0 : L[0] + L[4] + L[8];
+    double p;
+    double fgrow = transport ? 1.0 + h * divthu_[i] / s[C_THETA] : 1.0;  // growth of theta V
+    if (opt.antilock) {
+      const double *c = &g_.cell[CellRec::N * cell_node(i)];
+      div = c[CellRec::VDIV] / c[CellRec::V];
+      if (transport) fgrow = 1.0 + h * c[CellRec::VDIVTHU] / c[CellRec::THV];
+      const double rho_cell = transport ? c[CellRec::M] / (c[CellRec::THV] * fgrow)
+                                        : c[CellRec::M] / (c[CellRec::THV] * (1.0 + h * div));
+      p = opt.eos.pressure(rho_cell);
+    }
+    const double J = 1.0 + h * div;
+    s[C_VOL] *= J;
+    if (transport) s[C_THETA] = std::min(1.0, std::max(opt.theta_min, s[C_THETA] * fgrow / J));
+    s[C_RHO] = rmass[i] / (s[C_THETA] * s[C_VOL]);
+    if (!opt.antilock) p = opt.eos.pressure(s[C_RHO]);
+    // Liquid cannot carry tension beyond its cavitation pressure: without the cut a stretched
+    // surface layer would hold itself together (and to walls).
+    p = std::max(p, opt.pmin);
+    if (!(J > 0.0) || !std::isfinite(p)) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: material point " << pts.tag[i] << " was compressed to a non-positive volume at step "
+         << clock.step << "; the fluid became unstable (reduce the timestep)";
+      throw LocalError(os.str());
+    }
+    s[C_P] = p;
+    if (theta_only) continue;
+    const double Lm[3][3] = {{L[0], L[1], L[2]}, {L[3], L[4], L[5]}, {L[6], L[7], L[8]}};
+    newtonian_deviatoric_stress(opt.viscosity, Lm, s + C_TAU);
+  }
+}
+
+/* position update (8-41) with the grid velocity; a point that crossed a wall (or the closed gate)
+   by less than a cell is put back on the fluid side */
+void FluidSolver::advance_positions(double h) {
+  double **x = pts.x, **v = pts.v;
+  for (int i = 0; i < pts.nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const double xold[3] = {x[i][0], x[i][1], x[i][2]};
+    for (int d = 0; d < 3; ++d) x[i][d] += h * vpic_[3 * i + d];
+    state.n_clamped += bc.put_back(x[i], v[i], xold);
+  }
+}
+
+std::size_t FluidSolver::memory_bytes() const {
+  std::size_t bytes = (g_.p2g.size() + g_.vel.size() + g_.cell.size() + g_.aux.size()) * sizeof(double);
+  bytes += shapes_.size() * sizeof(Stencil) + (vpic_.size() + velgrad_.size()) * sizeof(double);
+  return bytes;
+}
+
+}  // namespace mpm

@@ -1,0 +1,164 @@
+// The MPM fluid of fix mpm/fluid without LIGGGHTS: the grid, the per-point state and the time step
+// of chapter 8, phase by phase (substep). The host (the LIGGGHTS adapter, fix_mpm_fluid.cpp) owns
+// the atoms and gives the solver views of their arrays (Points) before each call, its MPI
+// communicator and its clock; the solver throws mpm::Error / mpm::LocalError (mpm/error.h).
+// Phases and files: docs/design.md.
+#pragma once
+#include <mpi.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "mpm/boundaries.h"
+#include "mpm/grid.h"
+#include "mpm/grid_fields.h"
+#include "mpm/options.h"
+#include "mpm/stencil.h"
+
+namespace mpm {
+
+class Hdf5Series;
+
+// Views of the host's per-atom arrays (valid until the host reallocates them).
+struct Points {
+  int nlocal = 0;
+  double **x = nullptr, **v = nullptr, **f = nullptr;
+  double *rmass = nullptr, *radius = nullptr;
+  const int *mask = nullptr, *tag = nullptr, *type = nullptr;
+  double **state = nullptr;  // per-point state rows (Column)
+  int point_bit = 0;         // mask bit of the material points
+  int grain_bit = 0;         // mask bit of the coupled grains (couple)
+  int integrated_bits = 0;   // groups some integrator moves: other grains are fixed
+};
+
+// The host's clock, for the gate, messages and output.
+struct Clock {
+  long step = 0;
+  double time = 0.0;  // simulation time
+  double dt = 0.0;    // host time step
+};
+
+// The solver's state that a restart must keep.
+struct SolverState {
+  double point_mass_ref = 0.0;    // typical point mass, for the nodal mass threshold
+  double spacing[3] = {0, 0, 0};  // initial point spacing per direction
+  double n_clamped = 0;           // points put back inside a wall (cumulative)
+  int nsub = 1;                   // fluid sub-steps per step (last check)
+  bool theta_initialized = false; // fluid mass reduced by the grains' volume once
+};
+
+class FluidSolver {
+ public:
+  FluidSolver(const Options &opt, MPI_Comm comm);
+  ~FluidSolver();
+
+  Options opt;        // fix_modify changes some of them between runs
+  SolverState state;
+  Points pts;         // set by the host before every call
+  Clock clock;
+  Boundaries bc;
+
+  // Checks of the points and grains before a run (collective, throws mpm::Error): every point was
+  // set up by the fix, the options fit together, grains are no points and fit into a cell.
+  // Returns a warning (a grain larger than a cell with cell_check no) or "".
+  std::string check_points();
+  // The state row of a new point at x of reference volume vol (hydrostatic pre-compression);
+  // returns its mass.
+  double init_point(const double x[3], double vol, double *row) const;
+
+  // Grid patch of this rank's subdomain, with a halo of the shape functions' support plus the
+  // distance a point may travel before the host re-neighbours and migrates it (the skin, in cells
+  // rounded up, plus one).
+  void setup_grid(const double sublo[3], const double subhi[3], double skin);
+  bool grid_ready() const { return grid_ready_; }
+  const IndexBox &patch() const { return grid_.patch(); }
+  // First run with grains: the fluid mass reduced to theta rho0 V once; later runs: the nodes'
+  // fraction of the grains' present positions (theta_transport).
+  void setup_coupling();
+
+  // Time-step check of the current state (collective, throws mpm::Error): the number of fluid
+  // sub-steps of the next step (state.nsub); returns a log line when it changed at setup.
+  std::string check_timestep(bool at_setup);
+  // One fluid step of fluid_every * dt in state.nsub sub-steps; with couple, the fluid force on
+  // the grains (mean over the sub-steps) is added to their f and state rows (grain_force()).
+  void step();
+  const std::vector<double> &grain_force() const { return grain_force_; }
+
+  // f_ID[1..15] (collective): mass, kinetic energy, |v|max, front, height, sub-steps, stable dt,
+  // clamped, points, p max, fluid force on the grains (3), wall time of the fluid and coupling
+  void global_vector(double out[15]);
+  // HDF5 + XDMF output of the points (and grid) fields of keyword output (collective).
+  void write_output();
+  // wall time of the fluid's own work and of the coupling on this rank (s, cumulative)
+  double time_fluid = 0.0, time_couple = 0.0;
+  std::size_t memory_bytes() const;
+
+  // The phases of substep, in order; public so that a test (or another model) can run them one by
+  // one. Each works on the points of pts and the node records of fields() (docs/design.md).
+  void compute_shapes();            // shape functions of the points
+  void fluid_fraction();            // coupling: theta at nodes and points (8-11)-(8-16)
+  void refresh_pressure();          // coupling: density and pressure for the new theta
+  void particles_to_grid();         // P2G (8-10), (8-19), (8-24), traction (8-23)
+  void couple_fluid_grains(double h);  // coupling: pressure fit, drag exchange (8-25)-(8-29)
+  void update_grid(double h);       // (8-35), (8-36), boundary conditions
+  void grid_to_particles();         // G2P (8-37)-(8-40)
+  void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
+  void update_stress(double h, bool theta_only = false);  // (7-21)-(7-24)
+  void advance_positions(double h); // (8-41), points put back
+  void substep(double h);           // all of them
+  GridFields &fields() { return g_; }
+  const LocalGrid &grid() const { return grid_; }
+
+ private:
+  // kernels (transfer.cpp, coupling.cpp), instantiated per stencil size and transfer policy
+  template <int NS, class P> void p2g_kernel();
+  template <int NS, class P> void g2p_kernel();
+  template <int NS, class P> void musl_scatter();
+  template <int NS> void musl_gradient();
+  template <int NS> void pressure_moments();
+  template <int NS> void couple_kernel(double h);
+  template <class Fn> void for_nodes(const Stencil &ps, Fn &&fn) const;
+
+  bool shape_of(const double *x, Stencil &ps);
+  void smooth_solid_volume();
+  double solid_node_volume(int i, int j, int k) const;
+  void init_theta();
+  double stable_dt();
+  bool is_point(int i) const { return (pts.mask[i] & pts.point_bit) != 0; }
+  bool is_grain(int i) const { return opt.coupled && (pts.mask[i] & pts.grain_bit) != 0; }
+  double mass_min() const { return opt.mass_threshold * state.point_mass_ref; }
+
+  MPI_Comm comm_;
+  int me_ = 0, nprocs_ = 1;
+  LocalGrid grid_;
+  GridFields g_;
+  bool grid_ready_ = false;
+  bool th_prev_valid_ = false;
+  std::vector<Stencil> shapes_, grain_shapes_;
+  std::vector<int> plist_;          // local indices of the material points (this sub-step)
+  std::vector<double> vpic_;        // grid (PIC) velocity at the points, for the position update
+  std::vector<double> velgrad_;     // velocity gradient at the points, for the stress update
+  std::vector<double> divthu_;      // theta_transport: div(theta u) at the points (MUSL pass)
+  std::vector<double> grain_force_; // per local grain: fluid force averaged over sub-steps (3)
+  // time-step diagnostics of the last check
+  double dt_stable_ = 0.0, c_max_ = 0.0;
+  double dt_couple_ = HUGE_VAL, dt_grain_ = HUGE_VAL, c_couple_ = 0.0, c_grain_ = 0.0;
+  double couple_theta_min_ = 1.0, couple_rho_grain_ = 0.0;
+  std::unique_ptr<Hdf5Series> series_;
+  long last_output_step_ = -1;
+};
+
+// The kernels' one dispatch on the stencil size: fn(std::integral_constant<int, NS>) with NS = 3
+// for the quadratic B-spline, 2 for linear shape functions.
+template <class Fn>
+inline void with_stencil(ShapeKind k, Fn &&fn) {
+  if (k == ShapeKind::QuadraticBSpline)
+    fn(std::integral_constant<int, 3>());
+  else
+    fn(std::integral_constant<int, 2>());
+}
+
+}  // namespace mpm

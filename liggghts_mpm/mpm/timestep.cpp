@@ -1,0 +1,126 @@
+// The solver's stable time step: acoustic (CFL) and viscous limits of the fluid, and the
+// pore-pressure waves of fluid and grains with couple (docs/coupled_stability.md).
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "mpm/error.h"
+#include "mpm/solver.h"
+
+namespace mpm {
+
+// Largest stable fluid step of the current state (collective); sets the coupled limits too.
+double FluidSolver::stable_dt() {
+  const Eos &eos = opt.eos;
+  // max |v|, max density, -min density; with couple: max of rho (1 - theta) / theta over the
+  // points, -min theta, -min density of the grains an integrator moves
+  double loc[6] = {0.0, eos.rho0, -eos.rho0, 0.0, -1.0, -HUGE_VAL};
+  for (int i = 0; i < pts.nlocal; ++i) {
+    if (is_point(i)) {
+      const double *v = pts.v[i], *s = pts.state[i];
+      loc[0] = std::max(loc[0], std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+      loc[1] = std::max(loc[1], s[C_RHO]);
+      loc[2] = std::max(loc[2], -s[C_RHO]);
+      const double th = s[C_THETA];
+      if (opt.coupled && th > 0.0 && th < 1.0) {
+        loc[3] = std::max(loc[3], s[C_RHO] * (1.0 - th) / th);
+        loc[4] = std::max(loc[4], -th);
+      }
+    } else if (is_grain(i) && (pts.mask[i] & pts.integrated_bits) && pts.radius[i] > 0.0) {
+      const double r = pts.radius[i];
+      loc[5] = std::max(loc[5], -pts.rmass[i] / (4.0 / 3.0 * M_PI * r * r * r));
+    }
+  }
+  double glob[6];
+  MPI_Allreduce(loc, glob, 6, MPI_DOUBLE, MPI_MAX, comm_);
+  // Sound speed: largest over the density range (Tait stiffens under compression, the linear
+  // law under tension).
+  c_max_ = std::sqrt(std::max(eos.sound_speed_sq(glob[1]), eos.sound_speed_sq(-glob[2])));
+  const double c = c_max_, dx = opt.grid.dx;
+  const double dt_ac = acoustic_dt_limit(opt.cfl, dx, c, glob[0]);
+  const double dt_visc = viscous_dt_limit(dx, eos.rho0, opt.viscosity, opt.dimension);
+  // Grains an integrator moves: the pore-pressure wave. Fluid and grains pushed by the same
+  // pressure form one wave, c^2 = c_f^2 (1 + rho_f (1 - theta) / (theta rho_p)), that limits the
+  // fluid step when the fluid is not sub-cycled; with sub-cycling the fluid follows the grains
+  // within the step and the grains' own wave, c_g^2 = c_f^2 rho_f (1 - theta) / (theta rho_p),
+  // limits the grains' step. Largest rho_f (1 - theta) / theta over the points against the
+  // lightest moving grain.
+  couple_theta_min_ = glob[4] < 0.0 ? -glob[4] : 1.0;
+  couple_rho_grain_ = glob[5] > -HUGE_VAL ? -glob[5] : 0.0;
+  c_couple_ = c_grain_ = 0.0;
+  dt_couple_ = dt_grain_ = HUGE_VAL;
+  if (couple_rho_grain_ > 0.0) {
+    const double r = glob[3] / couple_rho_grain_;
+    c_couple_ = c * std::sqrt(1.0 + r);
+    c_grain_ = c * std::sqrt(r);
+    dt_couple_ = acoustic_dt_limit(opt.cfl, dx, c_couple_, glob[0]);
+    dt_grain_ = c_grain_ > 0.0 ? acoustic_dt_limit(opt.cfl, dx, c_grain_, glob[0]) : HUGE_VAL;
+  }
+  return std::min(dt_ac, dt_visc);
+}
+
+std::string FluidSolver::check_timestep(bool at_setup) {
+  dt_stable_ = stable_dt();
+  const int every = opt.fluid_every;
+  const double dt = every * clock.dt, cfl = opt.cfl, dx = opt.grid.dx;
+  if (!std::isfinite(dt_stable_) || dt_stable_ <= 0.0 || std::isnan(dt_couple_) || std::isnan(dt_grain_))
+    throw Error("Fix mpm/fluid: the fluid state is not finite (NaN velocity or density); "
+                "the run was unstable before this check");
+  const char *what = every > 1 ? "fluid step (every x timestep) " : "timestep ";
+  // a coupled limit exceeded: the error names the wave, its speed and the step to use
+  auto coupled_error = [&](double limit, const char *whose, const char *wave, const char *csym,
+                           const char *cformula, double cval, const char *before, const char *after) {
+    std::ostringstream os;
+    os.precision(4);
+    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << limit << " of the "
+       << whose << " (" << wave << ": cfl*dx/(" << csym << "+|v|max) with cfl = " << cfl << ", dx = " << dx
+       << ", " << csym << " = " << cformula << " = " << cval << ", fluid sound speed c_f = " << c_max_
+       << ", lowest fluid fraction theta = " << couple_theta_min_ << ", lightest moving grain rho_p = "
+       << couple_rho_grain_ << "); " << before << "reduce the timestep to " << limit / every << after
+       << " (docs/coupled_stability.md)" << (at_setup ? "" : " (limit reached during the run)");
+    throw Error(os.str());
+  };
+  // the grains' wave: sub-cycling the fluid does not help, the grains move once per step
+  if (opt.subcycle && dt > dt_grain_)
+    coupled_error(dt_grain_, "grains coupled with the fluid", "pore-pressure wave of the grains with the fluid sub-cycled",
+                  "c_g", "c_f*sqrt(rho_f*(1-theta)/(theta*rho_p))", c_grain_,
+                  "the grains move once per timestep, so 'subcycle yes' cannot help: ", "");
+  // without sub-cycling, fluid and grains together: the coupled wave
+  if (!opt.subcycle && dt > dt_couple_)
+    coupled_error(dt_couple_, "fluid coupled with the grains", "pore-pressure wave of fluid and grains", "c",
+                  "c_f*sqrt(1 + rho_f*(1-theta)/(theta*rho_p))", c_couple_, "", " or use keyword 'subcycle yes'");
+  // the fluid (sub-)step: its own limit and, so that a step that is not sub-cycled also
+  // satisfies it, the coupled one
+  const double dt_sub = std::min(dt_stable_, dt_couple_);
+  if (dt <= dt_sub) {
+    state.nsub = 1;
+    return "";
+  }
+  if (!opt.subcycle) {
+    std::ostringstream os;
+    os.precision(4);
+    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << dt_stable_
+       << " (acoustic limit cfl*dx/(c+|v|max) with cfl = " << cfl << ", dx = " << dx << ", c = " << c_max_
+       << ", or viscous limit dx^2 rho/(2 dim eta)); reduce the timestep to " << dt_stable_ / every
+       << " or use keyword 'subcycle yes'" << (at_setup ? "" : " (limit reached during the run)");
+    throw Error(os.str());
+  }
+  const int nsub = static_cast<int>(std::ceil(dt / dt_sub));
+  if (nsub > opt.max_subcycle) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: 'subcycle yes' would need " << nsub << " sub-steps per timestep (more than "
+       << opt.max_subcycle << "); reduce the timestep to at most " << opt.max_subcycle * dt_sub;
+    throw Error(os.str());
+  }
+  std::string log;
+  if (at_setup && nsub != state.nsub) {
+    std::ostringstream os;
+    os << "fix mpm/fluid: sub-cycling with " << nsub << " fluid sub-steps of " << dt / nsub
+       << " per timestep (stable limit " << dt_sub << ")\n";
+    log = os.str();
+  }
+  state.nsub = nsub;
+  return log;
+}
+
+}  // namespace mpm

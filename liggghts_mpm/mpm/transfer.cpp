@@ -1,0 +1,209 @@
+// The transfer phases of the solver: P2G, G2P and the MUSL remap (solver.h, transfer.h).
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "mpm/error.h"
+#include "mpm/solver.h"
+#include "mpm/transfer.h"
+
+namespace mpm {
+
+/* particles to grid: mass (8-19), momentum (8-10), internal force (8-24),
+   external forces (gravity (8-18) and whatever the host's fixes add), wall traction (8-23) */
+void FluidSolver::particles_to_grid() {
+  std::fill(g_.p2g.begin(), g_.p2g.end(), 0.0);
+  with_policy(opt, [&](auto pol) { p2g_kernel<decltype(pol)::NS, decltype(pol)>(); });
+  grid_.reverse_sum(g_.p2g.data(), P2gRec::N);
+}
+
+template <int NS, class P>
+void FluidSolver::p2g_kernel() {
+  double **x = pts.x, **v = pts.v, **f = pts.f;
+  const double *rmass = pts.rmass;
+  double *const g = g_.p2g.data();
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const bool traction = opt.wall_traction && opt.shape == ShapeKind::QuadraticBSpline;
+  for (const int i : plist_) {
+    const Stencil &ps = shapes_[i];
+    const double *s = pts.state[i];
+    const double m = rmass[i], V = s[C_VOL], p = s[C_P];
+    const double *t = s + C_TAU;
+    // -V sigma with sigma = -p I + tau (tau in Voigt order xx yy zz yz xz xy)
+    const double sxx = -V * (t[0] - p), syy = -V * (t[1] - p), szz = -V * (t[2] - p);
+    const double syz = -V * t[3], sxz = -V * t[4], sxy = -V * t[5];
+    // each node update is two 4-wide rows of the record (mass and momentum; force)
+    const Row4 mv = {m, m * v[i][0], m * v[i][1], m * v[i][2]};
+    const Row4 fe = {f[i][0], f[i][1], f[i][2], 0.0};
+    const Row4 sx = {sxx, sxy, sxz, 0.0}, sy_ = {sxy, syy, syz, 0.0}, sz_ = {sxz, syz, szz, 0.0};
+    double mC[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, o[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    if (P::apic) {
+      for (int c = 0; c < 9; ++c) mC[c] = m * s[C_AFF + c];
+      stencil_offsets(opt.grid, ps, x[i], o);
+    }
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double gx, double gy, double gz) {
+      Row4 u = mv;
+      if (P::apic) {
+        double d[3];
+        affine_momentum(mC, o, a, b, c, d);
+        for (int r = 0; r < 3; ++r) u[1 + r] += d[r];
+      }
+      double *gn = g + P2gRec::N * n;
+      row4(gn + P2gRec::M) += w * u;
+      row4(gn + P2gRec::F) += w * fe + gx * sx + gy * sy_ + gz * sz_;
+    });
+    // the boundary term after the point's own share, so that every node sums in point order
+    if (traction) bc.add_traction(ps, x[i], V, p, g);
+  }
+}
+
+/* grid to particles: velocity (8-37)/(8-40), affine velocity, velocity gradient */
+void FluidSolver::grid_to_particles() {
+  with_policy(opt, [&](auto pol) { g2p_kernel<decltype(pol)::NS, decltype(pol)>(); });
+}
+
+template <int NS, class P>
+void FluidSolver::g2p_kernel() {
+  double **x = pts.x, **v = pts.v;
+  const double *const gvel = g_.vel.data();
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const double dinv = apic_dinv_bspline2() / (opt.grid.dx * opt.grid.dx);
+  const bool flip = opt.transfer == Transfer::Flip;
+  const double alpha = opt.flip_alpha;
+  for (const int i : plist_) {
+    const Stencil &ps = shapes_[i];
+    double *s = pts.state[i];
+    // 4-wide accumulators of the velocity record; L and B by columns: Lc[e][d] = sum v_d dS/dx_e
+    Row4 vp = {0, 0, 0, 0}, dv = {0, 0, 0, 0};
+    Row4 Lc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}}, Bc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
+    double o[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    if (P::inertia) stencil_offsets(opt.grid, ps, x[i], o);
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double gx, double gy, double gz) {
+      const Row4 un = row4(gvel + VelRec::N * n + VelRec::V_NEW), uo = row4(gvel + VelRec::N * n + VelRec::V_OLD);
+      vp += w * un;
+      dv += w * (un - uo);
+      if (P::need_L) {
+        Lc[0] += gx * un;
+        Lc[1] += gy * un;
+        Lc[2] += gz * un;
+      }
+      if (P::inertia) {
+        const double ox = w * o[0][a], oy = w * o[1][b], oz = w * o[2][c];
+        Bc[0] += ox * un;
+        Bc[1] += oy * un;
+        Bc[2] += oz * un;
+      }
+    });
+    double L[9], B[9];
+    for (int d = 0; d < 3; ++d)
+      for (int e = 0; e < 3; ++e) {
+        L[3 * d + e] = Lc[e][d];
+        B[3 * d + e] = Bc[e][d];
+      }
+    for (int d = 0; d < 3; ++d) vpic_[3 * i + d] = vp[d];
+    if (flip) {
+      for (int d = 0; d < 3; ++d) v[i][d] = alpha * (v[i][d] + dv[d]) + (1.0 - alpha) * vp[d];
+    } else {
+      for (int d = 0; d < 3; ++d) v[i][d] = vp[d];
+    }
+    // Affine field: B D^-1 for the quadratic B-spline (exact inertia), the velocity gradient for
+    // linear shape functions and for FLIP/PIC without MUSL; with MUSL, FLIP/PIC store the
+    // remapped gradient there.
+    if (P::inertia)
+      for (int c = 0; c < 9; ++c) s[C_AFF + c] = B[c] * dinv;
+    else if (P::need_L)
+      for (int c = 0; c < 9; ++c) s[C_AFF + c] = L[c];
+    if (!(std::isfinite(v[i][0]) && std::isfinite(v[i][1]) && std::isfinite(v[i][2]))) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: velocity of material point " << pts.tag[i] << " is not finite at step " << clock.step
+         << "; the fluid became unstable (reduce the timestep or the bulk modulus)";
+      throw LocalError(os.str());
+    }
+    // velocity gradient for the stress update (USL; MUSL recomputes it)
+    if (P::need_L) std::copy(L, L + 9, &velgrad_[9 * static_cast<std::size_t>(i)]);
+  }
+}
+
+/* MUSL (Buzzi et al. 2008, text after (8-41)): the updated point momentum (with its new affine
+   field for APIC), mapped back to the grid, gives the velocity gradient for the stress update,
+   still at the positions of the start of the step. */
+void FluidSolver::remap_velocity_musl(double h) {
+  std::fill(g_.aux.begin(), g_.aux.end(), 0.0);
+  with_policy(opt, [&](auto pol) { musl_scatter<decltype(pol)::NS, decltype(pol)>(); });
+  grid_.reverse_sum(g_.aux.data(), AuxRec::N);
+  const double mmin = mass_min();
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    const double m = g_.p2g[P2gRec::N * n + P2gRec::M];
+    double *g = &g_.aux[AuxRec::N * n + AuxRec::U];
+    if (m <= mmin || m <= 0.0) {
+      g[0] = g[1] = g[2] = 0.0;
+      return;
+    }
+    const double inv = 1.0 / m;
+    for (int d = 0; d < 3; ++d) g[d] *= inv;
+    // the remapped velocity moves the points and gives their velocity gradient; the momentum of
+    // the points is not changed here, so the wall conditions (a shear wall's stress over h too)
+    // are those of the grid update
+    bc.apply(g, i, j, k, h);
+  });
+  grid_.forward(g_.aux.data(), AuxRec::N);
+  with_stencil(opt.shape, [&](auto ns) { musl_gradient<decltype(ns)::value>(); });
+}
+
+template <int NS, class P>
+void FluidSolver::musl_scatter() {
+  double **x = pts.x, **v = pts.v;
+  const double *rmass = pts.rmass;
+  double *const ga = g_.aux.data();
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  for (const int i : plist_) {
+    const Stencil &ps = shapes_[i];
+    const double *s = pts.state[i];
+    const double m = rmass[i];
+    const Row4 mv = {m * v[i][0], m * v[i][1], m * v[i][2], 0.0};
+    double mC[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, o[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    if (P::apic) {
+      for (int c = 0; c < 9; ++c) mC[c] = m * s[C_AFF + c];
+      stencil_offsets(opt.grid, ps, x[i], o);
+    }
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
+      Row4 u = mv;
+      if (P::apic) {
+        double d[3];
+        affine_momentum(mC, o, a, b, c, d);
+        for (int r = 0; r < 3; ++r) u[r] += d[r];
+      }
+      row4(ga + AuxRec::N * n + AuxRec::U) += w * u;
+    });
+  }
+}
+
+template <int NS>
+void FluidSolver::musl_gradient() {
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const double *const ga = g_.aux.data();
+  const bool store_affine = opt.transfer != Transfer::Apic;
+  const bool transport = opt.coupled && opt.theta_transport;
+  const double *const gth = transport ? g_.th.data() : nullptr;
+  if (transport && divthu_.size() < static_cast<std::size_t>(pts.nlocal)) divthu_.resize(pts.nlocal);
+  for (const int i : plist_) {
+    const Stencil &ps = shapes_[i];
+    Row4 Lc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // Lc[e][d] = sum v_d dS/dx_e
+    double dtu = 0.0;  // divergence of theta u (theta_transport)
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double, double gx, double gy, double gz) {
+      const Row4 u = row4(ga + AuxRec::N * n + AuxRec::U);
+      Lc[0] += gx * u;
+      Lc[1] += gy * u;
+      Lc[2] += gz * u;
+      if (transport) dtu += gth[n] * (gx * u[0] + gy * u[1] + gz * u[2]);
+    });
+    if (transport) divthu_[i] = dtu;
+    double L[9];
+    for (int d = 0; d < 3; ++d)
+      for (int e = 0; e < 3; ++e) L[3 * d + e] = Lc[e][d];
+    std::copy(L, L + 9, &velgrad_[9 * static_cast<std::size_t>(i)]);
+    if (store_affine) std::copy(L, L + 9, pts.state[i] + C_AFF);
+  }
+}
+
+}  // namespace mpm
