@@ -144,13 +144,6 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
   }
 }
 
-long LocalGrid::halo_nodes_sent() const {
-  long n = 0;
-  for (const auto &t : halo_side_)
-    if (t.peer != me_) n += t.mine.count();
-  return n;
-}
-
 void LocalGrid::reverse_sum(double *data, int stride) { exchange(data, stride, true); }
 void LocalGrid::forward(double *data, int stride) { exchange(data, stride, false); }
 

@@ -72,8 +72,6 @@ class LocalGrid {
   void reverse_sum(double *data, int stride);
   // Copies owned values into every rank's halo images.
   void forward(double *data, int stride);
-  // Doubles sent by this rank in one reverse_sum of stride 1 (for reports).
-  long halo_nodes_sent() const;
 
  private:
   struct Transfer {      // one box of nodes exchanged with one peer
