@@ -1,0 +1,126 @@
+// The keyword table of fix mpm/fluid (mpm/options.h): it parses, it is what fix_modify accepts, its
+// errors name keyword, expectation and value, and docs/fix_mpm_fluid.md lists exactly its keywords.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mpm/error.h"
+#include "mpm/options.h"
+
+namespace {
+
+mpm::ParseEnv box_env() {
+  mpm::ParseEnv env;
+  for (int d = 0; d < 3; ++d) env.boxhi[d] = 2.0;
+  env.ntypes = 2;
+  env.group_exists = [](const char *g) { return std::string(g) == "grains"; };
+  return env;
+}
+
+// parses "fix f all mpm/fluid <words>"
+mpm::Options parse(const std::string &words) {
+  std::vector<std::string> w = {"f", "all", "mpm/fluid"};
+  std::istringstream is(words);
+  for (std::string s; is >> s;) w.push_back(s);
+  std::vector<char *> argv;
+  for (auto &s : w) argv.push_back(&s[0]);
+  return mpm::parse_options(static_cast<int>(argv.size()), argv.data(), box_env());
+}
+
+std::string error_of(const std::string &words) {
+  try {
+    parse(words);
+  } catch (const mpm::Error &e) {
+    return e.what();
+  }
+  return "";
+}
+
+const std::string kBase = "cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 ";
+
+TEST(Options, DefaultsAndValues) {
+  const mpm::Options o = parse(kBase + "viscosity 1e-3 cfl 0.3 transfer flip 0.95 update usl antilock no "
+                                       "boundary zlo shear 1e-3 output 10 out points v p grid mass cfl 0.3");
+  EXPECT_EQ(o.grid.ncell[0], 4);
+  EXPECT_EQ(o.grid.pad, 1);
+  EXPECT_DOUBLE_EQ(o.eos.K, 2e6);
+  EXPECT_DOUBLE_EQ(o.viscosity, 1e-3);
+  EXPECT_DOUBLE_EQ(o.cfl, 0.3);
+  EXPECT_EQ(o.transfer, mpm::Transfer::Flip);
+  EXPECT_DOUBLE_EQ(o.flip_alpha, 0.95);
+  EXPECT_FALSE(o.musl);
+  EXPECT_FALSE(o.antilock);
+  EXPECT_EQ(o.face[4].kind, mpm::BcKind::Shear);
+  EXPECT_EQ(o.face[0].kind, mpm::BcKind::NoSlip);
+  EXPECT_EQ(o.out_point_fields, (std::vector<std::string>{"v", "p"}));
+  EXPECT_EQ(o.out_grid_fields, (std::vector<std::string>{"mass"}));  // 'cfl' ended the list
+  EXPECT_DOUBLE_EQ(o.mass_threshold, 1e-5);
+}
+
+TEST(Options, ErrorsNameKeywordExpectationAndValue) {
+  EXPECT_EQ(error_of(kBase + "cfl 0"), "Fix mpm/fluid: keyword 'cfl' expects a CFL number in (0,1], got '0'");
+  EXPECT_EQ(error_of(kBase + "bulk"), "Fix mpm/fluid: keyword 'bulk' expects a positive bulk modulus (pressure), got nothing");
+  EXPECT_NE(error_of(kBase + "colour red").find("unknown keyword 'colour'"), std::string::npos);
+  EXPECT_NE(error_of(kBase + "couple nosuch").find("keyword 'couple' expects an existing group-ID"), std::string::npos);
+  EXPECT_NE(error_of(kBase + "couple grains").find("needs keyword 'viscosity' > 0"), std::string::npos);
+  EXPECT_NE(error_of(kBase + "fill col 2 2 2 type 3").find("'fill type' expects an existing atom type"), std::string::npos);
+  EXPECT_NE(error_of("cell 0.3 density 1000 bulk 2e6").find("divides the grid extent"), std::string::npos);
+  EXPECT_NE(error_of(kBase + "output 1 o points velocity").find("'output points' expects point fields"), std::string::npos);
+  EXPECT_EQ(error_of(kBase + "theta_smooth 0"), "");
+}
+
+TEST(Options, FixModifyTakesTheModifiableRowsOnly) {
+  mpm::Options o = parse(kBase);
+  std::vector<std::string> w = {"damping", "5"};
+  std::vector<char *> a = {&w[0][0], &w[1][0]};
+  EXPECT_EQ(mpm::modify_option(o, 2, a.data()), 2);
+  EXPECT_DOUBLE_EQ(o.damping, 5.0);
+  w = {"viscosity", "1"};
+  a = {&w[0][0], &w[1][0]};
+  EXPECT_EQ(mpm::modify_option(o, 2, a.data()), 0);
+  w = {"subcycle", "maybe"};
+  a = {&w[0][0], &w[1][0]};
+  EXPECT_THROW(mpm::modify_option(o, 2, a.data()), mpm::Error);
+  std::vector<std::string> b = {"boundary", "all", "partial", "0.5"};
+  std::vector<char *> ab = {&b[0][0], &b[1][0], &b[2][0], &b[3][0]};
+  EXPECT_EQ(mpm::modify_option(o, 4, ab.data()), 4);
+  EXPECT_EQ(o.face[5].kind, mpm::BcKind::Partial);
+}
+
+TEST(Options, EveryRowIsComplete) {
+  std::set<std::string> names;
+  for (const mpm::Keyword &k : mpm::keywords()) {
+    EXPECT_TRUE(names.insert(k.name).second) << k.name;
+    EXPECT_TRUE(*k.type && *k.unit && *k.deflt && *k.help) << k.name;
+    const int kinds = (k.real != nullptr) + (k.flag != nullptr) + (k.parse != nullptr);
+    EXPECT_EQ(kinds, 1) << k.name << ": one of numeric target, yes/no flag, parse function";
+  }
+}
+
+// The contract with the reference page: its section '## Keywords' holds one table whose rows start
+// with | `keyword` |, one per row of mpm::keywords().
+TEST(Options, ReferencePageListsExactlyTheTableKeywords) {
+  std::ifstream in(MPM_DOC_PAGE);
+  ASSERT_TRUE(in) << MPM_DOC_PAGE;
+  std::vector<std::string> page;
+  bool inside = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("## ", 0) == 0) inside = line == "## Keywords";
+    if (!inside || line.rfind("| `", 0) != 0) continue;
+    const std::size_t end = line.find('`', 3);
+    ASSERT_NE(end, std::string::npos) << line;
+    page.push_back(line.substr(3, end - 3));
+  }
+  std::vector<std::string> table;
+  for (const mpm::Keyword &k : mpm::keywords()) table.push_back(k.name);
+  std::sort(page.begin(), page.end());
+  std::sort(table.begin(), table.end());
+  EXPECT_EQ(page, table) << "docs/fix_mpm_fluid.md, section Keywords";
+}
+
+}  // namespace

@@ -1,0 +1,195 @@
+// The solver's optimized transfer kernels (mpm/transfer.cpp: stencil loops, 4-wide rows, policy
+// types) against a plain serial reference written from the equations: P2G (8-10), (8-19), (8-24)
+// with the APIC affine momentum, and G2P (8-37)-(8-40) with PIC, FLIP, APIC and the velocity
+// gradient, for the quadratic B-spline and linear shape functions, at random points.
+#include <gtest/gtest.h>
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mpm/options.h"
+#include "mpm/solver.h"
+
+namespace {
+
+// ---- the reference: one point at a time, every node of a 5^3 box around it, plain loops ----
+double N(bool quad, double r, double &dN) {  // 1-D shape function of the offset r (cells) and dN/dr
+  const double a = std::fabs(r), s = r < 0 ? -1.0 : 1.0;
+  if (quad) {
+    if (a < 0.5) return dN = -2.0 * r, 0.75 - r * r;
+    if (a < 1.5) return dN = -s * (1.5 - a), 0.5 * (1.5 - a) * (1.5 - a);
+  } else if (a < 1.0) {
+    return dN = -s, 1.0 - a;
+  }
+  return dN = 0.0, 0.0;
+}
+
+struct RefNode { long i, j, k; double w, g[3], o[3]; };  // weight, gradient, x_i - x_p
+
+std::vector<RefNode> ref_nodes(bool quad, const mpm::GridSpec &gs, const double *x) {
+  std::vector<RefNode> out;
+  double xi[3];
+  for (int d = 0; d < 3; ++d) xi[d] = (x[d] - gs.origin[d]) / gs.dx;
+  for (long k = std::lround(xi[2]) - 2; k <= std::lround(xi[2]) + 2; ++k)
+    for (long j = std::lround(xi[1]) - 2; j <= std::lround(xi[1]) + 2; ++j)
+      for (long i = std::lround(xi[0]) - 2; i <= std::lround(xi[0]) + 2; ++i) {
+        const long idx[3] = {i, j, k};
+        double n[3], dn[3];
+        for (int d = 0; d < 3; ++d) n[d] = N(quad, xi[d] - idx[d], dn[d]);
+        RefNode r{i, j, k, n[0] * n[1] * n[2], {}, {}};
+        r.g[0] = dn[0] * n[1] * n[2] / gs.dx;
+        r.g[1] = n[0] * dn[1] * n[2] / gs.dx;
+        r.g[2] = n[0] * n[1] * dn[2] / gs.dx;
+        for (int d = 0; d < 3; ++d) r.o[d] = gs.origin[d] + idx[d] * gs.dx - x[d];
+        out.push_back(r);
+      }
+  return out;
+}
+
+// ---- the set-up: random points in the middle of a 10^3 grid (no wall is within reach) ----
+struct Scene {
+  std::vector<std::string> words;
+  mpm::Options opt;
+  std::vector<double> xs, vs, fs, rows;
+  std::vector<double *> x, v, f, state;
+  std::vector<double> rmass, radius;
+  std::vector<int> mask, tag, type;
+  std::unique_ptr<mpm::FluidSolver> solver;
+
+  explicit Scene(const std::string &args, int n = 40) {
+    std::istringstream is("f all mpm/fluid cell 0.1 density 1000 bulk 1e5 viscosity 1e-3 " + args);
+    for (std::string s; is >> s;) words.push_back(s);
+    std::vector<char *> argv;
+    for (auto &s : words) argv.push_back(&s[0]);
+    mpm::ParseEnv env;
+    opt = mpm::parse_options(static_cast<int>(argv.size()), argv.data(), env);
+    std::mt19937_64 gen(7);
+    std::uniform_real_distribution<double> pos(0.25, 0.75), val(-1.0, 1.0), pos1(0.5, 1.5);
+    xs.resize(3 * n), vs.resize(3 * n), fs.resize(3 * n), rows.assign(n * mpm::NCOL, 0.0);
+    for (int i = 0; i < 3 * n; ++i) xs[i] = pos(gen), vs[i] = val(gen), fs[i] = val(gen);
+    for (int i = 0; i < n; ++i) {
+      x.push_back(&xs[3 * i]), v.push_back(&vs[3 * i]), f.push_back(&fs[3 * i]), state.push_back(&rows[mpm::NCOL * i]);
+      rmass.push_back(pos1(gen)), radius.push_back(0.01), mask.push_back(1), tag.push_back(i + 1), type.push_back(1);
+      double *s = state.back();
+      s[mpm::C_VOL] = 1e-3 * pos1(gen);
+      s[mpm::C_P] = 1e3 * val(gen);
+      for (int c = 0; c < 6; ++c) s[mpm::C_TAU + c] = 10.0 * val(gen);
+      for (int c = 0; c < 9; ++c) s[mpm::C_AFF + c] = val(gen);
+      s[mpm::C_THETA] = 1.0;
+    }
+    solver.reset(new mpm::FluidSolver(opt, MPI_COMM_WORLD));
+    mpm::Points &p = solver->pts;
+    p.nlocal = n, p.x = x.data(), p.v = v.data(), p.f = f.data(), p.rmass = rmass.data(), p.radius = radius.data();
+    p.mask = mask.data(), p.tag = tag.data(), p.type = type.data(), p.state = state.data(), p.point_bit = 1;
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    solver->setup_grid(lo, hi, 0.0);
+    solver->compute_shapes();
+  }
+  bool quad() const { return opt.shape == mpm::ShapeKind::QuadraticBSpline; }
+  std::size_t node(const RefNode &r) const { return solver->grid().index(r.i, r.j, r.k); }
+};
+
+void expect_close(const std::vector<double> &a, const std::vector<double> &b, const char *what) {
+  double scale = 0.0, err = 0.0;
+  for (std::size_t q = 0; q < a.size(); ++q) scale = std::max(scale, std::fabs(b[q]));
+  for (std::size_t q = 0; q < a.size(); ++q) err = std::max(err, std::fabs(a[q] - b[q]));
+  EXPECT_GT(scale, 0.0) << what;
+  EXPECT_LE(err, 1e-13 * scale) << what << ": largest difference " << err << " of " << scale;
+}
+
+void check_p2g(const std::string &args) {
+  Scene sc(args);
+  sc.solver->particles_to_grid();
+  const bool apic = sc.opt.transfer == mpm::Transfer::Apic;
+  const std::size_t nn = sc.solver->grid().size();
+  std::vector<double> ref(nn * 7, 0.0), got(nn * 7, 0.0);
+  for (std::size_t p = 0; p < sc.x.size(); ++p) {
+    const double *s = sc.state[p], m = sc.rmass[p], V = s[mpm::C_VOL], P = s[mpm::C_P], *t = s + mpm::C_TAU;
+    const double sig[3][3] = {{t[0] - P, t[5], t[4]}, {t[5], t[1] - P, t[3]}, {t[4], t[3], t[2] - P}};
+    for (const RefNode &r : ref_nodes(sc.quad(), sc.opt.grid, sc.x[p])) {
+      double *g = &ref[7 * sc.node(r)];
+      g[0] += r.w * m;
+      for (int a = 0; a < 3; ++a) {
+        double mv = m * sc.v[p][a];
+        if (apic)
+          for (int b = 0; b < 3; ++b) mv += m * s[mpm::C_AFF + 3 * a + b] * r.o[b];
+        g[1 + a] += r.w * mv;
+        double fa = r.w * sc.f[p][a];
+        for (int b = 0; b < 3; ++b) fa -= V * sig[a][b] * r.g[b];
+        g[4 + a] += fa;
+      }
+    }
+  }
+  const std::vector<double> &rec = sc.solver->fields().p2g;
+  for (std::size_t n = 0; n < nn; ++n)
+    for (int c = 0; c < 7; ++c) got[7 * n + c] = rec[mpm::P2gRec::N * n + (c < 4 ? mpm::P2gRec::M + c : mpm::P2gRec::F + c - 4)];
+  expect_close(got, ref, ("P2G " + args).c_str());
+}
+
+void check_g2p(const std::string &args) {
+  Scene sc(args);
+  std::vector<double> &vel = sc.solver->fields().vel;
+  std::mt19937_64 gen(11);
+  std::uniform_real_distribution<double> val(-1.0, 1.0);
+  for (std::size_t n = 0; n < sc.solver->grid().size(); ++n)
+    for (int d = 0; d < 3; ++d) {
+      vel[mpm::VelRec::N * n + mpm::VelRec::V_NEW + d] = val(gen);
+      vel[mpm::VelRec::N * n + mpm::VelRec::V_OLD + d] = val(gen);
+    }
+  const std::vector<double> v0 = sc.vs;
+  sc.solver->grid_to_particles();
+  const bool apic = sc.opt.transfer == mpm::Transfer::Apic, flip = sc.opt.transfer == mpm::Transfer::Flip;
+  const double alpha = sc.opt.flip_alpha, dx = sc.opt.grid.dx;
+  std::vector<double> vref, vgot, cref, cgot;
+  for (std::size_t p = 0; p < sc.x.size(); ++p) {
+    double vp[3] = {0, 0, 0}, dv[3] = {0, 0, 0}, L[9] = {0}, B[9] = {0};
+    for (const RefNode &r : ref_nodes(sc.quad(), sc.opt.grid, sc.x[p])) {
+      const double *u = &vel[mpm::VelRec::N * sc.node(r)];
+      for (int a = 0; a < 3; ++a) {
+        vp[a] += r.w * u[mpm::VelRec::V_NEW + a];
+        dv[a] += r.w * (u[mpm::VelRec::V_NEW + a] - u[mpm::VelRec::V_OLD + a]);
+        for (int b = 0; b < 3; ++b) {
+          L[3 * a + b] += u[mpm::VelRec::V_NEW + a] * r.g[b];
+          B[3 * a + b] += r.w * u[mpm::VelRec::V_NEW + a] * r.o[b];
+        }
+      }
+    }
+    for (int a = 0; a < 3; ++a) {
+      vref.push_back(flip ? alpha * (v0[3 * p + a] + dv[a]) + (1.0 - alpha) * vp[a] : vp[a]);
+      vgot.push_back(sc.v[p][a]);
+    }
+    // the affine field: APIC's B D^-1 (bspline2, D = dx^2/4) or the velocity gradient
+    for (int c = 0; c < 9; ++c) {
+      cref.push_back(apic && sc.quad() ? 4.0 * B[c] / (dx * dx) : L[c]);
+      cgot.push_back(sc.state[p][mpm::C_AFF + c]);
+    }
+  }
+  expect_close(vgot, vref, ("G2P velocity " + args).c_str());
+  expect_close(cgot, cref, ("G2P affine field " + args).c_str());
+}
+
+TEST(TransferReference, P2gBSplineApic) { check_p2g("shape bspline2 transfer apic"); }
+TEST(TransferReference, P2gBSplineFlip) { check_p2g("shape bspline2 transfer flip"); }
+TEST(TransferReference, P2gLinearApic) { check_p2g("shape linear transfer apic"); }
+TEST(TransferReference, P2gLinearFlip) { check_p2g("shape linear transfer flip 0.9"); }
+// G2P with USL (the affine field is then the velocity gradient for FLIP/PIC) and APIC with MUSL
+TEST(TransferReference, G2pBSplineApic) { check_g2p("shape bspline2 transfer apic"); }
+TEST(TransferReference, G2pBSplineFlip) { check_g2p("shape bspline2 transfer flip 0.9 update usl"); }
+TEST(TransferReference, G2pLinearApic) { check_g2p("shape linear transfer apic"); }
+TEST(TransferReference, G2pLinearPic) { check_g2p("shape linear transfer pic update usl"); }
+
+}  // namespace
+
+int main(int argc, char **argv) {
+  MPI_Init(&argc, &argv);
+  ::testing::InitGoogleTest(&argc, argv);
+  const int rc = RUN_ALL_TESTS();
+  MPI_Finalize();
+  return rc;
+}
