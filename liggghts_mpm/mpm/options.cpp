@@ -257,8 +257,11 @@ void parse_output(Options &o, Args &a, const ParseEnv &) {
     if (!(points ? is_one_of(w, kPointFields, 10) : is_one_of(w, kGridFields, 2))) {
       // The first word that is no field name ends the list only if it is a keyword.
       if (find_keyword(w)) break;
-      bad_arg(points ? "output points" : "output grid",
-              points ? "point fields v p rho vol tau theta id type affine mass" : "grid fields mass v", w);
+      std::string names = points ? "point fields" : "grid fields";
+      for (const char *f : points ? std::vector<const char *>(kPointFields, kPointFields + 10)
+                                  : std::vector<const char *>(kGridFields, kGridFields + 2))
+        names += std::string(" ") + f;
+      bad_arg(points ? "output points" : "output grid", names.c_str(), w);
     }
     list->push_back(w);
     ++a.iarg;

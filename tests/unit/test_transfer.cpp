@@ -62,12 +62,13 @@ struct Scene {
   std::vector<int> mask, tag, type;
   std::unique_ptr<mpm::FluidSolver> solver;
 
-  explicit Scene(const std::string &args, int n = 40) {
+  explicit Scene(const std::string &args, int n = 40, bool periodic = false) {
     std::istringstream is("f all mpm/fluid cell 0.1 density 1000 bulk 1e5 viscosity 1e-3 " + args);
     for (std::string s; is >> s;) words.push_back(s);
     std::vector<char *> argv;
     for (auto &s : words) argv.push_back(&s[0]);
     mpm::ParseEnv env;
+    for (int d = 0; d < 3; ++d) env.periodic[d] = periodic;
     opt = mpm::parse_options(static_cast<int>(argv.size()), argv.data(), env);
     std::mt19937_64 gen(7);
     std::uniform_real_distribution<double> pos(0.25, 0.75), val(-1.0, 1.0), pos1(0.5, 1.5);
@@ -173,6 +174,31 @@ void check_g2p(const std::string &args) {
   expect_close(vgot, vref, ("G2P velocity " + args).c_str());
   expect_close(cgot, cref, ("G2P affine field " + args).c_str());
 }
+
+// A whole sub-step in a periodic box (no wall, no external force): P2G, grid update, G2P (APIC
+// or FLIP), MUSL, stress and advection keep the points' total momentum, since the internal forces
+// of the nodes sum to zero; no node is dropped (mass_threshold 0).
+void check_momentum(const std::string &args) {
+  Scene sc(args + " mass_threshold 0", 60, true);
+  std::fill(sc.fs.begin(), sc.fs.end(), 0.0);
+  auto momentum = [&](int d) {
+    double s = 0.0;
+    for (std::size_t p = 0; p < sc.x.size(); ++p) s += sc.rmass[p] * sc.v[p][d];
+    return s;
+  };
+  double before[3], scale = 0.0;
+  for (int d = 0; d < 3; ++d) before[d] = momentum(d);
+  for (std::size_t p = 0; p < sc.x.size(); ++p) scale += sc.rmass[p] * std::fabs(sc.v[p][0]);
+  const std::vector<double> v0 = sc.vs;
+  sc.solver->substep(1e-4);
+  double change = 0.0;  // the sub-step does change the velocities (pressure, stress, transfer)
+  for (std::size_t q = 0; q < v0.size(); ++q) change = std::max(change, std::fabs(sc.vs[q] - v0[q]));
+  EXPECT_GT(change, 1e-3) << args;
+  for (int d = 0; d < 3; ++d) EXPECT_NEAR(momentum(d), before[d], 1e-13 * scale) << args << ", direction " << d;
+}
+
+TEST(SubstepConservation, MomentumApicBSpline) { check_momentum("shape bspline2 transfer apic"); }
+TEST(SubstepConservation, MomentumFlipLinear) { check_momentum("shape linear transfer flip update usl"); }
 
 TEST(TransferReference, P2gBSplineApic) { check_p2g("shape bspline2 transfer apic"); }
 TEST(TransferReference, P2gBSplineFlip) { check_p2g("shape bspline2 transfer flip"); }
