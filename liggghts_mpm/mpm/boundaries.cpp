@@ -36,7 +36,7 @@ void Boundaries::apply(double *vel, int i, int j, int k, double h) {
     // of the face, rate nu / (delta dx) (as mesh_wall ... shear, docs/mesh_walls.md)
     const Face &f = opt_->face[fc];
     const double keep = f.kind == BcKind::Shear
-                            ? std::exp(-h * wall_layer_rate(opt_->viscosity / opt_->eos.rho0, f.delta, gs.dx))
+                            ? wall_slip_decay(wall_layer_rate(opt_->viscosity / opt_->eos.rho0, f.delta, gs.dx), h)
                             : 1.0 - f.sticky;
     for (int e = 0; e < 3; ++e) vel[e] = (e == d) ? 0.0 : keep * vel[e];
   }

@@ -39,20 +39,18 @@ double FluidSolver::stable_dt() {
   const double c = c_max_, dx = opt.grid.dx;
   const double dt_ac = acoustic_dt_limit(opt.cfl, dx, c, glob[0]);
   const double dt_visc = viscous_dt_limit(dx, eos.rho0, opt.viscosity, opt.dimension);
-  // Grains an integrator moves: the pore-pressure wave. Fluid and grains pushed by the same
-  // pressure form one wave, c^2 = c_f^2 (1 + rho_f (1 - theta) / (theta rho_p)), that limits the
-  // fluid step when the fluid is not sub-cycled; with sub-cycling the fluid follows the grains
-  // within the step and the grains' own wave, c_g^2 = c_f^2 rho_f (1 - theta) / (theta rho_p),
-  // limits the grains' step. Largest rho_f (1 - theta) / theta over the points against the
-  // lightest moving grain.
+  // Grains an integrator moves: the pore-pressure waves (fluid_laws.h). The coupled wave limits the
+  // fluid step when the fluid is not sub-cycled; with sub-cycling the grains' own wave limits the
+  // grains' step. Largest rho_f (1 - theta) / theta over the points against the lightest moving
+  // grain.
   couple_theta_min_ = glob[4] < 0.0 ? -glob[4] : 1.0;
   couple_rho_grain_ = glob[5] > -HUGE_VAL ? -glob[5] : 0.0;
   c_couple_ = c_grain_ = 0.0;
   dt_couple_ = dt_grain_ = HUGE_VAL;
   if (couple_rho_grain_ > 0.0) {
     const double r = glob[3] / couple_rho_grain_;
-    c_couple_ = c * std::sqrt(1.0 + r);
-    c_grain_ = c * std::sqrt(r);
+    c_couple_ = coupled_wave_speed(c, r);
+    c_grain_ = grain_wave_speed(c, r);
     dt_couple_ = acoustic_dt_limit(opt.cfl, dx, c_couple_, glob[0]);
     dt_grain_ = c_grain_ > 0.0 ? acoustic_dt_limit(opt.cfl, dx, c_grain_, glob[0]) : HUGE_VAL;
   }

@@ -74,4 +74,16 @@ TEST(TimeStepLimits, AcousticAndViscous) {
   EXPECT_TRUE(std::isinf(mpm::viscous_dt_limit(0.01, 1000.0, 0.0, 3)));
 }
 
+TEST(PoreWave, CoupledAndGrainSpeeds) {
+  // water (c_f = 1483 m/s) in a bed of glass beads, theta = 0.4: r = 1000 * 0.6 / (0.4 * 2500) = 0.6
+  const double cf = 1483.0, r = 1000.0 * 0.6 / (0.4 * 2500.0);
+  EXPECT_DOUBLE_EQ(mpm::coupled_wave_speed(cf, r), cf * std::sqrt(1.6));
+  EXPECT_DOUBLE_EQ(mpm::grain_wave_speed(cf, r), cf * std::sqrt(0.6));
+  // c^2 = c_f^2 + c_g^2; no grains (r = 0): the fluid's own speed, no grain wave
+  EXPECT_NEAR(std::pow(mpm::coupled_wave_speed(cf, r), 2),
+              cf * cf + std::pow(mpm::grain_wave_speed(cf, r), 2), 1e-9 * cf * cf);
+  EXPECT_DOUBLE_EQ(mpm::coupled_wave_speed(cf, 0.0), cf);
+  EXPECT_DOUBLE_EQ(mpm::grain_wave_speed(cf, 0.0), 0.0);
+}
+
 }  // namespace
