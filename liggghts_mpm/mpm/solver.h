@@ -114,7 +114,7 @@ class FluidSolver {
 
  private:
   // kernels (transfer.cpp, coupling.cpp), instantiated per stencil size and transfer policy
-  template <int NS, class P> void p2g_kernel();
+  template <int NS, class P, class Fn> void p2g_kernel(Fn &&after_point);
   template <int NS, class P> void g2p_kernel();
   template <int NS, class P> void musl_scatter();
   template <int NS> void musl_gradient();

@@ -13,17 +13,23 @@ namespace mpm {
    external forces (gravity (8-18) and whatever the host's fixes add), wall traction (8-23) */
 void FluidSolver::particles_to_grid() {
   std::fill(g_.p2g.begin(), g_.p2g.end(), 0.0);
-  with_policy(opt, [&](auto pol) { p2g_kernel<decltype(pol)::NS, decltype(pol)>(); });
+  // the boundary term of each point right after its own share, so that every node sums its
+  // contributions in point order
+  const bool traction = opt.wall_traction && opt.shape == ShapeKind::QuadraticBSpline;
+  double *const g = g_.p2g.data();
+  auto boundary_term = [&](int i, const Stencil &ps) {
+    if (traction) bc.add_traction(ps, pts.x[i], pts.state[i][C_VOL], pts.state[i][C_P], g);
+  };
+  with_policy(opt, [&](auto pol) { p2g_kernel<decltype(pol)::NS, decltype(pol)>(boundary_term); });
   grid_.reverse_sum(g_.p2g.data(), P2gRec::N);
 }
 
-template <int NS, class P>
-void FluidSolver::p2g_kernel() {
+template <int NS, class P, class Fn>
+void FluidSolver::p2g_kernel(Fn &&after_point) {
   double **x = pts.x, **v = pts.v, **f = pts.f;
   const double *rmass = pts.rmass;
   double *const g = g_.p2g.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  const bool traction = opt.wall_traction && opt.shape == ShapeKind::QuadraticBSpline;
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     const double *s = pts.state[i];
@@ -52,8 +58,7 @@ void FluidSolver::p2g_kernel() {
       row4(gn + P2gRec::M) += w * u;
       row4(gn + P2gRec::F) += w * fe + gx * sx + gy * sy_ + gz * sz_;
     });
-    // the boundary term after the point's own share, so that every node sums in point order
-    if (traction) bc.add_traction(ps, x[i], V, p, g);
+    after_point(i, ps);
   }
 }
 
