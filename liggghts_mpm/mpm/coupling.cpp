@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <sstream>
 
 #include "mpm/coupling.h"
+#include "mpm/error.h"
 #include "mpm/solver.h"
 
 namespace mpm {
@@ -92,6 +94,25 @@ void FluidSolver::init_theta() {
    with the pressure of the previous sub-step the restoring force of the fluid on a grain lags
    one step behind its displacement, which feeds energy into the grain-fluid oscillation (stiff:
    K / theta per unit volume change) and made the moving dense bed of C3 blow up. */
+/* What the coupling reads of grain k (position, velocity, radius, mass) is finite, the radius
+   and mass positive: a grain whose mass underflowed (d = 1e-110) gets a non-finite position from
+   its integrator, whose stencil would index far outside the grid. */
+void FluidSolver::check_grain(int k) const {
+  const double *x = pts.x[k], *v = pts.v[k];
+  const char *what = nullptr;
+  if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))) what = "position";
+  else if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))) what = "velocity";
+  else if (!(std::isfinite(pts.radius[k]) && pts.radius[k] > 0.0)) what = "radius";
+  else if (!(std::isfinite(pts.rmass[k]) && pts.rmass[k] > 0.0)) what = "mass";
+  if (!what) return;
+  std::ostringstream os;
+  os << "Fix mpm/fluid: the " << what << " of grain " << pts.tag[k] << " (group '" << opt.couple_group
+     << "') is not finite" << (what[0] == 'r' || what[0] == 'm' ? " and positive" : "") << " at step " << clock.step << " (x = (" << x[0] << ", " << x[1] << ", " << x[2]
+     << "), v = (" << v[0] << ", " << v[1] << ", " << v[2] << "), radius " << pts.radius[k] << ", mass " << pts.rmass[k]
+     << "); a grain of underflowing mass or an unstable DEM step";
+  throw LocalError(os.str());
+}
+
 void FluidSolver::fluid_fraction() {
   const GridSpec &gs = opt.grid;
   const int nlocal = pts.nlocal;
@@ -102,6 +123,7 @@ void FluidSolver::fluid_fraction() {
   std::fill(g_.need.begin(), g_.need.end(), 0.0);
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k)) continue;
+    check_grain(k);
     Stencil &ps = grain_shapes_[k];
     if (!shape_of(x[k], ps)) {
       ps.base[0] = INT_MIN;  // outside the grid: no fluid there
@@ -114,6 +136,9 @@ void FluidSolver::fluid_fraction() {
     });
   }
   grid_.reverse_sum(g_.need.data(), 1);  // nodes some grain reads (fit of the pressure only there)
+  // and back to the halo copies: a point of this rank must add its pressure moments to a node
+  // that only another rank's grain reads (else np 2 differs from np 1 with 'grad_p fit')
+  grid_.forward(g_.need.data(), 1);
   // Walls: the solid volume mapped to a node outside a grid face is folded onto its mirror node
   // inside (reflected shape functions), so that no node has the sliver volume that (8-13) gives
   // the padding nodes (1/48 of a cell for the B-spline: one grain near the wall would swing its
@@ -124,28 +149,7 @@ void FluidSolver::fluid_fraction() {
     if (gs.periodic[d]) return c;
     return c < 0 ? -c : (c > gs.ncell[d] ? 2 * gs.ncell[d] - c : c);
   };
-  const IndexBox &pb = grid_.patch();
-  for (int d = 0; d < 3; ++d) {
-    if (gs.periodic[d]) continue;
-    // only the patch's padding layers outside the low and the high face
-    const int layers[2][2] = {{pb.lo[d], std::min(pb.hi[d], -1)}, {std::max(pb.lo[d], gs.ncell[d] + 1), pb.hi[d]}};
-    for (const auto &L : layers) {
-      IndexBox b = pb;
-      b.lo[d] = L[0];
-      b.hi[d] = L[1];
-      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-        for (int j = b.lo[1]; j <= b.hi[1]; ++j)
-          for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
-            const std::size_t n = grid_.index(i, j, k);
-            int idx[3] = {i, j, k};
-            idx[d] = mirror(idx[d], d);
-            if (g_.sol[n] != 0.0 && grid_.in_patch(idx[0], idx[1], idx[2])) {
-              g_.sol[grid_.index(idx[0], idx[1], idx[2])] += g_.sol[n];
-              g_.sol[n] = 0.0;
-            }
-          }
-    }
-  }
+  fold_to_mirror(g_.sol, 1);
   grid_.reverse_sum(g_.sol.data(), 1);
   if (opt.theta_smooth > 0.0) smooth_solid_volume();
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -183,9 +187,45 @@ void FluidSolver::fluid_fraction() {
 // The points' density and pressure for the new fluid fraction (their volume is unchanged).
 void FluidSolver::refresh_pressure() { update_stress(0.0, true); }
 
+/* Walls: what is mapped to a node outside a grid face (patch, partial sums before the reverse sum)
+   is folded onto its mirror node inside (reflected shape functions), one direction after the
+   other, so a corner's share ends on the inside too. */
+void FluidSolver::fold_to_mirror(std::vector<double> &a, int stride) {
+  const GridSpec &gs = opt.grid;
+  auto mirror = [&](int c, int d) { return c < 0 ? -c : (c > gs.ncell[d] ? 2 * gs.ncell[d] - c : c); };
+  const IndexBox &pb = grid_.patch();
+  for (int d = 0; d < 3; ++d) {
+    if (gs.periodic[d]) continue;
+    // only the patch's padding layers outside the low and the high face
+    const int layers[2][2] = {{pb.lo[d], std::min(pb.hi[d], -1)}, {std::max(pb.lo[d], gs.ncell[d] + 1), pb.hi[d]}};
+    for (const auto &L : layers) {
+      IndexBox b = pb;
+      b.lo[d] = L[0];
+      b.hi[d] = L[1];
+      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+          for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
+            int idx[3] = {i, j, k};
+            idx[d] = mirror(idx[d], d);
+            if (!grid_.in_patch(idx[0], idx[1], idx[2])) continue;
+            double *from = &a[stride * grid_.index(i, j, k)];
+            double *to = &a[stride * grid_.index(idx[0], idx[1], idx[2])];
+            for (int c = 0; c < stride; ++c)
+              if (from[c] != 0.0) {
+                to[c] += from[c];
+                from[c] = 0.0;
+              }
+          }
+    }
+  }
+}
+
 /* Smoothing of the grains' volume at the owned nodes by a discrete diffusion of the solid
    fraction phi_j = S_j / V_j (smoothing_step along each direction, smoothing_passes passes). */
-void FluidSolver::smooth_solid_volume() {
+void FluidSolver::smooth_solid_volume() { smooth_node_volume(g_.sol); }
+
+// The same filter for any volume-like quantity at the owned nodes (a: one value per node).
+void FluidSolver::smooth_node_volume(std::vector<double> &a) {
   const GridSpec &gs = opt.grid;
   const int passes = smoothing_passes(opt.theta_smooth, gs.dx);
   if (passes <= 0) return;
@@ -193,7 +233,7 @@ void FluidSolver::smooth_solid_volume() {
   phi.assign(2 * grid_.size(), 0.0);  // phi, node volume
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     const double V = solid_node_volume(i, j, k);
-    phi[2 * n] = V > 0.0 ? g_.sol[n] / V : 0.0;
+    phi[2 * n] = V > 0.0 ? a[n] / V : 0.0;
     phi[2 * n + 1] = V;
   });
   grid_.forward(phi.data(), 2);
@@ -218,7 +258,7 @@ void FluidSolver::smooth_solid_volume() {
       grid_.for_owned([&](int, int, int, std::size_t n) { phi[2 * n] = phi_new[n]; });
       grid_.forward(phi.data(), 2);
     }
-  grid_.for_owned([&](int, int, int, std::size_t n) { g_.sol[n] = phi[2 * n] * phi[2 * n + 1]; });
+  grid_.for_owned([&](int, int, int, std::size_t n) { a[n] = phi[2 * n] * phi[2 * n + 1]; });
 }
 
 /* Moments of the points' pressures for the linear least-squares fit at each node: with
@@ -234,7 +274,7 @@ void FluidSolver::pressure_moments() {
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     const double V = pts.state[i][C_VOL], p = pts.state[i][C_P];
-    if (!opt.grad_p_fit) {
+    if (opt.grad_p == GradP::Nodal) {
       // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
         double *cn = g + PfitRec::N * n;
@@ -291,10 +331,16 @@ void FluidSolver::couple_kernel(double h) {
   const int nsub = state.nsub;
   if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
 
-  // pressure at the nodes for the force on the grains (fit_linear_pressure)
-  std::fill(g_.pfit.begin(), g_.pfit.end(), 0.0);
-  pressure_moments<NS>();
-  grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
+  const bool weak = opt.grad_p == GradP::Weak;
+  if (weak || opt.reaction_points) point_sums<NS>();
+  if (weak) {
+    weak_pressure_gradient();
+  } else {
+    // pressure at the nodes for the force on the grains (fit_linear_pressure)
+    std::fill(g_.pfit.begin(), g_.pfit.end(), 0.0);
+    pressure_moments<NS>();
+    grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
+  }
 
   const double mmin = mass_min();
   grid_.for_owned([&](int, int, int, std::size_t n) {
@@ -303,9 +349,9 @@ void FluidSolver::couple_kernel(double h) {
     double *st = &g_.st[StRec::N * n];
     for (int q = 0; q < StRec::N; ++q) st[q] = 0.0;
     st[StRec::TH] = g_.th[n];
-    st[StRec::P] = c[PfitRec::MAT] > 0.0 ? c[PfitRec::R] / c[PfitRec::MAT] : 0.0;
+    st[StRec::P] = !weak && c[PfitRec::MAT] > 0.0 ? c[PfitRec::R] / c[PfitRec::MAT] : 0.0;
     double fit[4];
-    if (opt.grad_p_fit && c[PfitRec::MAT] > 0.0 && g_.need[n] > 0.0 && fit_linear_pressure(c, opt.grid.dx, fit)) {
+    if (opt.grad_p == GradP::Fit && c[PfitRec::MAT] > 0.0 && g_.need[n] > 0.0 && fit_linear_pressure(c, opt.grid.dx, fit)) {
       st[StRec::P] = fit[0];
       for (int a = 0; a < 3; ++a) st[StRec::FIT + a] = fit[1 + a];
       st[StRec::FIT + 3] = 1.0;  // the fit (value and gradient) is determined
@@ -354,6 +400,13 @@ void FluidSolver::couple_kernel(double h) {
     // in one layer); the gradient of the interpolated nodal pressures where no fit is determined.
     if (wfit > 0.5)
       for (int d = 0; d < 3; ++d) gradp[d] = fw[d] / wfit;
+    if (weak) {
+      // the gradient the fluid itself feels at the nodes (weak_pressure_gradient), interpolated
+      gradp[0] = gradp[1] = gradp[2] = 0.0;
+      for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+        for (int d = 0; d < 3; ++d) gradp[d] += w * g_.gw[3 * n + d];
+      });
+    }
     const double d_k = 2.0 * radius[k];
     const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
     double K = 0.0;
@@ -385,6 +438,13 @@ void FluidSolver::couple_kernel(double h) {
       row4(q + DrRec::KA) += w * r2;
     });
   }
+  if (opt.reaction_points) {
+    // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
+    for (std::size_t n = 0; n < grid_.size(); ++n)
+      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
+    fold_to_mirror(g_.rp, 3);
+    grid_.reverse_sum(g_.rp.data(), 3);
+  }
   grid_.reverse_sum(g_.dr.data(), DrRec::N);
 
   // node-wise exchange; the fluid's share of it stays on the owner
@@ -405,10 +465,11 @@ void FluidSolver::couple_kernel(double h) {
       drag_implicit_impulse(vg, st + StRec::U, mg, mf, K, h, J, ag, af);
     }
     for (int d = 0; d < 3; ++d) {
-      rx[d] = q[DrRec::FP + d] - J[d] / h;                          // force on the fluid
+      rx[d] = (opt.reaction_points ? 0.0 : q[DrRec::FP + d]) - J[d] / h;  // force on the fluid
       q[DrRec::J + d] = q[DrRec::K] > 0.0 ? J[d] / q[DrRec::K] : 0.0;  // impulse per unit K, to the grains
     }
   });
+  if (opt.reaction_points) route_reaction<NS>();
   grid_.forward(g_.dr.data(), DrRec::N);
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
@@ -420,6 +481,126 @@ void FluidSolver::couple_kernel(double h) {
     for (int d = 0; d < 3; ++d)
       grain_force_[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
   }
+}
+
+/* The points' volume and external force at the nodes (WkRec, reverse-summed), and the volume
+   again folded at the faces (rq[3 n], for route_reaction). */
+template <int NS>
+void FluidSolver::point_sums() {
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  double *const wk = g_.wk.data();
+  std::fill(g_.wk.begin(), g_.wk.end(), 0.0);
+  for (const int i : plist_) {
+    const double *f = pts.f[i];
+    const Row4 r = {pts.state[i][C_VOL], f[0], f[1], f[2]};
+    for_stencil<NS>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+      row4(wk + WkRec::N * n) += w * r;
+    });
+  }
+  if (opt.reaction_points) {
+    std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
+    for (std::size_t n = 0; n < grid_.size(); ++n) g_.rq[3 * n] = wk[WkRec::N * n + WkRec::V];
+    fold_to_mirror(g_.rq, 3);
+    grid_.reverse_sum(g_.rq.data(), 3);
+  }
+  grid_.reverse_sum(g_.wk.data(), WkRec::N);
+}
+
+/* grad_p weak: the pressure gradient the fluid itself feels at node i, -(internal force + wall
+   traction) / sum_p S_ip V_p: the P2G force less the points' external forces. At rest every free
+   node balances it with the weight of its fluid and the grains' reaction, so a grain reads
+   exactly rho g there, whatever the packing and next to a floor, where the anti-locked cell
+   pressure has its staircase (docs/background/well_balanced.md). Nodes on a grid face and padding
+   nodes (their velocity is the wall's) take the value of the nearest node off the faces. */
+void FluidSolver::weak_pressure_gradient() {
+  const GridSpec &gs = opt.grid;
+  const double vmin = 1e-12 * gs.dx * gs.dx * gs.dx;
+  std::fill(g_.gw.begin(), g_.gw.end(), 0.0);
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    const double *w = &g_.wk[WkRec::N * n];
+    if (!(w[WkRec::V] > vmin)) return;
+    const double *f = &g_.p2g[P2gRec::N * n + P2gRec::F];
+    for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = -(f[d] - w[WkRec::F + d]) / w[WkRec::V];
+  });
+  grid_.forward(g_.gw.data(), 3);
+  const IndexBox &pb = grid_.patch();
+  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
+    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
+        int c[3] = {i, j, k};
+        bool moved = false;
+        for (int d = 0; d < 3; ++d) {
+          if (gs.periodic[d] || gs.ncell[d] < 2) continue;
+          const int cc = std::min(std::max(c[d], 1), gs.ncell[d] - 1);
+          moved = moved || cc != c[d];
+          c[d] = cc;
+        }
+        if (!moved || !grid_.in_patch(c[0], c[1], c[2])) continue;
+        const std::size_t n = grid_.index(i, j, k), m = grid_.index(c[0], c[1], c[2]);
+        for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = g_.gw[3 * m + d];
+      }
+}
+
+/* reaction points: the grains' pressure reaction r_i (rp, owned, folded) goes to the fluid
+   through its points, the way the fluid's displaced mass went (theta_p interpolated from the
+   nodes, then mapped back with the mass): q_i = r_i / V_i (V_i = sum_p S_ip V_p folded, smoothed
+   like the grains' volume with theta_smooth), q_p = sum_i S_ip q_i, R_j = sum_p S_jp V_p q_p.
+   For a uniform gradient this is exactly the complement of the fluid's weight, and
+   sum_j R_j = sum_i r_i (momentum kept). A node with a reaction but no fluid point keeps it. */
+template <int NS>
+void FluidSolver::route_reaction() {
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const double vmin = 1e-12 * opt.grid.dx * opt.grid.dx * opt.grid.dx;
+  if (opt.theta_smooth > 0.0) {
+    std::vector<double> c(grid_.size(), 0.0);
+    for (int d = 0; d < 3; ++d) {
+      grid_.for_owned([&](int, int, int, std::size_t n) { c[n] = g_.rp[3 * n + d]; });
+      smooth_node_volume(c);
+      grid_.for_owned([&](int, int, int, std::size_t n) { g_.rp[3 * n + d] = c[n]; });
+    }
+  }
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    const double V = g_.rq[3 * n];
+    for (int d = 0; d < 3; ++d) {
+      const double r = g_.rp[3 * n + d];
+      g_.rq[3 * n + d] = V > vmin ? r / V : 0.0;
+      if (!(V > vmin)) g_.rx[3 * n + d] += r;
+    }
+  });
+  grid_.forward(g_.rq.data(), 3);
+  // padding nodes take their mirror's value, as the fluid fraction does
+  const GridSpec &gs = opt.grid;
+  auto mirror = [&](int c, int d) {
+    if (gs.periodic[d]) return c;
+    return c < 0 ? -c : (c > gs.ncell[d] ? 2 * gs.ncell[d] - c : c);
+  };
+  const IndexBox &pb = grid_.patch();
+  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
+    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
+        const int mi[3] = {mirror(i, 0), mirror(j, 1), mirror(k, 2)};
+        if ((mi[0] == i && mi[1] == j && mi[2] == k) || !grid_.in_patch(mi[0], mi[1], mi[2])) continue;
+        const std::size_t n = grid_.index(i, j, k), m = grid_.index(mi[0], mi[1], mi[2]);
+        for (int d = 0; d < 3; ++d) g_.rq[3 * n + d] = g_.rq[3 * m + d];
+      }
+  std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
+  double *const rr = g_.rp.data();
+  const double *const q = g_.rq.data();
+  for (const int i : plist_) {
+    const Stencil &ps = shapes_[i];
+    Row4 qp = {0, 0, 0, 0};
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+      qp += w * Row4{q[3 * n], q[3 * n + 1], q[3 * n + 2], 0.0};
+    });
+    const Row4 vq = pts.state[i][C_VOL] * qp;
+    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+      for (int d = 0; d < 3; ++d) rr[3 * n + d] += w * vq[d];
+    });
+  }
+  grid_.reverse_sum(g_.rp.data(), 3);
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    for (int d = 0; d < 3; ++d) g_.rx[3 * n + d] += rr[3 * n + d];
+  });
 }
 
 }  // namespace mpm

@@ -39,6 +39,8 @@ struct StRec { enum { U = 0, FIT = 4, TH = 8, P = 9, M = 10, N = 12 }; };
 // coupling, the grains' share of a node: sum S K, sum S K v (3) (after the exchange: the impulse
 // per unit K (3)); sum S m, pressure reaction (3); sum S K a (3), sum S K of fixed grains
 struct DrRec { enum { K = 0, KV = 1, J = 1, M = 4, FP = 5, KA = 8, KFIX = 11, N = 12 }; };
+// coupling, grad_p weak: the points' volume and external force at the node, sum S V, sum S f (3)
+struct WkRec { enum { V = 0, F = 1, N = 4 }; };
 
 // The node arrays of the rank's grid patch (flat index n, record of length R::N at R::N * n).
 struct GridFields {
@@ -51,6 +53,9 @@ struct GridFields {
   std::vector<double> rx;       // force of the grains on the fluid (3), owned nodes
   std::vector<double> th_prev;  // theta_transport: nodal fraction of the last sub-step
   std::vector<double> phi, phi_new;  // smoothing work arrays
+  std::vector<double> wk;       // grad_p weak: WkRec (reverse-summed)
+  std::vector<double> gw;       // grad_p weak: the fluid's pressure gradient (3), every patch node
+  std::vector<double> rp, rq;   // reaction points: the grains' pressure reaction, its density (3)
 
   void assign(std::size_t nodes, bool musl, bool coupled, bool theta_transport) {
     p2g.assign(nodes * P2gRec::N, 0.0);
@@ -66,6 +71,10 @@ struct GridFields {
       st.assign(nodes * StRec::N, 0.0);
       rx.assign(nodes * 3, 0.0);
       dr.assign(nodes * DrRec::N, 0.0);
+      wk.assign(nodes * WkRec::N, 0.0);
+      gw.assign(nodes * 3, 0.0);
+      rp.assign(nodes * 3, 0.0);
+      rq.assign(nodes * 3, 0.0);
     }
   }
 };

@@ -80,8 +80,8 @@ void parse_transfer(Options &o, Args &a, const ParseEnv &) {
     o.flip_alpha = 1.0;
     a.iarg += 2;
     double v;
-    if (a.iarg < a.narg && parse_double(a.at(0), v)) {
-      if (v < 0.0 || v > 1.0) bad_arg("transfer flip", "a FLIP fraction in [0,1]", a.at(0));
+    if (a.iarg < a.narg && !find_keyword(a.at(0))) {
+      if (!parse_double(a.at(0), v) || v < 0.0 || v > 1.0) bad_arg("transfer flip", "a FLIP fraction in [0,1]", a.at(0));
       o.flip_alpha = v;
       ++a.iarg;
     }
@@ -90,7 +90,19 @@ void parse_transfer(Options &o, Args &a, const ParseEnv &) {
 }
 
 void parse_update(Options &o, Args &a, const ParseEnv &) { choice(a, "musl", "usl", o.musl); }
-void parse_grad_p(Options &o, Args &a, const ParseEnv &) { choice(a, "fit", "nodal", o.grad_p_fit); }
+void parse_grad_p(Options &o, Args &a, const ParseEnv &) {
+  a.need(1, "grad_p", "'weak', 'fit' or 'nodal'");
+  if (strcmp(a.at(1), "weak") == 0)
+    o.grad_p = GradP::Weak;
+  else if (strcmp(a.at(1), "fit") == 0)
+    o.grad_p = GradP::Fit;
+  else if (strcmp(a.at(1), "nodal") == 0)
+    o.grad_p = GradP::Nodal;
+  else
+    bad_arg("grad_p", "'weak', 'fit' or 'nodal'", a.at(1));
+  a.iarg += 2;
+}
+void parse_reaction(Options &o, Args &a, const ParseEnv &) { choice(a, "points", "direct", o.reaction_points); }
 
 // boundary FACE KIND [value], also for fix_modify (a.iarg at the keyword)
 void parse_face(Options &o, Args &a) {
@@ -300,6 +312,55 @@ void fit_grid(Options &o, const ParseEnv &env) {
   g.pad = o.shape == ShapeKind::QuadraticBSpline ? 1 : 0;
 }
 
+// Values each within its range whose derived quantities are not (sound speed, stable steps,
+// smoothing passes, hydrostatic density): an error naming the keywords, before any computation.
+void check_derived(const Options &o) {
+  const GridSpec &g = o.grid;
+  std::ostringstream os;
+  os.precision(6);
+  double extent = 0.0;
+  for (int d = 0; d < 3; ++d) extent = std::max(extent, g.ncell[d] * g.dx);
+  // passes of the smoothing filter: 2 L^2 / dx^2 (coupling.h), at most 2 ncell^2
+  if (o.theta_smooth > extent) {
+    os << "Fix mpm/fluid: keyword 'theta_smooth' expects a smoothing length (length unit, m in SI) in [0, " << extent
+       << "] (at most the largest grid extent), got " << o.theta_smooth;
+    throw Error(os.str());
+  }
+  const double passes = 2.0 * (o.theta_smooth / g.dx) * (o.theta_smooth / g.dx);
+  if (!(passes <= 1e6)) {
+    os << "Fix mpm/fluid: keyword 'theta_smooth' (" << o.theta_smooth << " m) needs " << passes
+       << " smoothing passes per step with cell " << g.dx << " (at most 1e6); reduce it";
+    throw Error(os.str());
+  }
+  const Eos &e = o.eos;
+  double rho_hi = e.rho0;
+  if (o.hydrostatic) {
+    // the deepest point of the grid: the largest initial pressure and density
+    const double depth = o.hydro_surface - g.origin[o.hydro_axis];
+    const double p = std::max(0.0, e.rho0 * o.hydro_g * depth);
+    rho_hi = e.density(p);
+    if (!std::isfinite(p) || !std::isfinite(rho_hi) || !(rho_hi > 0.0)) {
+      os << "Fix mpm/fluid: keyword 'hydrostatic' gives at the bottom of the grid a pressure rho0 g depth = " << p
+         << " with which the equation of state ('bulk' " << e.K << ") has no finite density; reduce g or the surface";
+      throw Error(os.str());
+    }
+  }
+  const double c2 = std::max(e.sound_speed_sq(e.rho0), e.sound_speed_sq(rho_hi));
+  const double dt_ac = acoustic_dt_limit(o.cfl, g.dx, std::sqrt(c2), 0.0);
+  if (!std::isfinite(c2) || !(c2 > 0.0) || !std::isfinite(dt_ac) || !(dt_ac > 0.0)) {
+    os << "Fix mpm/fluid: keywords 'bulk' (" << e.K << ") and 'density' (" << e.rho0
+       << ") give a sound speed squared " << c2 << " and an acoustic time step limit " << dt_ac
+       << " that are not finite and positive in double precision; use values of physical size";
+    throw Error(os.str());
+  }
+  const double dt_visc = viscous_dt_limit(g.dx, e.rho0, o.viscosity, o.dimension);
+  if (!(dt_visc > 0.0) || std::isnan(dt_visc)) {
+    os << "Fix mpm/fluid: keywords 'viscosity' (" << o.viscosity << ") and 'density' (" << e.rho0
+       << ") give a viscous time step limit " << dt_visc << " that is not positive in double precision";
+    throw Error(os.str());
+  }
+}
+
 #define REAL(member) &Options::member
 constexpr double kInf = HUGE_VAL;
 
@@ -362,8 +423,10 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, &Options::wall_traction, nullptr, true},
     {"theta_transport", "yes/no", "-", "", "no", "'yes' or 'no'",
      nullptr, 0, 0, false, false, &Options::theta_transport, nullptr, true},
-    {"grad_p", "fit | nodal", "-", "", "fit", "'fit' or 'nodal'",
+    {"grad_p", "weak | fit | nodal", "-", "", "weak", "'weak', 'fit' or 'nodal'",
      nullptr, 0, 0, false, false, nullptr, parse_grad_p, false},
+    {"reaction", "points | direct", "-", "", "points", "'points' or 'direct'",
+     nullptr, 0, 0, false, false, nullptr, parse_reaction, false},
     {"front", "axis", "-", "x, y or z", "x", "an axis x, y or z",
      nullptr, 0, 0, false, false, nullptr, parse_front, false},
     {"height", "axis wall-axis wall-position", "length", "two different axes", "z x (grid's low x)",
@@ -438,6 +501,7 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
   o.eos.K = o.bulk;
   fit_grid(o, env);
   if (!o.wall_pos_given) o.wall_pos = o.grid.origin[o.wall_axis];
+  check_derived(o);
   const Gate &g = o.gate;
   if (g.active && !o.grid.periodic[g.dim] && (g.pos <= o.grid.origin[g.dim] || g.pos >= o.grid.upper(g.dim)))
     throw Error("Fix mpm/fluid: keyword 'gate' expects a position inside the grid");

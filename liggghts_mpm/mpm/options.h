@@ -35,6 +35,7 @@ struct Gate {
   double release_time = -1;  // simulation time of removal; < 0 = only by fix_modify
 };
 enum class Transfer { Apic, Pic, Flip };
+enum class GradP { Weak, Fit, Nodal };  // docs/background/well_balanced.md
 
 struct Options {
   // fluid and grid
@@ -51,7 +52,12 @@ struct Options {
   bool musl = true;
   bool antilock = true;
   bool wall_traction = true;        // (8-23) at grid-face walls for bspline2
-  bool grad_p_fit = true;           // grad p at the grains: fitted nodal gradients (fit) or of the nodal means (nodal)
+  // grad p at the grains: the gradient the fluid feels at the nodes, -(internal force)/volume
+  // (weak, default), fitted nodal gradients (fit) or the gradient of the nodal means (nodal)
+  GradP grad_p = GradP::Weak;
+  // the grains' pressure reaction goes to the fluid through its points (points, default: the
+  // kernel the displaced fluid mass went through) or straight to the nodes (direct, the text's)
+  bool reaction_points = true;
   bool theta_transport = false;     // points carry theta (updated by div(theta u)) instead of re-interpolating it
   Face face[6];
   Gate gate;

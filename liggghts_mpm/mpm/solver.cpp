@@ -140,6 +140,7 @@ void FluidSolver::compute_shapes() {
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
     plist_.push_back(i);
+    check_point(i);
     if (!shape_of(x[i], shapes_[i])) {
       std::ostringstream os;
       os << "Fix mpm/fluid: material point " << pts.tag[i] << " at (" << x[i][0] << ", " << x[i][1] << ", "
@@ -149,6 +150,22 @@ void FluidSolver::compute_shapes() {
       throw LocalError(os.str());
     }
   }
+}
+
+// What the step reads of point i (position, velocity, mass) is finite, the mass positive.
+void FluidSolver::check_point(int i) const {
+  const double *x = pts.x[i], *v = pts.v[i];
+  const char *what = nullptr;
+  if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))) what = "position";
+  else if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))) what = "velocity";
+  else if (!(std::isfinite(pts.rmass[i]) && pts.rmass[i] > 0.0)) what = "mass";
+  if (!what) return;
+  std::ostringstream os;
+  os << "Fix mpm/fluid: the " << what << " of material point " << pts.tag[i] << " is not finite"
+     << (what[0] == 'm' ? " and positive" : "") << " at step " << clock.step << " (x = (" << x[0] << ", " << x[1]
+     << ", " << x[2] << "), v = (" << v[0] << ", " << v[1] << ", " << v[2] << "), mass " << pts.rmass[i]
+     << "); the run became unstable (reduce the timestep)";
+  throw LocalError(os.str());
 }
 
 // Weights and gradients of the nodes around x; false if x is outside the grid.

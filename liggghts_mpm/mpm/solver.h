@@ -120,6 +120,11 @@ class FluidSolver {
   template <int NS> void musl_gradient();
   template <int NS> void pressure_moments();
   template <int NS> void couple_kernel(double h);
+  template <int NS> void point_sums();             // grad_p weak, reaction points: WkRec
+  void weak_pressure_gradient();                   // grad_p weak
+  template <int NS> void route_reaction();         // reaction points
+  void fold_to_mirror(std::vector<double> &a, int stride);
+  void smooth_node_volume(std::vector<double> &a);
   template <class Fn> void for_nodes(const Stencil &ps, Fn &&fn) const;
 
   bool shape_of(const double *x, Stencil &ps);
@@ -147,6 +152,11 @@ class FluidSolver {
   double dt_stable_ = 0.0, c_max_ = 0.0;
   double dt_couple_ = HUGE_VAL, dt_grain_ = HUGE_VAL, c_couple_ = 0.0, c_grain_ = 0.0;
   double couple_theta_min_ = 1.0, couple_rho_grain_ = 0.0;
+  double rho_range_[2] = {0.0, 0.0};  // lowest and highest density of the points at the last check
+  bool density_warned_ = false;       // density_warning() given in this run
+  std::string density_warning();
+  void check_point(int i) const;      // finite position, velocity, mass (compute_shapes)
+  void check_grain(int k) const;      // finite position, velocity, radius, mass (fluid_fraction)
   std::unique_ptr<Hdf5Series> series_;
   long last_output_step_ = -1;
 };

@@ -36,6 +36,8 @@ double FluidSolver::stable_dt() {
   // Sound speed: largest over the density range (Tait stiffens under compression, the linear
   // law under tension).
   c_max_ = std::sqrt(std::max(eos.sound_speed_sq(glob[1]), eos.sound_speed_sq(-glob[2])));
+  rho_range_[0] = -glob[2];
+  rho_range_[1] = glob[1];
   const double c = c_max_, dx = opt.grid.dx;
   const double dt_ac = acoustic_dt_limit(opt.cfl, dx, c, glob[0]);
   const double dt_visc = viscous_dt_limit(dx, eos.rho0, opt.viscosity, opt.dimension);
@@ -57,7 +59,23 @@ double FluidSolver::stable_dt() {
   return std::min(dt_ac, dt_visc);
 }
 
+// Once per run: the points' density (reduced in stable_dt) left [0.5, 2] rho0 under the equation
+// of state: the weakly compressible model is far from its range (a column hitting the floor fast).
+std::string FluidSolver::density_warning() {
+  if (density_warned_) return "";
+  const double r0 = opt.eos.rho0, lo = rho_range_[0] / r0, hi = rho_range_[1] / r0;
+  if (lo >= 0.5 && hi <= 2.0) return "";
+  density_warned_ = true;
+  std::ostringstream os;
+  os.precision(6);
+  os << "WARNING: fix mpm/fluid: the points' density left [0.5, 2] rho0 at step " << clock.step << " (rho/rho0 from "
+     << lo << " to " << hi << "): the fluid is compressed or stretched far beyond a weakly compressible fluid; "
+     << "raise keyword 'bulk' (" << opt.eos.K << ") or lower the speeds (warned once per run)\n";
+  return os.str();
+}
+
 std::string FluidSolver::check_timestep(bool at_setup) {
+  if (at_setup) density_warned_ = false;
   dt_stable_ = stable_dt();
   const int every = opt.fluid_every;
   const double dt = every * clock.dt, cfl = opt.cfl, dx = opt.grid.dx;
@@ -69,7 +87,7 @@ std::string FluidSolver::check_timestep(bool at_setup) {
   auto coupled_error = [&](double limit, const char *whose, const char *wave, const char *csym,
                            const char *cformula, double cval, const char *before, const char *after) {
     std::ostringstream os;
-    os.precision(4);
+    os.precision(6);
     os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << limit << " of the "
        << whose << " (" << wave << ": cfl*dx/(" << csym << "+|v|max) with cfl = " << cfl << ", dx = " << dx
        << ", " << csym << " = " << cformula << " = " << cval << ", fluid sound speed c_f = " << c_max_
@@ -90,16 +108,24 @@ std::string FluidSolver::check_timestep(bool at_setup) {
   // the fluid (sub-)step: its own limit and, so that a step that is not sub-cycled also
   // satisfies it, the coupled one
   const double dt_sub = std::min(dt_stable_, dt_couple_);
+  std::string log = density_warning();
   if (dt <= dt_sub) {
     state.nsub = 1;
-    return "";
+    return log;
   }
   if (!opt.subcycle) {
+    // name the limit that applies and the keyword that sets it
+    const double dt_visc = viscous_dt_limit(dx, opt.eos.rho0, opt.viscosity, opt.dimension);
     std::ostringstream os;
-    os.precision(4);
-    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << dt_stable_
-       << " (acoustic limit cfl*dx/(c+|v|max) with cfl = " << cfl << ", dx = " << dx << ", c = " << c_max_
-       << ", or viscous limit dx^2 rho/(2 dim eta)); reduce the timestep to " << dt_stable_ / every
+    os.precision(6);
+    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << dt_stable_;
+    if (dt_visc <= dt_stable_)
+      os << " (viscous limit dx^2 rho/(2 dim eta) with dx = " << dx << ", rho = " << opt.eos.rho0
+         << ", keyword 'viscosity' eta = " << opt.viscosity << ")";
+    else
+      os << " (acoustic limit cfl*dx/(c+|v|max) with cfl = " << cfl << ", dx = " << dx << ", c = " << c_max_
+         << " from keyword 'bulk' " << opt.eos.K << " and 'density' " << opt.eos.rho0 << ")";
+    os << "; reduce the timestep to " << dt_stable_ / every
        << " or use keyword 'subcycle yes'" << (at_setup ? "" : " (limit reached during the run)");
     throw Error(os.str());
   }
@@ -110,12 +136,11 @@ std::string FluidSolver::check_timestep(bool at_setup) {
        << opt.max_subcycle << "); reduce the timestep to at most " << opt.max_subcycle * dt_sub;
     throw Error(os.str());
   }
-  std::string log;
   if (at_setup && nsub != state.nsub) {
     std::ostringstream os;
     os << "fix mpm/fluid: sub-cycling with " << nsub << " fluid sub-steps of " << dt / nsub
        << " per timestep (stable limit " << dt_sub << ")\n";
-    log = os.str();
+    log += os.str();
   }
   state.nsub = nsub;
   return log;

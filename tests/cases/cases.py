@@ -422,15 +422,17 @@ def case_every(r):
 
 def case_buoyancy_floor(r):
     """A grain at rest in a fluid at rest gets Archimedes' force, also next to the floor: the
-    pressure gradient at the grain comes from linear fits of the cell pressures (cell = 3 d)."""
+    pressure gradient at the grain is the one the fluid feels at the nodes (grad_p weak, cell = 3 d).
+    Measured 0.9995, 1.0017, 1.0013, 1.0008 (the least-squares fit of the cell pressures, grad_p
+    fit, gave up to 20 % next to the floor; docs/background/well_balanced.md)."""
     inp = os.path.join(DATA, "in.buoyancy")
-    for zg, tol in ((0.0005, 0.2), (0.0015, 0.2), (0.006, 0.03), (0.012, 0.01)):
+    for zg, tol in ((0.0005, 0.005), (0.0015, 0.005), (0.006, 0.005), (0.012, 0.005)):
         _, p = r.run(f"buoyancy_floor/z{zg}", inp, {"zg": zg})
         m = re.search(r"RESULT zg \S+ ratio (\S+)", p.stdout)
         check(m is not None, f"z = {zg}: result printed")
         ratio = float(m.group(1))
         print(f"  grain centre {1e3 * zg:.1f} mm above the floor: fluid force / Archimedes = {ratio:.4f}")
-        check(abs(ratio - 1.0) < tol, f"z = {zg}: within {100 * tol:.0f} % of Archimedes")
+        check(abs(ratio - 1.0) < tol, f"z = {zg}: within {100 * tol:.1f} % of Archimedes")
 
 
 def case_momentum_balance(r):
@@ -545,8 +547,13 @@ def case_jar_quick(r):
     check("resumed at step 721" in p.stdout, "the second run resumed at the restart step 721")
     c2 = read_csv(os.path.join(d2, "jar.csv"))
     check(c2["turn"] == c["turn"] and c2["mass"] == c["mass"], "resumed run: same rows, identical fluid mass")
-    # not to round-off: LIGGGHTS does not restore the contact history with the mesh
-    for k, tol in (("zmax_beads", 1e-3), ("ke", 2e-2), ("pmax", 5e-2)):
+    # not to round-off: LIGGGHTS does not restore the contact history with the mesh, and the
+    # difference grows as the beads tumble. First row after the restart (0.01 s): measured 5.5e-6
+    # (zmax), 2.4e-5 (ke), 3.3e-4 (pmax); all rows (0.03 s): 2.4e-3, 5.9e-4, 1.1e-2 (with the
+    # text's coupling, reaction direct: 2e-4, 3e-3, 8e-3)
+    for k, tol1, tol in (("zmax_beads", 1e-4, 1e-2), ("ke", 1e-3, 2e-2), ("pmax", 5e-3, 5e-2)):
+        rel1 = abs(c[k][0] - c2[k][0]) / abs(c[k][0])
+        check(rel1 < tol1, f"resumed run, first row: {k} within {tol1:g} of the uninterrupted run (rel. diff {rel1:.1e})")
         rel = max(abs(a - b) / abs(a) for a, b in zip(c[k], c2[k]))
         check(rel < tol, f"resumed run: {k} within {tol:g} of the uninterrupted run (rel. diff {rel:.1e})")
 
