@@ -631,7 +631,9 @@ def run_cases(table, name, runner):
     return 1 if FAILURES else 0
 
 
-def main():
+def driver_main(namespace):
+    """main() of a case driver: CASE --exe --inputs --work [--mpirun]; runs namespace's case_CASE
+    and returns the exit status (1 if a check failed, 2 for an unknown case)."""
     ap = argparse.ArgumentParser()
     ap.add_argument("case")
     ap.add_argument("--exe", required=True)
@@ -639,7 +641,7 @@ def main():
     ap.add_argument("--work", required=True)
     ap.add_argument("--mpirun", default="mpirun --allow-run-as-root --oversubscribe")
     a = ap.parse_args()
-    fn = globals().get("case_" + a.case)
+    fn = namespace.get("case_" + a.case)
     if fn is None:
         print("unknown case " + a.case)
         return 2
@@ -649,4 +651,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(driver_main(globals()))

@@ -7,13 +7,12 @@ tolerance, so that the case can tell the two apart (docs/background/well_balance
 
     test_archimedes.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR [--mpirun "..."]
 """
-import argparse
 import os
 import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cases import FAILURES, Runner, check  # noqa: E402
+from cases import check, driver_main  # noqa: E402
 
 # reduced: 150 grains of 2 mm at solid fraction 0.3, cell 1.5 d, 0.05 s damped + 0.01 s averaged
 SMALL = {"nbeads": 150, "tsettle": 0.05, "tavg": 0.01}
@@ -40,21 +39,5 @@ def case_bed(r):
     check(abs(q - 1.0) > TOL, f"text's coupling on the floor is off by more than {TOL:.0%} ({q:.4f})")
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("case")
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--inputs", required=True)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--mpirun", default="mpirun")
-    a = ap.parse_args()
-    fn = globals().get("case_" + a.case)
-    if fn is None:
-        sys.exit(f"unknown case {a.case}")
-    fn(Runner(a))
-    print(f"{a.case}: {len(FAILURES)} failed checks")
-    return 1 if FAILURES else 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(driver_main(globals()))
