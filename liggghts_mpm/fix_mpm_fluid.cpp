@@ -13,6 +13,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <unistd.h>
+
 #include "atom.h"
 #include "atom_vec.h"
 #include "comm.h"
@@ -57,7 +59,7 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   // the first setup and wipe the points' state; new rows are zeroed in grow_arrays
   time_integrate = 1;  // the fix moves its material points itself
   vector_flag = 1;
-  size_vector = 15;
+  size_vector = mpm::FluidSolver::kGlobalSize;
   global_freq = 1;
   extvector = 0;
   peratom_flag = 1;
@@ -94,6 +96,9 @@ void FixMpmFluid::guarded(Fn &&fn) {
     fail_one(e.what());
   } catch (const mpm::Error &e) {
     error->all(FLERR, e.what());
+  } catch (const std::bad_alloc &) {
+    fail_one("Fix mpm/fluid: out of memory on this rank (grid or points too large for the machine: a larger 'cell' or "
+             "fewer points per cell)");
   }
 }
 
@@ -115,7 +120,9 @@ void FixMpmFluid::print(const std::string &text) const {
 
 bool FixMpmFluid::is_point(int i) const { return (atom->mask[i] & groupbit) != 0; }
 
-double FixMpmFluid::sim_time() const { return update->atime + (update->ntimestep - update->atimestep) * update->dt; }
+double FixMpmFluid::sim_time() const {
+  return time_offset + update->atime + (update->ntimestep - update->atimestep) * update->dt;
+}
 
 mpm::FluidSolver &FixMpmFluid::sync() {
   mpm::Points &p = solver->pts;
@@ -187,6 +194,8 @@ void FixMpmFluid::post_create() {
   // After a read_restart the points exist already (recent_restart is set
   // when our global state came from the restart file).
   if (!recent_restart && !solver->opt.fill_region.empty()) fill_points();
+  if (!recent_restart) point_type = solver->opt.fill_type;
+  exclude_points_from_pairs();
   // The fluid force on each grain as the per-atom vector 'dragforce', the
   // property/atom convention of LIGGGHTS/CFDEM (reused if the input made it).
   if (solver->opt.coupled) {
@@ -195,6 +204,56 @@ void FixMpmFluid::post_create() {
     fix_dragforce = static_cast<FixPropertyAtom *>(
         modify->find_fix_property("dragforce", "property/atom", "vector", 3, 0, style, false));
     if (!fix_dragforce) fix_dragforce = modify->add_fix_property_atom(11, const_cast<char **>(args), style);
+  }
+}
+
+/* The material points are the fluid, not grains: no pair style may act on them (a granular pair
+   style would make a water column pile up like sand). Same as the input lines 'neigh_modify
+   exclude type T t' for every type t; lines the input already has only repeat an exclusion. */
+void FixMpmFluid::exclude_points_from_pairs() {
+  if (point_type < 1 || point_type > atom->ntypes) return;
+  const std::string T = std::to_string(point_type);
+  for (int t = 1; t <= atom->ntypes; ++t) {
+    const std::string ts = std::to_string(t);
+    char *args[4] = {const_cast<char *>("exclude"), const_cast<char *>("type"), const_cast<char *>(T.c_str()),
+                     const_cast<char *>(ts.c_str())};
+    neighbor->modify_params(4, args);
+  }
+  print("fix mpm/fluid: material points (type " + T + ") excluded from pair interactions (neigh_modify exclude type " +
+        T + " 1.." + std::to_string(atom->ntypes) + ")\n");
+}
+
+/* Before creating the points: an upper estimate of their number (the cells of the grid within the
+   region's bounding box, times the points per cell) against half of the machine's physical memory,
+   so that 'cell 0.002' in a 1 m box stops with a message instead of dying in the allocator. */
+void FixMpmFluid::check_fill_memory(Region *region, const int lo[3], const int hi[3]) {
+  const mpm::Options &o = solver->opt;
+  const mpm::GridSpec &gs = o.grid;
+  double ncells = 1.0;
+  for (int d = 0; d < 3; ++d) {
+    double a = lo[d], b = hi[d];
+    if (region->bboxflag) {
+      const double ext[2][3] = {{region->extent_xlo, region->extent_ylo, region->extent_zlo},
+                                {region->extent_xhi, region->extent_yhi, region->extent_zhi}};
+      a = std::max(a, std::floor((ext[0][d] - gs.origin[d]) / gs.dx));
+      b = std::min(b, std::floor((ext[1][d] - gs.origin[d]) / gs.dx));
+    }
+    ncells *= std::max(0.0, b - a + 1.0);
+  }
+  double npts = ncells * o.fill_ppc[0] * o.fill_ppc[1] * o.fill_ppc[2], total = 0.0;
+  MPI_Allreduce(&npts, &total, 1, MPI_DOUBLE, MPI_SUM, world);
+  // bytes per point: LIGGGHTS' per-atom arrays (sphere style, neighbour bins) and the fix's state
+  // and shape records, about 1 kB; the ranks of one node share its memory
+  const double per_point = 1024.0;
+  const double mem = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  if (mem > 0.0 && total * per_point > 0.5 * mem) {
+    std::ostringstream os;
+    os.precision(3);
+    os << "Fix mpm/fluid: keyword 'fill' would create up to " << total << " material points (keyword 'cell' " << gs.dx
+       << ", " << o.fill_ppc[0] << "x" << o.fill_ppc[1] << "x" << o.fill_ppc[2] << " per cell), about "
+       << total * per_point / 1e9 << " GB, more than half of this machine's " << mem / 1e9
+       << " GB; use a larger cell or fewer points per cell";
+    error->all(FLERR, os.str().c_str());
   }
 }
 
@@ -218,6 +277,7 @@ void FixMpmFluid::fill_points() {
     lo[d] = std::max(0, static_cast<int>(std::floor((domain->sublo[d] - gs.origin[d]) / dx)) - 1);
     hi[d] = std::min(gs.ncell[d] - 1, static_cast<int>(std::floor((domain->subhi[d] - gs.origin[d]) / dx)) + 1);
   }
+  check_fill_memory(region, lo, hi);
   double x[3];
   for (int k = lo[2]; k <= hi[2]; ++k)
     for (int j = lo[1]; j <= hi[1]; ++j)
@@ -272,6 +332,7 @@ void FixMpmFluid::fill_points() {
 void FixMpmFluid::init() {
   const mpm::Options &o = solver->opt;
   if (!filled) error->all(FLERR, "Fix mpm/fluid: no material points; use keyword 'fill region-ID nx ny nz type T'");
+  check_group_atoms();
   // Material points must not be integrated twice.
   int integrated = 0;  // groups moved by some other integrator: the coupled grains not in them are fixed
   for (int m = 0; m < modify->nfix; ++m) {
@@ -299,6 +360,35 @@ void FixMpmFluid::init() {
   guarded([&] { warning = s.check_points(); });
   if (!warning.empty() && comm->me == 0) error->warning(FLERR, warning.c_str());
   vector_step = -1;
+}
+
+/* The fix's group holds its material points only, and no other atom has their type (the
+   exclusion from the pair styles is by type). Checked before the integrators, so that grains in
+   the group are named as such, not as atoms some integrator also moves. */
+void FixMpmFluid::check_group_atoms() {
+  bigint loc[3] = {0, 0, 0}, glob[3];  // group atoms of other types; of the points' type without state; type shared
+  for (int i = 0; i < atom->nlocal; ++i) {
+    const bool same_type = atom->type[i] == point_type;
+    if (is_point(i)) {
+      if (pdata[i][mpm::C_FLAG] != 1.0) ++loc[same_type ? 1 : 0];
+    } else if (same_type)
+      ++loc[2];
+  }
+  MPI_Allreduce(loc, glob, 3, MPI_LMP_BIGINT, MPI_SUM, world);
+  const std::string G = std::string("group '") + group->names[igroup] + "'";
+  const std::string T = std::to_string(point_type);
+  std::ostringstream os;
+  if (glob[0] > 0)
+    os << "Fix mpm/fluid: " << G << " of the fix holds " << glob[0] << " atoms of other types than the material points' type "
+       << T << " (grains?); give the fix a group of the fill type only (e.g. 'group fluid type " << T << "')";
+  else if (glob[1] > 0)
+    os << "Fix mpm/fluid: " << glob[1] << " atoms of " << G << " have the material points' type " << T
+       << " but no state of this fix (ID '" << id << "'): the restart file is truncated or was written without this fix "
+       << "(or with another fix ID), or another command created atoms of type " << T;
+  else if (glob[2] > 0)
+    os << "Fix mpm/fluid: " << glob[2] << " atoms of type " << T << " are outside " << G
+       << " of the fix: grains must not share the type of the material points (give them another atom type)";
+  if (!os.str().empty()) error->all(FLERR, os.str().c_str());
 }
 
 // the mesh walls' triangles near this rank's grid patch, after the meshes moved
@@ -345,6 +435,13 @@ void FixMpmFluid::setup(int) {
     s.setup_coupling();
     print(s.check_timestep(true));
   });
+  // LIGGGHTS recomputed the grains' forces for this run; the fluid force of the last fluid step
+  // (kept in the state rows, also across restart files) belongs to them as it did at the end of
+  // that step, so that run N; run M (or a restart between them) equals run N+M
+  if (s.opt.coupled && update->ntimestep % s.opt.fluid_every == 0)
+    for (int k = 0; k < atom->nlocal; ++k)
+      if (atom->mask[k] & couple_groupbit)
+        for (int d = 0; d < 3; ++d) atom->f[k][d] += s.opt.fluid_every * pdata[k][mpm::C_FGRAIN + d];
   if (s.opt.out_every > 0 && update->ntimestep % s.opt.out_every == 0) guarded([&] { s.write_output(); });
   run_time_start[0] = s.time_fluid;
   run_time_start[1] = s.time_couple;
@@ -380,7 +477,7 @@ void FixMpmFluid::pre_final_integrate() {
   // between two fluid steps the grains get no fluid force: the fluid step gave them the
   // whole impulse of its N steps at once (FluidSolver::step)
   if (s.opt.fluid_every > 1 && update->ntimestep % s.opt.fluid_every != 0) return;
-  guarded([&] { s.check_timestep(false); });
+  guarded([&] { print(s.check_timestep(false)); });
   refresh_walls();
   guarded([&] { s.step(); });
   if (s.opt.coupled && fix_dragforce)
@@ -453,7 +550,7 @@ int FixMpmFluid::size_restart(int) { return NCOL + 1; }
 int FixMpmFluid::maxsize_restart() { return NCOL + 1; }
 
 namespace {
-enum { R_FILLED, R_PMASS, R_SP0, R_SP1, R_SP2, R_CLAMPED, R_GATE, R_NSUB, R_THETA, R_COUNT };
+enum { R_FILLED, R_PMASS, R_SP0, R_SP1, R_SP2, R_CLAMPED, R_GATE, R_NSUB, R_THETA, R_TIME, R_TYPE, R_COUNT };
 }
 
 void FixMpmFluid::write_restart(FILE *fp) {
@@ -466,6 +563,8 @@ void FixMpmFluid::write_restart(FILE *fp) {
   list[R_GATE] = solver->opt.gate.active ? 1.0 : 0.0;
   list[R_NSUB] = st.nsub;
   list[R_THETA] = st.theta_initialized ? 1.0 : 0.0;
+  list[R_TIME] = sim_time();
+  list[R_TYPE] = point_type;
   if (comm->me == 0) {
     int size = R_COUNT * sizeof(double);
     fwrite(&size, sizeof(int), 1, fp);
@@ -484,6 +583,10 @@ void FixMpmFluid::restart(char *buf) {
   if (list[R_GATE] == 0.0) solver->opt.gate.active = false;
   st.nsub = static_cast<int>(list[R_NSUB]);
   st.theta_initialized = list[R_THETA] != 0.0;
+  // LIGGGHTS' time starts again at 0 here; the fix's time goes on from the saved one
+  time_offset = 0.0;
+  time_offset = list[R_TIME] - sim_time();
+  point_type = static_cast<int>(list[R_TYPE]);
 }
 
 double FixMpmFluid::memory_usage() {

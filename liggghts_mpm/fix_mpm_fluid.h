@@ -65,10 +65,11 @@ class FixMpmFluid : public Fix {
   double **pdata = nullptr;  // per-point state rows (mpm::Column)
   int pdata_rows = 0;
   bigint vector_step = -1;   // f_ID[] cached for this step
-  double vector_cache[15];
+  double vector_cache[mpm::FluidSolver::kGlobalSize];
 
   int parse_mesh_wall(int narg, char **arg, int iarg);
   void fill_points();
+  void check_fill_memory(class Region *region, const int lo[3], const int hi[3]);
   void refresh_walls();
   mpm::FluidSolver &sync();  // the solver with views of the current atom arrays and clock
   template <class Fn> void guarded(Fn &&fn);  // runs fn, translating the solver's errors
@@ -76,6 +77,12 @@ class FixMpmFluid : public Fix {
   [[noreturn]] void fail_one(const std::string &msg);
   bool is_point(int i) const;
   double sim_time() const;
+  void exclude_points_from_pairs();
+  void check_group_atoms();
+  // The fix's own clock: LIGGGHTS' time restarts at 0 after read_restart, the fix's time goes on
+  // (saved in the restart file); sim_time() = LIGGGHTS' time + time_offset.
+  double time_offset = 0.0;
+  int point_type = 0;  // atom type of the material points (fill type, or from the restart file)
 };
 
 }  // namespace LAMMPS_NS
