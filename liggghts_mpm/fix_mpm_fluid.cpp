@@ -59,7 +59,7 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   // the first setup and wipe the points' state; new rows are zeroed in grow_arrays
   time_integrate = 1;  // the fix moves its material points itself
   vector_flag = 1;
-  size_vector = 15;
+  size_vector = mpm::FluidSolver::kGlobalSize;
   global_freq = 1;
   extvector = 0;
   peratom_flag = 1;

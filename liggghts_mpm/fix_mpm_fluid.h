@@ -65,7 +65,7 @@ class FixMpmFluid : public Fix {
   double **pdata = nullptr;  // per-point state rows (mpm::Column)
   int pdata_rows = 0;
   bigint vector_step = -1;   // f_ID[] cached for this step
-  double vector_cache[15];
+  double vector_cache[mpm::FluidSolver::kGlobalSize];
 
   int parse_mesh_wall(int narg, char **arg, int iarg);
   void fill_points();

@@ -280,9 +280,36 @@ void parse_output(Options &o, Args &a, const ParseEnv &) {
   }
 }
 
+void parse_pressure(Options &o, Args &a, const ParseEnv &) { choice(a, "projection", "eos", o.projection); }
+
+void parse_max_iterations(Options &o, Args &a, const ParseEnv &) {
+  const char *what = "an integer >= 1 (iterations of the pressure solve)";
+  a.need(1, "max_iterations", what);
+  if (!parse_int(a.at(1), o.pressure_max_iterations) || o.pressure_max_iterations < 1)
+    bad_arg("max_iterations", what, a.at(1));
+  a.iarg += 2;
+}
+
 void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
   if (!env.mesh_wall) bad_arg("mesh_wall", "a LIGGGHTS host", nullptr);
   a.iarg = env.mesh_wall(a.narg, a.arg, a.iarg);
+}
+
+// Keywords that belong to one pressure model only: an error under the other, naming them.
+void check_pressure_model(const Options &o, const std::vector<std::string> &seen) {
+  static const char *const eos_only[] = {"bulk", "eos", "antilock", "pmin"};
+  static const char *const projection_only[] = {"tolerance", "max_iterations"};
+  std::string bad;
+  for (const std::string &kw : seen)
+    for (const char *w : o.projection ? std::vector<const char *>(eos_only, eos_only + 4)
+                                      : std::vector<const char *>(projection_only, projection_only + 2))
+      if (kw == w && bad.find("'" + kw + "'") == std::string::npos) bad += (bad.empty() ? "'" : ", '") + kw + "'";
+  if (bad.empty()) return;
+  if (o.projection)
+    throw Error("Fix mpm/fluid: keyword 'pressure projection' does not use keyword(s) " + bad +
+                " (they belong to the equation of state of 'pressure eos'); remove them");
+  throw Error("Fix mpm/fluid: keyword(s) " + bad + " belong to 'pressure projection' (the pressure solve); "
+              "add 'pressure projection' or remove them");
 }
 
 // Grid: cubic cells fitted exactly into the bounds (the box, or keyword grid).
@@ -332,6 +359,7 @@ void check_derived(const Options &o) {
        << " smoothing passes per step with cell " << g.dx << " (at most 1e6); reduce it";
     throw Error(os.str());
   }
+  if (o.projection) return;  // no equation of state
   const Eos &e = o.eos;
   double rho_hi = e.rho0;
   if (o.hydrostatic) {
@@ -402,6 +430,12 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_every, false},
     {"mass_threshold", "real", "-", "[0,1)", "1e-5", "a fraction of the point mass in [0,1)",
      REAL(mass_threshold), 0.0, 1.0, false, true, nullptr, nullptr, false},
+    {"pressure", "eos | projection", "-", "", "eos",
+     "'eos' or 'projection'", nullptr, 0, 0, false, false, nullptr, parse_pressure, false},
+    {"tolerance", "real", "-", "> 0", "1e-8", "a relative residual > 0 of the pressure solve",
+     REAL(pressure_tolerance), 0.0, kInf, true, true, nullptr, nullptr, false},
+    {"max_iterations", "integer", "-", ">= 1", "200", "an integer >= 1 (iterations of the pressure solve)",
+     nullptr, 0, 0, false, false, nullptr, parse_max_iterations, false},
     {"fill", "region nx ny nz type T", "-", "1..8 points per cell per direction", "required (not after read_restart)",
      "'region-ID nx ny nz type T'", nullptr, 0, 0, false, false, nullptr, parse_fill, false},
     {"hydrostatic", "axis surface g", "length, acceleration", "g >= 0", "none",
@@ -468,6 +502,7 @@ void bad_arg(const char *keyword, const char *expected, const char *given) {
 Options parse_options(int narg, char **arg, const ParseEnv &env) {
   Options o;
   bool given[3] = {false, false, false};  // cell, density, bulk
+  std::vector<std::string> seen;          // keywords given
   Args a{narg, arg, 3};
   while (a.iarg < narg) {
     const char *kw = a.at(0);
@@ -475,6 +510,7 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
     if (!k)
       throw Error(std::string("Fix mpm/fluid: unknown keyword '") + kw +
                   "' (see docs/fix_mpm_fluid.md for the keywords)");
+    seen.push_back(kw);
     if (k->real) {
       a.need(1, kw, k->help);
       parse_real(o, *k, a.at(1));
@@ -492,7 +528,8 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
   }
   if (!given[0]) throw Error("Fix mpm/fluid: keyword 'cell' (cell size) is required");
   if (!given[1]) throw Error("Fix mpm/fluid: keyword 'density' (reference density) is required");
-  if (!given[2]) throw Error("Fix mpm/fluid: keyword 'bulk' (bulk modulus) is required");
+  if (!given[2] && !o.projection) throw Error("Fix mpm/fluid: keyword 'bulk' (bulk modulus) is required");
+  check_pressure_model(o, seen);
   if (o.coupled && !(o.viscosity > 0.0))
     throw Error("Fix mpm/fluid: keyword 'couple' needs keyword 'viscosity' > 0 (the drag laws scale with it)");
   o.dimension = env.dimension;

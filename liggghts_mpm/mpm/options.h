@@ -67,6 +67,11 @@ struct Options {
   int max_subcycle = 1000;
   int fluid_every = 1;              // the fluid advances every N-th time step, by N dt (keyword every)
   double mass_threshold = 1e-5;
+  // pressure model (keyword pressure): eos, the text's weakly compressible fluid, or projection,
+  // the incompressible fluid of a pressure Poisson solve (mpm/projection.h, docs/projection.md)
+  bool projection = false;
+  double pressure_tolerance = 1e-8;  // relative residual of the solve
+  int pressure_max_iterations = 200;
   // reports
   int front_axis = 0;
   int height_axis = 2, wall_axis = 0;

@@ -5,11 +5,12 @@
 
 #include "mpm/error.h"
 #include "mpm/hdf5_series.h"
+#include "mpm/projection.h"
 #include "mpm/solver.h"
 
 namespace mpm {
 
-void FluidSolver::global_vector(double out[15]) {
+void FluidSolver::global_vector(double out[kGlobalSize]) {
   const GridSpec &gs = opt.grid;
   double **x = pts.x, **v = pts.v;
   const double *rmass = pts.rmass;
@@ -51,6 +52,8 @@ void FluidSolver::global_vector(double out[15]) {
   out[9] = std::isfinite(gmx[3]) ? gmx[3] : 0.0;
   out[13] = gmx[4];
   out[14] = gmx[5];
+  out[15] = proj_ ? proj_->iterations() : 0.0;
+  out[16] = proj_ ? proj_->residual() : 0.0;
 }
 
 namespace {

@@ -176,7 +176,9 @@ void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const do
       sum = 0.0;
       open = 0;
     }
-    if (!f.wall) {
+    // at an EMPTY node only the faces to FLUID nodes: the gradient extrapolated from the fluid
+    // side (a face between two EMPTY nodes carries no pressure information)
+    if (!f.wall && !(labels.kind[n] == kEmpty && labels.kind[f.m] == kEmpty)) {
       sum += side * (p[f.m] - p[n]) * inv_dx;
       ++open;
     }

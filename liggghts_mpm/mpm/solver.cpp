@@ -8,6 +8,7 @@
 
 #include "mpm/error.h"
 #include "mpm/hdf5_series.h"
+#include "mpm/projection.h"
 
 namespace mpm {
 
@@ -43,6 +44,10 @@ std::string FluidSolver::check_points() {
   if (opt.theta_transport && !opt.musl)
     throw Error("Fix mpm/fluid: keyword 'theta_transport yes' needs 'update musl' (the divergence of "
                 "theta u is taken in the MUSL remap)");
+  if (opt.projection && bc.has_walls())
+    throw Error("Fix mpm/fluid: keyword 'pressure projection' does not support keyword 'mesh_wall' yet");
+  if (opt.projection && opt.coupled)
+    throw Error("Fix mpm/fluid: keyword 'pressure projection' does not support keyword 'couple' yet");
   if (!opt.coupled) return "";
   double dmax = 0.0, gd = 0.0;
   int overlap = 0, go = 0;
@@ -68,7 +73,7 @@ double FluidSolver::init_point(const double x[3], double vol, double *s) const {
   double rho = eos.rho0, p = 0.0;
   if (opt.hydrostatic) {
     p = std::max(0.0, eos.rho0 * opt.hydro_g * (opt.hydro_surface - x[opt.hydro_axis]));
-    rho = eos.density(p);
+    rho = opt.projection ? eos.rho0 : eos.density(p);  // projection: incompressible
   }
   // The point keeps the reference mass; a pre-compressed point is smaller.
   const double m = eos.rho0 * vol;
@@ -86,6 +91,7 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
   grid_.setup(opt.grid, comm_, sublo, subhi, halo);
   g_.assign(grid_.size(), opt.musl, opt.coupled, opt.theta_transport);
   th_prev_valid_ = false;
+  if (opt.projection) proj_.reset(new Projection(grid_, comm_, opt));
   grid_ready_ = true;
 }
 
@@ -120,6 +126,7 @@ void FluidSolver::substep(double h) {
   if (opt.coupled) timed(time_couple, [&] { couple_fluid_grains(h); });
   timed(time_fluid, [&] {
     update_grid(h);
+    if (opt.projection) interpolate_pressure();
     grid_to_particles();
     if (opt.musl) remap_velocity_musl(h);
     update_stress(h);
@@ -213,10 +220,27 @@ void FluidSolver::update_grid(double h) {
       // damping is implicit in time so that any rate is stable
       vnew[d] = (gv[VelRec::V_OLD + d] + h * f * inv) / (1.0 + h * opt.damping);
     }
-    bc.apply(vnew, i, j, k, h);
+    // projection: u* here; the wall conditions come with the projection (Projection::project)
+    if (!opt.projection) bc.apply(vnew, i, j, k, h);
     for (int d = 0; d < 3; ++d) gv[VelRec::V_NEW + d] = vnew[d];
   });
+  if (opt.projection) proj_->project(g_.vel.data(), g_.p2g.data(), mmin, nullptr, nullptr, h, bc, clock.step);
   grid_.forward(g_.vel.data(), VelRec::N);
+}
+
+/* projection: the points' pressure (state column C_P, for output and f_ID[10]) interpolated
+   from the nodal pressure of the solve */
+void FluidSolver::interpolate_pressure() {
+  const std::vector<double> &p = proj_->pressure();
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  with_stencil(opt.shape, [&](auto ns) {
+    for (const int i : plist_) {
+      double sum = 0.0;
+      for_stencil<decltype(ns)::value>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double,
+                                                               double, double) { sum += w * p[n]; });
+      pts.state[i][C_P] = sum;
+    }
+  });
 }
 
 /* Continuity (7-21) as a volume update, equation of state (7-23) or Tait, Navier-Poisson (7-24).
@@ -224,6 +248,20 @@ void FluidSolver::update_grid(double h) {
    follows from the cell's mean density, so all points of a cell carry one pressure (Mast et al.
    2012). theta_only: the fluid fraction changed, the volume did not (refresh_pressure). */
 void FluidSolver::update_stress(double h, bool theta_only) {
+  if (opt.projection) {
+    // incompressible: density rho0 and the volume m / (theta rho0) held (the points' number per
+    // cell measures the volume drift, docs/projection.md); the pressure is the solve's
+    for (const int i : plist_) {
+      double *s = pts.state[i];
+      s[C_RHO] = opt.rho0;
+      s[C_VOL] = pts.rmass[i] / (s[C_THETA] * opt.rho0);
+      if (theta_only) continue;
+      const double *L = &velgrad_[9 * static_cast<std::size_t>(i)];
+      const double Lm[3][3] = {{L[0], L[1], L[2]}, {L[3], L[4], L[5]}, {L[6], L[7], L[8]}};
+      newtonian_deviatoric_stress(opt.viscosity, Lm, s + C_TAU);
+    }
+    return;
+  }
   const GridSpec &gs = opt.grid;
   const int nlocal = pts.nlocal;
   double **x = pts.x;

@@ -21,6 +21,7 @@
 namespace mpm {
 
 class Hdf5Series;
+class Projection;
 
 // Views of the host's per-atom arrays (valid until the host reallocates them).
 struct Points {
@@ -87,9 +88,11 @@ class FluidSolver {
   void step();
   const std::vector<double> &grain_force() const { return grain_force_; }
 
-  // f_ID[1..15] (collective): mass, kinetic energy, |v|max, front, height, sub-steps, stable dt,
-  // clamped, points, p max, fluid force on the grains (3), wall time of the fluid and coupling
-  void global_vector(double out[15]);
+  // f_ID[1..17] (collective): mass, kinetic energy, |v|max, front, height, sub-steps, stable dt,
+  // clamped, points, p max, fluid force on the grains (3), wall time of the fluid and coupling,
+  // iterations and relative residual of the last pressure solve (pressure projection; else 0)
+  static constexpr int kGlobalSize = 17;
+  void global_vector(double out[kGlobalSize]);
   // HDF5 + XDMF output of the points (and grid) fields of keyword output (collective).
   void write_output();
   // wall time of the fluid's own work and of the coupling on this rank (s, cumulative)
@@ -103,7 +106,8 @@ class FluidSolver {
   void refresh_pressure();          // coupling: density and pressure for the new theta
   void particles_to_grid();         // P2G (8-10), (8-19), (8-24), traction (8-23)
   void couple_fluid_grains(double h);  // coupling: pressure fit, drag exchange (8-25)-(8-29)
-  void update_grid(double h);       // (8-35), (8-36), boundary conditions
+  void update_grid(double h);       // (8-35), (8-36), boundary conditions (projection: u*, solve, correction)
+  void interpolate_pressure();      // projection: the points' pressure from the nodes
   void grid_to_particles();         // G2P (8-37)-(8-40)
   void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
   void update_stress(double h, bool theta_only = false);  // (7-21)-(7-24)
@@ -158,6 +162,8 @@ class FluidSolver {
   void check_point(int i) const;      // finite position, velocity, mass (compute_shapes)
   void check_grain(int k) const;      // finite position, velocity, radius, mass (fluid_fraction)
   std::unique_ptr<Hdf5Series> series_;
+  std::unique_ptr<Projection> proj_;  // pressure projection (opt.projection)
+  double vmax_ = 0.0;                 // |v|max of the points at the last time-step check
   long last_output_step_ = -1;
 };
 

@@ -35,7 +35,9 @@ double FluidSolver::stable_dt() {
   MPI_Allreduce(loc, glob, 6, MPI_DOUBLE, MPI_MAX, comm_);
   // Sound speed: largest over the density range (Tait stiffens under compression, the linear
   // law under tension).
-  c_max_ = std::sqrt(std::max(eos.sound_speed_sq(glob[1]), eos.sound_speed_sq(-glob[2])));
+  // Projection: incompressible, no sound speed; the advective and viscous limits remain.
+  c_max_ = opt.projection ? 0.0 : std::sqrt(std::max(eos.sound_speed_sq(glob[1]), eos.sound_speed_sq(-glob[2])));
+  vmax_ = glob[0];
   rho_range_[0] = -glob[2];
   rho_range_[1] = glob[1];
   const double c = c_max_, dx = opt.grid.dx;
@@ -62,7 +64,7 @@ double FluidSolver::stable_dt() {
 // Once per run: the points' density (reduced in stable_dt) left [0.5, 2] rho0 under the equation
 // of state: the weakly compressible model is far from its range (a column hitting the floor fast).
 std::string FluidSolver::density_warning() {
-  if (density_warned_) return "";
+  if (opt.projection || density_warned_) return "";
   const double r0 = opt.eos.rho0, lo = rho_range_[0] / r0, hi = rho_range_[1] / r0;
   if (lo >= 0.5 && hi <= 2.0) return "";
   density_warned_ = true;
@@ -79,7 +81,8 @@ std::string FluidSolver::check_timestep(bool at_setup) {
   dt_stable_ = stable_dt();
   const int every = opt.fluid_every;
   const double dt = every * clock.dt, cfl = opt.cfl, dx = opt.grid.dx;
-  if (!std::isfinite(dt_stable_) || dt_stable_ <= 0.0 || std::isnan(dt_couple_) || std::isnan(dt_grain_))
+  // (projection at rest without viscosity: no limit at all, dt_stable_ = inf)
+  if (std::isnan(dt_stable_) || (!opt.projection && std::isinf(dt_stable_)) || dt_stable_ <= 0.0 || std::isnan(dt_couple_) || std::isnan(dt_grain_))
     throw Error("Fix mpm/fluid: the fluid state is not finite (NaN velocity or density); "
                 "the run was unstable before this check");
   const char *what = every > 1 ? "fluid step (every x timestep) " : "timestep ";
@@ -109,6 +112,22 @@ std::string FluidSolver::check_timestep(bool at_setup) {
   // satisfies it, the coupled one
   const double dt_sub = std::min(dt_stable_, dt_couple_);
   std::string log = density_warning();
+  if (opt.projection && (dt > dt_sub ? !opt.subcycle : at_setup)) {
+    // the limit applied: advective cfl*dx/|v|max or viscous dx^2 rho/(2 dim eta)
+    const double dt_adv = acoustic_dt_limit(cfl, dx, 0.0, vmax_);
+    const double dt_visc = viscous_dt_limit(dx, opt.rho0, opt.viscosity, opt.dimension);
+    std::ostringstream os;
+    os.precision(4);
+    os << "advective limit cfl*dx/|v|max = " << dt_adv << " (cfl = " << cfl << ", dx = " << dx << ", |v|max = " << vmax_
+       << "), viscous limit dx^2 rho/(2 dim eta) = " << dt_visc << "; "
+       << (dt_adv <= dt_visc ? "advective" : "viscous") << " limit applies";
+    if (dt > dt_sub)
+      throw Error("Fix mpm/fluid: " + std::string(what) + std::to_string(dt) + " exceeds the largest stable time step of " +
+                  "'pressure projection' (" + os.str() + "); reduce the timestep to " + std::to_string(dt_sub / every) +
+                  " or use keyword 'subcycle yes'" + (at_setup ? "" : " (limit reached during the run)"));
+    state.nsub = 1;
+    return "fix mpm/fluid: pressure projection, no sound speed: " + os.str() + "\n";
+  }
   if (dt <= dt_sub) {
     state.nsub = 1;
     return log;

@@ -15,7 +15,8 @@ void FluidSolver::particles_to_grid() {
   std::fill(g_.p2g.begin(), g_.p2g.end(), 0.0);
   // the boundary term of each point right after its own share, so that every node sums its
   // contributions in point order
-  const bool traction = opt.wall_traction && opt.shape == ShapeKind::QuadraticBSpline;
+  // (projection: the walls' reaction is the solve's pressure, not a traction of the points)
+  const bool traction = opt.wall_traction && opt.shape == ShapeKind::QuadraticBSpline && !opt.projection;
   double *const g = g_.p2g.data();
   auto boundary_term = [&](int i, const Stencil &ps) {
     if (traction) bc.add_traction(ps, pts.x[i], pts.state[i][C_VOL], pts.state[i][C_P], g);
@@ -30,10 +31,11 @@ void FluidSolver::p2g_kernel(Fn &&after_point) {
   const double *rmass = pts.rmass;
   double *const g = g_.p2g.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const bool eos_p = !opt.projection;  // projection: no pressure in the internal force (u*)
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     const double *s = pts.state[i];
-    const double m = rmass[i], V = s[C_VOL], p = s[C_P];
+    const double m = rmass[i], V = s[C_VOL], p = eos_p ? s[C_P] : 0.0;
     const double *t = s + C_TAU;
     // -V sigma with sigma = -p I + tau (tau in Voigt order xx yy zz yz xz xy)
     const double sxx = -V * (t[0] - p), syy = -V * (t[1] - p), szz = -V * (t[2] - p);

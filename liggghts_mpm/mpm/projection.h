@@ -1,0 +1,52 @@
+// The pressure model 'projection' of fix mpm/fluid (docs/projection.md): the glue between the
+// solver's grid update and the discrete operators (projection_ops.h) and the hypre solve
+// (pressure_solver.h). Per fluid sub-step: labels from the node mass, the box walls and the gate;
+// u* -> solve div(beta grad p) = div(theta u*) / dt -> correction u = u* - (dt / rho) grad p ->
+// wall conditions (Boundaries::apply). Keeps p between steps for the warm start.
+#pragma once
+#include <mpi.h>
+
+#include <memory>
+#include <vector>
+
+#include "mpm/boundaries.h"
+#include "mpm/grid.h"
+#include "mpm/options.h"
+#include "mpm/pressure_solver.h"
+#include "mpm/projection_ops.h"
+
+namespace mpm {
+
+class Projection {
+ public:
+  // grid: the solver's patch (set up); collective over comm.
+  Projection(LocalGrid &grid, MPI_Comm comm, const Options &opt);
+
+  // vel: the VelRec rows of the grid update, V_NEW = u* at the owned nodes (0 where the node
+  // mass p2g M <= mmin: those become EMPTY nodes, p = 0). On return V_NEW holds the corrected,
+  // wall-conditioned velocity at the owned nodes (not forwarded). theta: nodal fluid fraction
+  // (null: 1), theta_prev: the last fluid step's (null: no d(theta)/dt source). Throws
+  // mpm::Error naming the step if the solve does not converge.
+  void project(double *vel, const double *p2g, double mmin, const double *theta, const double *theta_prev,
+               double h, Boundaries &bc, long step);
+
+  // nodal pressure of the last solve (owned nodes and halos), the padding nodes behind the box
+  // walls with the pressure of the wall node in front (for interpolation to points and grains)
+  const std::vector<double> &pressure() const { return p_ext_; }
+  int iterations() const { return last_.iterations; }
+  double residual() const { return last_.relative_residual; }
+
+ private:
+  void make_labels(const double *p2g, double mmin);
+
+  LocalGrid &grid_;
+  const Options &opt_;
+  ProjectionGeometry geo_;
+  std::unique_ptr<PressureSolver> solver_;
+  NodeLabels lab_;
+  std::vector<double> u_, theta_, beta_, rhs_, p_, p_ext_, grad_, inv_rho_;
+  PressureResult last_;
+  MPI_Comm comm_;
+};
+
+}  // namespace mpm
