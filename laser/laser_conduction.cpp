@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 
 #include "laser_laws.h"
@@ -126,6 +128,15 @@ CorrectedConduction::CorrectedConduction(double c0) : c0_(c0) {
   for (size_t k = 1; k < s_.size(); ++k)
     H_[k] = H_[k - 1] + 0.5 * (h_[k] + h_[k - 1]) * (s_[k] - s_[k - 1]);
   asym_coef_ = h_.back() * std::pow(s_.back(), 1.5);
+}
+
+std::shared_ptr<const CorrectedConduction> shared_corrected_conduction(double c0) {
+  static std::mutex mutex;
+  static std::map<double, std::shared_ptr<const CorrectedConduction>> tables;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& t = tables[c0];
+  if (!t) t = std::make_shared<const CorrectedConduction>(c0);
+  return t;
 }
 
 double CorrectedConduction::correction(double s) const {

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 namespace laser {
@@ -63,6 +64,12 @@ class CorrectedConduction {
   std::vector<double> s_, g2_, g3_, th2b_, h_, H_;
   double asym_coef_ = 0;  // h ~ asym_coef / s^1.5 beyond the table
 };
+
+// The table for c0, built on the first request and shared by every later run
+// of the process (it depends on c0 only): building it costs about as much as
+// the time stepping of the Table 5.1 case, and the step-doubling policy runs
+// the model at least twice. Thread-safe.
+std::shared_ptr<const CorrectedConduction> shared_corrected_conduction(double c0);
 
 // Independent reference for L2: the full 1-D problem u_s = u_xx, u(0) = 0,
 // u(inf) = 1, u(x, 0) = (3-28)/theta_i, on a uniform grid with Crank-Nicolson.

@@ -64,7 +64,7 @@ class Drill {
   Groups G_;
   FrameSink* sink_;
   bool advected_;
-  std::unique_ptr<CorrectedConduction> exact_;
+  std::shared_ptr<const CorrectedConduction> exact_;
   std::vector<Node> nodes_;
   Result res_;
   double A_ = 0, u_peak_ = 0;
@@ -103,7 +103,7 @@ void Drill::setup() {
   res_.nodes = N;
   const double xi_out = (N - 0.5) * cfg_.dxi;
   res_.energy.laser_exact = kPi * R2 * cfg_.I0 * cfg_.tp * (1.0 - std::exp(-xi_out * xi_out));
-  if (cfg_.solid == SolidModel::Exact) exact_ = std::make_unique<CorrectedConduction>(kTau0OverTauM);
+  if (cfg_.solid == SolidModel::Exact) exact_ = shared_corrected_conduction(kTau0OverTauM);
 }
 
 // A node melts inside [ta, tb) at its onset time (3-27); until then the beam
