@@ -309,6 +309,7 @@ TEST(LaserCases, ObservedConvergenceOrders) {
 // The default (advected) melt layer stays below and approaches the bound as the
 // intensity grows; the text's linear layer exceeds it (issue #14).
 TEST(LaserCases, EnergyBoundFromInputsAlone) {
+  double table51_depth = -1;  // the default layer at 7.5e10 W/m2 is the Table 5.1 case
   for (MeltEnergy energy : {MeltEnergy::Advected, MeltEnergy::Text}) {
     double prev = 0;
     for (double I : {2.5e10, 7.5e10, 16e10}) {
@@ -346,15 +347,16 @@ TEST(LaserCases, EnergyBoundFromInputsAlone) {
         EXPECT_GT(ratio, 1.0) << "the text's layer is expected above the bound (issue #14)";
       }
       prev = ratio;
+      if (energy == MeltEnergy::Advected && I == base().I0) table51_depth = r.depth_center;
     }
   }
   // Table 5.1: the whole centre energy buys at most I0 t_p / (rho H(T_sat0))
-  Config c = base();
-  const Result r = run_simulation(c);
+  const Config c = base();
   const Material& m = c.mat;
   const double bound = c.I0 * c.tp / (m.rho * (m.cps * (m.Tm - m.Ti) + m.hls + m.cpl * (m.Tsat0 - m.Tm) + m.hlv));
-  std::printf("[ BOUND ] Table 5.1 centre depth %.4f mm, bound %.4f mm\n", r.depth_center * 1e3, bound * 1e3);
-  EXPECT_LT(r.depth_center, bound);
+  std::printf("[ BOUND ] Table 5.1 centre depth %.4f mm, bound %.4f mm\n", table51_depth * 1e3, bound * 1e3);
+  ASSERT_GT(table51_depth, 0.0) << "the loop did not run the Table 5.1 case";
+  EXPECT_LT(table51_depth, bound);
 }
 
 // Error-controlled step: a 1 us pulse at 7.5e10 W/m2 (melting from 52 ns)
