@@ -188,31 +188,20 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
     if (r0 < 0.0) {
       // Upper bracket: the conduction-only root, where the vapour term is > 0.
       const double hi = G.theta_m + avail * g * (1.0 - G.theta_m) / G.kprime;
-      if (!advected) {
-        auto fdf = [&](double phi, double& f, double& df) {
-          f = interface_residual(G, phi, xi, g, b2, &df);
-        };
-        if (interface_residual(G, hi, xi, g, b2) > 0.0) {
-          const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
-          s.phi = rr.x;
-          s.iterations = rr.iterations;
-          s.converged = rr.converged;
-        } else {
-          // hi - theta_m below round-off (very thin layer): the conduction root.
-          s.phi = hi;
-        }
+      // Advected layer: vapour + k' (theta_sat/g F(w(phi) g) + b2 g) - beam; every
+      // term rises with phi and F >= 1, so the linear layer's bracket [theta_m, hi] holds.
+      auto residual = [&](double phi, double* df) {
+        return advected ? advected_residual(G, phi, xi, g, b2, df) : interface_residual(G, phi, xi, g, b2, df);
+      };
+      if (residual(hi, nullptr) > 0.0) {
+        auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
+        const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+        s.phi = rr.x;
+        s.iterations = rr.iterations;
+        s.converged = rr.converged;
       } else {
-        // vapour + k' (theta_sat/g F(w(phi) g) + b2 g) - beam: every term rises
-        // with phi and F >= 1, so the linear bracket [theta_m, hi] still holds.
-        auto fdf = [&](double phi, double& f, double& df) { f = advected_residual(G, phi, xi, g, b2, &df); };
-        if (advected_residual(G, hi, xi, g, b2, nullptr) > 0.0) {
-          const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
-          s.phi = rr.x;
-          s.iterations = rr.iterations;
-          s.converged = rr.converged;
-        } else {
-          s.phi = hi;
-        }
+        // hi - theta_m below round-off (very thin layer): the conduction root.
+        s.phi = hi;
       }
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
       if (advected) {

@@ -22,13 +22,6 @@ struct Node {
 
 constexpr int kUnstableFlips = 3;
 
-std::string fmt(double v) {
-  std::ostringstream o;
-  o.precision(4);
-  o << v;
-  return o.str();
-}
-
 class Drill {
  public:
   Drill(const Config& c, FrameSink* sink)
@@ -273,7 +266,7 @@ Drill::Geometry Drill::front_geometry(int i, const std::vector<double>& S2old, d
     const double a = -s2xx / (geo.J * geo.J * geo.J);
     const double d = h * geo.J;
     if (std::fabs(a * d) >= 2.0 && res_.curvature_clamps++ == 0)
-      first_clamp_ = "first at xi = " + fmt(nodes_[i].xi) + ", t = " + fmt(tb * G_.t_scale) + " s";
+      first_clamp_ = "first at xi = " + fmt(nodes_[i].xi, 4) + ", t = " + fmt(tb * G_.t_scale, 4) + " s";
     geo.Cc = curvature_factor(a, d);
   }
   return geo;
@@ -357,8 +350,8 @@ void Drill::check_stability(Node& n, const Geometry& geo, double grad_n, const R
   n.last_dg = dg;
   if (n.flips >= kUnstableFlips && !res_.unstable) {
     res_.unstable = true;
-    res_.message = "melt thickness update (4-14) unstable at xi = " + fmt(n.xi) + ", t = " +
-                   fmt(tb * G_.t_scale) + " s: lambda*dtau = " + fmt(lambda * dtn) + " > 2";
+    res_.message = "melt thickness update (4-14) unstable at xi = " + fmt(n.xi, 4) + ", t = " +
+                   fmt(tb * G_.t_scale, 4) + " s: lambda*dtau = " + fmt(lambda * dtn, 4) + " > 2";
   }
 }
 
@@ -556,7 +549,7 @@ Result Drill::run() {
     solve_interfaces();
     if (!solve_melt_flow()) {
       res_.status = "no_flow_solution";
-      res_.message = flow_failure_ + " at t = " + fmt(ta * G_.t_scale) + " s";
+      res_.message = flow_failure_ + " at t = " + fmt(ta * G_.t_scale, 4) + " s";
       break;
     }
     advance_interfaces(ta, tb);
@@ -575,9 +568,9 @@ Result Drill::run() {
       if (!std::isfinite(n.S2) || !std::isfinite(n.g) || !std::isfinite(n.S1) ||
           !std::isfinite(n.b2) || !std::isfinite(n.itf.phi)) {
         res_.status = "diverged";
-        res_.message = "non-finite state at xi = " + fmt(n.xi) + ", t = " + fmt(tb * G_.t_scale) +
-                       " s (model " + to_string(cfg_.model) + "; S2 " + fmt(n.S2) + ", g " + fmt(n.g) +
-                       ", S1 " + fmt(n.S1) + ", phi " + fmt(n.itf.phi) + ", b2 " + fmt(n.b2) + ")";
+        res_.message = "non-finite state at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb * G_.t_scale, 4) +
+                       " s (model " + to_string(cfg_.model) + "; S2 " + fmt(n.S2, 4) + ", g " + fmt(n.g, 4) +
+                       ", S1 " + fmt(n.S1, 4) + ", phi " + fmt(n.itf.phi, 4) + ", b2 " + fmt(n.b2, 4) + ")";
         break;
       }
     }
@@ -602,8 +595,8 @@ Result Drill::run() {
   res_.dt = cfg_.dt;
   res_.max_stable_dt = lambda_max_ > 0 ? 2.0 / lambda_max_ * G_.t_scale : 0.0;
   if (res_.unstable)
-    res_.message += "; use --dt below about " + fmt(res_.max_stable_dt) + " s (--dtau " +
-                    fmt(res_.max_stable_dt / G_.t_scale) + ")";
+    res_.message += "; use --dt below about " + fmt(res_.max_stable_dt, 4) + " s (--dtau " +
+                    fmt(res_.max_stable_dt / G_.t_scale, 4) + ")";
   // summary quantities
   const double R = cfg_.R;
   const Node& c = nodes_[0];
@@ -623,13 +616,13 @@ Result Drill::run() {
   if (res_.status == "ok" && c.tau_m >= tau_p) {
     res_.status = "no_melt";
     res_.message = "the surface does not reach T_m within the pulse: melt onset at the centre would be at t = " +
-                   fmt(c.tau_m * G_.t_scale) + " s > pulse " + fmt(cfg_.tp) + " s";
+                   fmt(c.tau_m * G_.t_scale, 4) + " s > pulse " + fmt(cfg_.tp, 4) + " s";
     res_.T_peak = cfg_.mat.Tm + G_.dT * premelt_temperature(G_, 0.0, 0.0, tau_p);
   }
   if (res_.status == "ok" && nodes_.back().molten) {
     res_.status = "truncated";
-    res_.message = "the melt zone reaches the last node (xi = " + fmt(nodes_.back().xi) +
-                   "; melting would reach xi = " + fmt(res_.xi_melt_edge) +
+    res_.message = "the melt zone reaches the last node (xi = " + fmt(nodes_.back().xi, 4) +
+                   "; melting would reach xi = " + fmt(res_.xi_melt_edge, 4) +
                    "): removed volume and energy are cut at --xi-max";
   }
   if (res_.status == "ok") {
@@ -638,13 +631,13 @@ Result Drill::run() {
     const double node_steps = double(res_.steps) * res_.nodes;
     if (std::fabs(imb) > 0.01 || res_.curvature_clamps > 1e-4 * node_steps) {
       res_.status = "inaccurate";
-      res_.message = "energy imbalance " + fmt(imb) + ", curvature |a d| >= 2 clamped " +
+      res_.message = "energy imbalance " + fmt(imb, 4) + ", curvature |a d| >= 2 clamped " +
                      std::to_string(res_.curvature_clamps) + " times (" + first_clamp_ + "), b2 limiter hit " +
                      std::to_string(res_.b2_clamps) + " times, melt thickness clamped at 0 " +
                      std::to_string(res_.melt_clamps) + " times";
     } else if (res_.curvature_clamps > 0) {
       res_.message = "curvature |a d| >= 2 clamped " + std::to_string(res_.curvature_clamps) + " times (of " +
-                     fmt(node_steps) + " node steps; " + first_clamp_ + ")";
+                     fmt(node_steps, 4) + " node steps; " + first_clamp_ + ")";
     }
   }
   return res_;

@@ -15,6 +15,13 @@
 
 namespace laser {
 
+std::string fmt(double v, int precision) {
+  std::ostringstream o;
+  o.precision(precision);
+  o << v;
+  return o.str();
+}
+
 const char* to_string(FlowModel m) {
   switch (m) {
     case FlowModel::Conduction: return "conduction";
@@ -67,12 +74,6 @@ struct Param {
     return k;
   }
 };
-
-std::string fmt(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
 
 std::string range_text(const Param& p) {
   std::string s = (p.lo_open ? "(" : "[") + fmt(p.lo) + ", " + fmt(p.hi) + "]";

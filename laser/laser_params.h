@@ -12,6 +12,9 @@
 
 namespace laser {
 
+// v as an ostream prints it with that precision (numbers in messages and notes).
+std::string fmt(double v, int precision = 6);
+
 constexpr const char* kVersion = "2.0.0";
 
 enum class FlowModel { Conduction, Rising, RisingFall, Boundary };

@@ -8,12 +8,6 @@
 namespace laser {
 
 namespace {
-std::string fmt(double v) {
-  std::ostringstream o;
-  o.precision(4);
-  o << v;
-  return o.str();
-}
 double rel_diff(double a, double b) {
   const double s = std::max(std::fabs(a), std::fabs(b));
   return s > 0.0 ? std::fabs(a - b) / s : 0.0;
@@ -42,21 +36,21 @@ TimeStepPolicy::TimeStepPolicy(const Config& cfg) {
       throw UsageError(buf);
     }
     if (cfg.tp / dt_ > kMaxSteps / 3)
-      throw UsageError(reason_ + ": " + fmt(cfg.tp / dt_) + " steps of " + fmt(dt_) + " s over the pulse " +
-                       fmt(cfg.tp) + " s; at most " + fmt(kMaxSteps / 3) + " allowed (valid range [" +
-                       fmt(3 * cfg.tp / kMaxSteps) + ", " + fmt(cfg.tp) + ") s)");
+      throw UsageError(reason_ + ": " + fmt(cfg.tp / dt_, 4) + " steps of " + fmt(dt_, 4) + " s over the pulse " +
+                       fmt(cfg.tp, 4) + " s; at most " + fmt(kMaxSteps / 3, 4) + " allowed (valid range [" +
+                       fmt(3 * cfg.tp / kMaxSteps, 4) + ", " + fmt(cfg.tp, 4) + ") s)");
     return;
   }
   automatic_ = true;
   dt_ = cfg.tp / kStepsPerPulse;
-  reason_ = "pulse / " + fmt(kStepsPerPulse);
+  reason_ = "pulse / " + fmt(kStepsPerPulse, 4);
   if (t_melt < cfg.tp && (cfg.tp - t_melt) / kStepsPerMelting < dt_) {
     dt_ = (cfg.tp - t_melt) / kStepsPerMelting;
-    reason_ = "melting time / " + fmt(kStepsPerMelting);
+    reason_ = "melting time / " + fmt(kStepsPerMelting, 4);
   }
   if (dt_stable_ > 0.0 && kStableFraction * dt_stable_ < dt_) {
     dt_ = kStableFraction * dt_stable_;
-    reason_ = "explicit limit (4-14) x " + fmt(kStableFraction);
+    reason_ = "explicit limit (4-14) x " + fmt(kStableFraction, 4);
   }
 }
 
@@ -132,9 +126,9 @@ Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) cons
   s.steps_total = steps;
   s.reason = reason_ + (dt < dt_ ? ", refined to meet --tol" : "");
   if (std::max(ed, ev) > cfg.tol && (fine.status == "ok" || fine.status == "inaccurate")) {
-    const std::string m = "estimated error of the time step: depth " + fmt(ed) + ", volume " + fmt(ev) +
-                          " (step doubling, dt = " + fmt(dt) + " s against " + fmt(companion) +
-                          " s) above --tol " + fmt(cfg.tol) +
+    const std::string m = "estimated error of the time step: depth " + fmt(ed, 4) + ", volume " + fmt(ev, 4) +
+                          " (step doubling, dt = " + fmt(dt, 4) + " s against " + fmt(companion, 4) +
+                          " s) above --tol " + fmt(cfg.tol, 4) +
                           (automatic_ ? " after refining to the step budget" : "; use a smaller --dt or leave it automatic");
     fine.message = fine.status == "ok" ? m : fine.message + "; " + m;
     fine.status = "inaccurate";
