@@ -1,6 +1,7 @@
 """Helpers shared by the laser_*.py tools: locate and run laser_drill."""
 import json
 import os
+import resource
 import subprocess
 import sys
 
@@ -16,13 +17,18 @@ def find_exe(exe=None):
 
 
 def run_case(exe, out, args, quiet=True):
-    """Runs laser_drill into directory out; returns (exit code, summary dict or None, stderr)."""
+    """Runs laser_drill into directory out; returns (exit code, summary dict or None, stderr).
+    The summary gains cpu_time_s, the process's user + system CPU time: on the shared
+    machine it varies much less with the load than wall_time_s."""
     # --overwrite: the tools re-run cases into their own folders
     cmd = [exe, "--out", out, "--overwrite"] + [str(a) for a in args] + (["--quiet"] if quiet else [])
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     p = subprocess.run(cmd, capture_output=True, text=True)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
     summary = None
     path = os.path.join(out, "summary.json")
     if p.returncode == 0 and os.path.exists(path):
         with open(path) as f:
             summary = json.load(f)
+        summary["cpu_time_s"] = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return p.returncode, summary, p.stderr.strip()

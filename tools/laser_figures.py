@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
 """Redraws Figures 3.7, 3.8 and 5.1-5.8 of Yang (2016), Part I, from laser_drill output.
 
-  tools/python tools/laser_figures.py --work figs/ [--exe build/laser_drill] [--sweep DIR]
+  tools/python tools/laser_figures.py --work figs/ [--melt-energy advected|text] [--exe build/laser_drill] [--sweep DIR]
 
-Runs the cases it needs into --work (a few seconds each, skipped when the
-run directory already has a summary.json) and writes fig3_7.png ... fig5_8.png
-there. With --sweep, Figure 5.1 uses DIR/sweep.csv of tools/laser_sweep.py.
+Runs the cases it needs into --work/<melt layer>/ (a few seconds each, skipped when
+the run directory already has a summary.json) and writes fig3_7.png ... fig5_8.png
+into --work. --melt-energy text draws the dissertation's linear melt layer (the
+model of chapter 5); the default is laser_drill's default, the energy-consistent
+advected layer, whose holes are 16-22 % shallower (docs/laser_model.md 2.9).
+With --sweep, Figure 5.1 uses DIR/sweep.csv of tools/laser_sweep.py.
 """
 import argparse
 import csv
@@ -32,13 +35,13 @@ def read_csv(path):
 
 
 class Runner:
-    def __init__(self, exe, work):
-        self.exe, self.work = exe, work
+    def __init__(self, exe, work, melt_energy):
+        self.exe, self.work, self.melt_energy = exe, os.path.join(work, melt_energy), melt_energy
 
     def get(self, name, args):
         d = os.path.join(self.work, name)
         if not os.path.exists(os.path.join(d, "summary.json")):
-            code, s, err = run_case(self.exe, d, args)
+            code, s, err = run_case(self.exe, d, list(args) + ["--melt-energy", self.melt_energy])
             if code != 0:
                 print("%s: %s" % (name, err), file=sys.stderr)
                 return None
@@ -206,10 +209,11 @@ def main():
     ap.add_argument("--work", default="laser_figures")
     ap.add_argument("--exe")
     ap.add_argument("--sweep")
+    ap.add_argument("--melt-energy", choices=("advected", "text"), default="advected")
     a = ap.parse_args()
     exe = find_exe(a.exe)
     os.makedirs(a.work, exist_ok=True)
-    R = Runner(exe, a.work)
+    R = Runner(exe, a.work, a.melt_energy)
     fig3(a.work, exe)
     fig5_1(a.work, R, a.sweep)
     d = R.get("I7.5e+10_rf1", ["--intensity", 7.5e10, "--xi-p", "1"])
@@ -229,7 +233,7 @@ def main():
         label = "rising m = 2 (rising-fall failed, see stderr)"
     if d:
         fig_rates(a.work, d, "fig5_8.png", "Fig. 5.8: rates, Pr = 142, " + label)
-    print("wrote figures to %s" % a.work)
+    print("wrote figures to %s (%s melt layer)" % (a.work, a.melt_energy))
 
 
 if __name__ == "__main__":

@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
 """Sweep of laser_drill over centre intensities and melt-flow models.
 
-  tools/python tools/laser_sweep.py --out sweep/ [--full] [--exe build/laser_drill]
+  tools/python tools/laser_sweep.py --out sweep/ [--full] [--melt-energy advected|text] [--exe build/laser_drill]
 
 Writes one run directory per case under --out and the table sweep.csv
-(intensity, model, parameter, status, removal rate, depth, T_peak, p_peak,
-flow share, wall time). --full adds every m and xi_p of chapter 5.
+(intensity, model, parameter, melt layer, status, removal rate, depth, T_peak,
+p_peak, flow share, wall and CPU time). --full adds every m and xi_p of chapter 5.
+--melt-energy text uses the dissertation's linear melt layer (chapter 5's numbers);
+the default is laser_drill's energy-consistent advected layer.
 """
 import argparse
 import csv
@@ -31,6 +33,7 @@ def main():
     ap.add_argument("--out", default="laser_sweep")
     ap.add_argument("--exe")
     ap.add_argument("--full", action="store_true")
+    ap.add_argument("--melt-energy", choices=("advected", "text"), default="advected")
     ap.add_argument("--intensities", type=float, nargs="*", default=INTENSITIES)
     ap.add_argument("extra", nargs="*", help="extra laser_drill options after --")
     a = ap.parse_args()
@@ -41,22 +44,23 @@ def main():
         for model, par, args in cases(a.full):
             name = "I%.3g_%s%s" % (I, model, "" if par is None else "_%g" % par)
             d = os.path.join(a.out, name)
-            code, s, err = run_case(exe, d, ["--intensity", I, "--model", model] + args + a.extra)
+            code, s, err = run_case(exe, d, ["--intensity", I, "--model", model,
+                                                "--melt-energy", a.melt_energy] + args + a.extra)
             row = {"intensity_W_per_m2": I, "model": model, "parameter": "" if par is None else par, "dir": name,
-                   "exit_code": code}
+                   "melt_energy": a.melt_energy, "exit_code": code}
             if s:
                 row.update(status=s["status"], removal_rate_m3_per_s=s["removal_rate_m3_per_s"],
                            volume_removed_m3=s["volume_removed_m3"], depth_center_m=s["depth_center_m"],
                            T_peak_K=s["T_peak_K"], p_peak_Pa=s["p_peak_Pa"],
                            flow_share=(s["volume_removed_by_flow_m3"] / s["volume_removed_m3"]
                                        if s["volume_removed_m3"] else 0.0),
-                           wall_time_s=s["wall_time_s"], message=s["message"])
+                           wall_time_s=s["wall_time_s"], cpu_time_s=s["cpu_time_s"], message=s["message"])
             else:
                 row.update(status="error", message=err.splitlines()[-1] if err else "")
             rows.append(row)
             print("%-32s %-20s %s" % (name, row["status"], row.get("message", "")), file=sys.stderr)
-    keys = ["intensity_W_per_m2", "model", "parameter", "status", "removal_rate_m3_per_s", "volume_removed_m3",
-            "depth_center_m", "T_peak_K", "p_peak_Pa", "flow_share", "wall_time_s", "exit_code", "dir", "message"]
+    keys = ["intensity_W_per_m2", "model", "parameter", "melt_energy", "status", "removal_rate_m3_per_s", "volume_removed_m3",
+            "depth_center_m", "T_peak_K", "p_peak_Pa", "flow_share", "wall_time_s", "cpu_time_s", "exit_code", "dir", "message"]
     with open(os.path.join(a.out, "sweep.csv"), "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
         w.writeheader()
