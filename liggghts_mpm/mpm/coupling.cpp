@@ -261,6 +261,23 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a) {
   grid_.for_owned([&](int, int, int, std::size_t n) { a[n] = phi[2 * n] * phi[2 * n + 1]; });
 }
 
+// A node within one node of a grid face of a non-periodic dimension (padding nodes included).
+bool FluidSolver::near_face(int i, int j, int k) const {
+  const GridSpec &gs = opt.grid;
+  const int idx[3] = {i, j, k};
+  for (int d = 0; d < 3; ++d)
+    if (!gs.periodic[d] && (idx[d] <= 1 || idx[d] >= gs.ncell[d] - 1)) return true;
+  return false;
+}
+
+// Some node of a stencil of ns nodes per direction from base is near_face.
+bool FluidSolver::near_face(const int base[3], int ns) const {
+  const GridSpec &gs = opt.grid;
+  for (int d = 0; d < 3; ++d)
+    if (!gs.periodic[d] && (base[d] <= 1 || base[d] + ns - 1 >= gs.ncell[d] - 1)) return true;
+  return false;
+}
+
 /* Moments of the points' pressures for the linear least-squares fit at each node: with
    e = (1, x_s - x_j) for the point's sample position x_s, the node collects r = sum S V p e and
    the normal matrix M = sum S V e e^T (PfitRec). */
@@ -274,7 +291,7 @@ void FluidSolver::pressure_moments() {
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     const double V = pts.state[i][C_VOL], p = pts.state[i][C_P];
-    if (opt.grad_p == GradP::Nodal) {
+    if (opt.grad_p == GradP::Nodal && !near_face(ps.base, NS)) {
       // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
         double *cn = g + PfitRec::N * n;
@@ -331,9 +348,14 @@ void FluidSolver::couple_kernel(double h) {
   const int nsub = state.nsub;
   if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
 
-  const bool weak = opt.grad_p == GradP::Weak;
-  if (weak || opt.reaction_points) point_sums<NS>();
-  if (weak) {
+  // projection: the grains feel the nodal gradient of the last solve (the one the fluid felt),
+  // and the fluid gets no pressure reaction (its share -theta grad p is in the projection)
+  const bool proj = opt.projection;
+  const bool weak = opt.grad_p == GradP::Weak || proj;
+  if (!proj && (weak || opt.reaction_points)) point_sums<NS>();
+  if (proj) {
+    projection_gradient_to_grains();
+  } else if (weak) {
     weak_pressure_gradient();
   } else {
     // pressure at the nodes for the force on the grains (fit_linear_pressure)
@@ -343,7 +365,7 @@ void FluidSolver::couple_kernel(double h) {
   }
 
   const double mmin = mass_min();
-  grid_.for_owned([&](int, int, int, std::size_t n) {
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     const double *c = &g_.pfit[PfitRec::N * n];
     const double *g = &g_.p2g[P2gRec::N * n];
     double *st = &g_.st[StRec::N * n];
@@ -351,7 +373,13 @@ void FluidSolver::couple_kernel(double h) {
     st[StRec::TH] = g_.th[n];
     st[StRec::P] = !weak && c[PfitRec::MAT] > 0.0 ? c[PfitRec::R] / c[PfitRec::MAT] : 0.0;
     double fit[4];
-    if (opt.grad_p == GradP::Fit && c[PfitRec::MAT] > 0.0 && g_.need[n] > 0.0 && fit_linear_pressure(c, opt.grid.dx, fit)) {
+    if (opt.grad_p == GradP::Nodal && c[PfitRec::MAT] > 0.0 && g_.need[n] > 0.0 && near_face(i, j, k) &&
+        fit_linear_pressure(c, opt.grid.dx, fit)) {
+      // grad_p nodal next to a grid face: the nodal mean there is the pressure of the points'
+      // centre, up to half a cell off the node (a bed on the floor felt 0.79 of Archimedes); the
+      // value of the node's linear fit is exact for a hydrostatic field
+      st[StRec::P] = fit[0];
+    } else if (opt.grad_p == GradP::Fit && c[PfitRec::MAT] > 0.0 && g_.need[n] > 0.0 && fit_linear_pressure(c, opt.grid.dx, fit)) {
       st[StRec::P] = fit[0];
       for (int a = 0; a < 3; ++a) st[StRec::FIT + a] = fit[1 + a];
       st[StRec::FIT + 3] = 1.0;  // the fit (value and gradient) is determined
@@ -429,7 +457,7 @@ void FluidSolver::couple_kernel(double h) {
     const bool mobile = (pts.mask[k] & pts.integrated_bits) != 0;
     if (!mobile) ak[0] = ak[1] = ak[2] = 0.0;
     const Row4 r0 = {K, K * v[k][0], K * v[k][1], K * v[k][2]};
-    const Row4 r1 = {rmass[k], -Fp[0], -Fp[1], -Fp[2]};
+    const Row4 r1 = proj ? Row4{rmass[k], 0.0, 0.0, 0.0} : Row4{rmass[k], -Fp[0], -Fp[1], -Fp[2]};
     const Row4 r2 = {K * ak[0], K * ak[1], K * ak[2], mobile ? 0.0 : K};
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
       double *q = gdr + DrRec::N * n;
@@ -438,7 +466,7 @@ void FluidSolver::couple_kernel(double h) {
       row4(q + DrRec::KA) += w * r2;
     });
   }
-  if (opt.reaction_points) {
+  if (opt.reaction_points && !proj) {
     // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
     for (std::size_t n = 0; n < grid_.size(); ++n)
       for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
@@ -469,7 +497,7 @@ void FluidSolver::couple_kernel(double h) {
       q[DrRec::J + d] = q[DrRec::K] > 0.0 ? J[d] / q[DrRec::K] : 0.0;  // impulse per unit K, to the grains
     }
   });
-  if (opt.reaction_points) route_reaction<NS>();
+  if (opt.reaction_points && !proj) route_reaction<NS>();
   grid_.forward(g_.dr.data(), DrRec::N);
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;

@@ -52,9 +52,10 @@ struct Options {
   bool musl = true;
   bool antilock = true;
   bool wall_traction = true;        // (8-23) at grid-face walls for bspline2
-  // grad p at the grains: the gradient the fluid feels at the nodes, -(internal force)/volume
-  // (weak, default), fitted nodal gradients (fit) or the gradient of the nodal means (nodal)
-  GradP grad_p = GradP::Weak;
+  // grad p at the grains: the gradient of the nodal mean pressures (nodal, default: the
+  // derivative of the fluid's energy; at a grid face the nodes' linear fit), the gradient the
+  // fluid feels at the nodes, -(internal force)/volume (weak), or fitted nodal gradients (fit)
+  GradP grad_p = GradP::Nodal;
   // the grains' pressure reaction goes to the fluid through its points (points, default: the
   // kernel the displaced fluid mass went through) or straight to the nodes (direct, the text's)
   bool reaction_points = true;
@@ -72,6 +73,7 @@ struct Options {
   bool projection = false;
   double pressure_tolerance = 1e-8;  // relative residual of the solve
   int pressure_max_iterations = 200;
+  bool projection_dtheta = true;     // couple: the d(theta)/dt source of the pressure equation
   // reports
   int front_axis = 0;
   int height_axis = 2, wall_axis = 0;

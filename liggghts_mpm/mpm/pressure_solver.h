@@ -74,6 +74,7 @@ class PressureSolver {
   void build_grid();
   bool assemble_values(const NodeLabels &labels, const double *beta);
   void setup_solver();
+  bool any_periodic() const;
   long node_key(int i, int j, int k) const;
   bool unknown(const NodeLabels &labels, int i, int j, int k, std::size_t n) const;
 

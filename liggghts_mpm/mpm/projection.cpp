@@ -24,6 +24,7 @@ Projection::Projection(LocalGrid &grid, MPI_Comm comm, const Options &opt)
   rhs_.assign(n, 0.0);
   p_.assign(n, 0.0);
   p_ext_.assign(n, 0.0);
+  grad_ext_.assign(3 * n, 0.0);
 }
 
 namespace {
@@ -40,13 +41,14 @@ constexpr double kSurfaceFill = 0.25;
    EMPTY elsewhere (the free surface: p = 0), SOLID padding behind the box walls (NodeLabels::reset). The closed gate is a
    wall at rest: the face between the last node on the fluid side and the next one (a gate through
    a node plane leaves that node on the fluid side, like a box wall through its nodes). */
-void Projection::make_labels(const double *p2g, double mmin) {
+void Projection::make_labels(const double *p2g, double mmin, const double *theta) {
   lab_.reset(grid_);
   const double dx = opt_.grid.dx, full = opt_.rho0 * dx * dx * dx;
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kSolid) return;
     const double m = p2g[P2gRec::N * n + P2gRec::M];
-    if (m <= mmin || m <= 0.0 || m < kSurfaceFill * full * geo_.volume(i, j, k)) lab_.kind[n] = kEmpty;
+    const double th = theta ? theta[n] : 1.0;
+    if (m <= mmin || m <= 0.0 || m < kSurfaceFill * th * full * geo_.volume(i, j, k)) lab_.kind[n] = kEmpty;
   });
   const Gate &g = opt_.gate;
   if (g.active) {
@@ -67,9 +69,33 @@ void Projection::make_labels(const double *p2g, double mmin) {
   lab_.exchange(grid_, comm_);
 }
 
-void Projection::project(double *vel, const double *p2g, double mmin, const double *theta,
-                         const double *theta_prev, double h, Boundaries &bc, long step) {
-  make_labels(p2g, mmin);
+/* The node of the box (indices clamped to 0..ncell in non-periodic dimensions) in front of a
+   padding node (itself if that node is outside the patch). */
+std::size_t Projection::wall_node(int i, int j, int k) const {
+  const GridSpec &gs = opt_.grid;
+  int q[3] = {i, j, k};
+  for (int d = 0; d < 3; ++d)
+    if (!gs.periodic[d]) q[d] = std::min(std::max(q[d], 0), gs.ncell[d]);
+  return grid_.in_patch(q[0], q[1], q[2]) ? grid_.index(q[0], q[1], q[2]) : grid_.index(i, j, k);
+}
+
+void Projection::extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const {
+  out = a;
+  const IndexBox &pb = grid_.patch();
+  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
+    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
+        const std::size_t n = grid_.index(i, j, k);
+        if (lab_.kind[n] != kSolid) continue;
+        const std::size_t c = wall_node(i, j, k);
+        for (int e = 0; e < stride; ++e) out[stride * n + e] = a[stride * c + e];
+      }
+}
+
+void Projection::project(double *vel, const double *p2g, double mmin, const double *theta, bool dtheta, double h,
+                         Boundaries &bc, long step) {
+  make_labels(p2g, mmin, theta);
+  const double *theta_prev = theta && dtheta && have_theta_last_ ? theta_last_.data() : nullptr;
   // u* as it is; every wall condition comes after the projection: the wall's reaction is the
   // pressure, and a wall node's velocity zeroed before it (normal or, no-slip, tangential) would
   // be moved again by the correction (measured: the F1 column at rest, docs/projection.md)
@@ -91,23 +117,17 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
        << e.residual << " (keyword 'tolerance' " << opt_.pressure_tolerance << ")";
     throw Error(os.str());
   }
-  // for the points (and grains): the padding nodes behind the box walls carry the pressure of
-  // the wall node in front (the solve holds them at 0; interpolated as they are, they would lower
-  // the pressure of the points next to a wall by half a cell's hydrostatic difference)
-  const GridSpec &gs = opt_.grid;
-  p_ext_ = p_;
-  const IndexBox &pb = grid_.patch();
-  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
-    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
-      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-        const std::size_t n = grid_.index(i, j, k);
-        if (lab_.kind[n] != kSolid) continue;
-        int q[3] = {i, j, k};
-        for (int d = 0; d < 3; ++d)
-          if (!gs.periodic[d]) q[d] = std::min(std::max(q[d], 0), gs.ncell[d]);
-        if (grid_.in_patch(q[0], q[1], q[2])) p_ext_[n] = p_[grid_.index(q[0], q[1], q[2])];
-      }
+  // for the points and grains: the padding nodes behind the box walls carry the pressure (and
+  // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
+  // they would lower the pressure of the points next to a wall by half a cell's hydrostatic step)
+  extend_to_padding(p_, p_ext_, 1);
   pressure_gradient(grid_, lab_, p_.data(), grad_.data());
+  grid_.forward(grad_.data(), 3);
+  extend_to_padding(grad_, grad_ext_, 3);
+  if (theta) {
+    theta_last_.assign(theta, theta + grid_.size());
+    have_theta_last_ = true;
+  }
   correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), h, u_.data());
   grid_.forward(u_.data(), 3);
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -118,10 +138,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
       // the wall node in front, with the wall condition. Their own u* is not projected; left as
       // it is, it would let the points next to a free-slip wall fall through the rest state.
       if (!(m > mmin && m > 0.0)) return;
-      int q[3] = {i, j, k};
-      for (int d = 0; d < 3; ++d)
-        if (!gs.periodic[d]) q[d] = std::min(std::max(q[d], 0), gs.ncell[d]);
-      const std::size_t c = grid_.index(q[0], q[1], q[2]);
+      const std::size_t c = wall_node(i, j, k);
       for (int d = 0; d < 3; ++d) v[d] = lab_.kind[c] == kFluid ? u_[3 * c + d] : 0.0;
       bc.apply(v, i, j, k, h);
       return;

@@ -25,26 +25,34 @@ class Projection {
   // vel: the VelRec rows of the grid update, V_NEW = u* at the owned nodes (0 where the node
   // mass p2g M <= mmin: those become EMPTY nodes, p = 0). On return V_NEW holds the corrected,
   // wall-conditioned velocity at the owned nodes (not forwarded). theta: nodal fluid fraction
-  // (null: 1), theta_prev: the last fluid step's (null: no d(theta)/dt source). Throws
+  // (null: 1); dtheta: the d(theta)/dt source with theta of the last solve (none at the first).
+  // Throws
   // mpm::Error naming the step if the solve does not converge.
-  void project(double *vel, const double *p2g, double mmin, const double *theta, const double *theta_prev,
-               double h, Boundaries &bc, long step);
+  void project(double *vel, const double *p2g, double mmin, const double *theta, bool dtheta, double h,
+               Boundaries &bc, long step);
 
   // nodal pressure of the last solve (owned nodes and halos), the padding nodes behind the box
   // walls with the pressure of the wall node in front (for interpolation to points and grains)
   const std::vector<double> &pressure() const { return p_ext_; }
+  // nodal pressure gradient of the last solve, the one the fluid felt (owned nodes and halos;
+  // padding nodes with the wall node's): for the grains
+  const std::vector<double> &gradient() const { return grad_ext_; }
   int iterations() const { return last_.iterations; }
   double residual() const { return last_.relative_residual; }
 
  private:
-  void make_labels(const double *p2g, double mmin);
+  void make_labels(const double *p2g, double mmin, const double *theta);
+  std::size_t wall_node(int i, int j, int k) const;
+  void extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const;
 
   LocalGrid &grid_;
   const Options &opt_;
   ProjectionGeometry geo_;
   std::unique_ptr<PressureSolver> solver_;
   NodeLabels lab_;
-  std::vector<double> u_, theta_, beta_, rhs_, p_, p_ext_, grad_, inv_rho_;
+  std::vector<double> u_, theta_, beta_, rhs_, p_, p_ext_, grad_, grad_ext_, inv_rho_;
+  std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)
+  bool have_theta_last_ = false;
   PressureResult last_;
   MPI_Comm comm_;
 };

@@ -46,8 +46,6 @@ std::string FluidSolver::check_points() {
                 "theta u is taken in the MUSL remap)");
   if (opt.projection && bc.has_walls())
     throw Error("Fix mpm/fluid: keyword 'pressure projection' does not support keyword 'mesh_wall' yet");
-  if (opt.projection && opt.coupled)
-    throw Error("Fix mpm/fluid: keyword 'pressure projection' does not support keyword 'couple' yet");
   if (!opt.coupled) return "";
   double dmax = 0.0, gd = 0.0;
   int overlap = 0, go = 0;
@@ -224,9 +222,15 @@ void FluidSolver::update_grid(double h) {
     if (!opt.projection) bc.apply(vnew, i, j, k, h);
     for (int d = 0; d < 3; ++d) gv[VelRec::V_NEW + d] = vnew[d];
   });
-  if (opt.projection) proj_->project(g_.vel.data(), g_.p2g.data(), mmin, nullptr, nullptr, h, bc, clock.step);
+  if (opt.projection)
+    proj_->project(g_.vel.data(), g_.p2g.data(), mmin, opt.coupled ? g_.th.data() : nullptr, opt.projection_dtheta, h,
+                   bc, clock.step);
   grid_.forward(g_.vel.data(), VelRec::N);
 }
+
+/* projection with couple: the grains feel the nodal pressure gradient of the last solve, the
+   discrete gradient the fluid felt (grad_p weak's array, read by couple_kernel) */
+void FluidSolver::projection_gradient_to_grains() { g_.gw = proj_->gradient(); }
 
 /* projection: the points' pressure (state column C_P, for output and f_ID[10]) interpolated
    from the nodal pressure of the solve */

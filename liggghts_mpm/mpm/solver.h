@@ -108,6 +108,7 @@ class FluidSolver {
   void couple_fluid_grains(double h);  // coupling: pressure fit, drag exchange (8-25)-(8-29)
   void update_grid(double h);       // (8-35), (8-36), boundary conditions (projection: u*, solve, correction)
   void interpolate_pressure();      // projection: the points' pressure from the nodes
+  void projection_gradient_to_grains();  // projection + couple: grad p for the grains
   void grid_to_particles();         // G2P (8-37)-(8-40)
   void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
   void update_stress(double h, bool theta_only = false);  // (7-21)-(7-24)
@@ -128,6 +129,8 @@ class FluidSolver {
   void weak_pressure_gradient();                   // grad_p weak
   template <int NS> void route_reaction();         // reaction points
   void fold_to_mirror(std::vector<double> &a, int stride);
+  bool near_face(int i, int j, int k) const;
+  bool near_face(const int base[3], int ns) const;
   void smooth_node_volume(std::vector<double> &a);
   template <class Fn> void for_nodes(const Stencil &ps, Fn &&fn) const;
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """fix mpm/fluid ... pressure projection (issue #13, docs/projection.md): the incompressible fluid
-of a pressure solve, fluid only.
+of a pressure solve, alone and coupled with grains.
 
     test_projection.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR --mpirun "mpirun ..."
 """
@@ -79,6 +79,29 @@ def case_dambreak(r):
 def case_np2_vs_np1(r):
     """Dam break with projection on 2 ranks against 1: equal to the solver tolerance."""
     dambreak_np2_vs_np1(r, "projection_np2_vs_np1", 1e-5, "the solver tolerance", tend=1.5, pressure="projection")
+
+
+def case_settling(r):
+    """C1 with projection: one sphere settles at the isolated-sphere terminal velocity within 1 %."""
+    from cases import schiller_naumann_settling
+    d, _ = r.run("projection_settling", os.path.join(r.inputs, "settling", "in.settling"), {"pressure": "projection"})
+    sim = read_csv(os.path.join(d, "settling.csv"))
+    _, vt = schiller_naumann_settling(1e-4, 3000.0, 10.0, 1e-5, 9.81, sim["t"][-1])
+    err = abs(-sim["v_z"][-1] - vt) / vt
+    print(f"  terminal velocity {-sim['v_z'][-1]:.5f} m/s, Schiller-Naumann {vt:.5f} m/s ({100 * err:.2f} %)")
+    check(err < 0.01, "terminal velocity within 1 % (measured 0.94 %)")
+
+
+def case_archimedes(r):
+    """A random bed held in still water (inputs/archimedes/in.bed, 150 grains) with projection:
+    the fluid force on it is Archimedes' within 2 %, mid-depth and on the floor."""
+    for name, v in (("mid", {}), ("floor", {"floor": 1})):
+        v = dict({"nbeads": 150, "tsettle": 0.05, "tavg": 0.01, "pressure": "projection"}, **v)
+        d, p = r.run(f"projection_archimedes/{name}", os.path.join(r.inputs, "archimedes", "in.bed"), v)
+        m = re.search(r"RESULT ratio (\S+)", p.stdout)
+        q = float(m.group(1)) if m else float("nan")
+        print(f"  {name}: fluid force / Archimedes = {q:.4f}")
+        check(abs(q - 1.0) < 0.02, f"{name}: within 2 % of Archimedes")
 
 
 TMPL = """atom_style sphere
