@@ -1,0 +1,251 @@
+/* fix mpm/fluid, the adapter's part that makes the material points LIGGGHTS atoms: the fill
+   (with the memory estimate before it), the exclusion of the points from every pair style, the
+   checks of the fix group, and the mesh_wall keyword (its meshes are LIGGGHTS fixes). The rest
+   of the adapter: fix_mpm_fluid.cpp; docs/design.md. */
+
+#include "fix_mpm_fluid.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <unistd.h>
+
+#include "atom.h"
+#include "atom_vec.h"
+#include "comm.h"
+#include "domain.h"
+#include "error.h"
+#include "fix_property_atom.h"
+#include "group.h"
+#include "memory.h"
+#include "modify.h"
+#include "neighbor.h"
+#include "region.h"
+#include "update.h"
+
+#include "mpm/error.h"
+#include "fix_mpm_fluid_guarded.h"
+
+using namespace LAMMPS_NS;
+using namespace FixConst;
+using mpm::NCOL;
+
+
+/* mesh_wall fix-ID kind [value] [side s] (the meshes are LIGGGHTS fixes; docs/mesh_walls.md) */
+int FixMpmFluid::parse_mesh_wall(int narg, char **arg, int iarg) {
+  using mpm::bad_arg;
+  using mpm::parse_double;
+  const mpm::Args a{narg, arg, iarg};
+  a.need(2, "mesh_wall", "a fix ID and noslip | freeslip | partial f | sticky f | shear delta f");
+  mpm::MeshWallSpec ms;
+  ms.fix_id = arg[iarg + 1];
+  ms.side = mpm::SIDE_AUTO;
+  const char *k = arg[iarg + 2];
+  iarg += 3;
+  if (strcmp(k, "noslip") == 0) ms.kind = mpm::WALL_NOSLIP;
+  else if (strcmp(k, "freeslip") == 0) ms.kind = mpm::WALL_FREESLIP;
+  else if (strcmp(k, "partial") == 0 || strcmp(k, "sticky") == 0) {
+    const bool sticky_kind = strcmp(k, "sticky") == 0;
+    const char *kwname = sticky_kind ? "mesh_wall sticky" : "mesh_wall partial";
+    if (iarg >= narg) bad_arg(kwname, "a sticky fraction", nullptr);
+    ms.kind = sticky_kind ? mpm::WALL_STICKY : mpm::WALL_PARTIAL;
+    if (!parse_double(arg[iarg], ms.sticky)) bad_arg(kwname, "a sticky fraction in [0,1]", arg[iarg]);
+    ++iarg;
+  } else if (strcmp(k, "shear") == 0) {
+    // wall shear stress mu (f w_t - v_t) / delta: an unresolved viscous layer of thickness delta
+    if (iarg + 1 >= narg)
+      bad_arg("mesh_wall shear", "a wall layer thickness delta (length) and a fraction f in [0,1]", nullptr);
+    ms.kind = mpm::WALL_SHEAR;
+    if (!parse_double(arg[iarg], ms.delta) || !(ms.delta > 0.0))
+      bad_arg("mesh_wall shear", "a positive wall layer thickness delta (length)", arg[iarg]);
+    if (!parse_double(arg[iarg + 1], ms.sticky) || ms.sticky < 0.0 || ms.sticky > 1.0)
+      bad_arg("mesh_wall shear", "a fraction f in [0,1] of the wall's tangential velocity", arg[iarg + 1]);
+    iarg += 2;
+  } else bad_arg("mesh_wall", "noslip, freeslip, partial f, sticky f or shear delta f", k);
+  if (iarg + 1 < narg && strcmp(arg[iarg], "side") == 0) {
+    const char *sd = arg[iarg + 1];
+    if (strcmp(sd, "auto") == 0) ms.side = mpm::SIDE_AUTO;
+    else if (strcmp(sd, "normal") == 0) ms.side = mpm::SIDE_NORMAL;
+    else if (strcmp(sd, "opposite") == 0) ms.side = mpm::SIDE_OPPOSITE;
+    else if (strcmp(sd, "both") == 0) ms.side = mpm::SIDE_BOTH;
+    else bad_arg("mesh_wall side", "auto, normal, opposite or both", sd);
+    iarg += 2;
+  }
+  mesh_specs.push_back(ms);
+  return iarg;
+}
+
+/* ---------------------------------------------------------------------- */
+
+void FixMpmFluid::post_create() {
+  // After a read_restart the points exist already (recent_restart is set
+  // when our global state came from the restart file).
+  if (!recent_restart && !solver->opt.fill_region.empty()) fill_points();
+  if (!recent_restart) point_type = solver->opt.fill_type;
+  exclude_points_from_pairs();
+  // The fluid force on each grain as the per-atom vector 'dragforce', the
+  // property/atom convention of LIGGGHTS/CFDEM (reused if the input made it).
+  if (solver->opt.coupled) {
+    const char *args[] = {"dragforce", "all", "property/atom", "dragforce", "vector", "yes", "no", "no",
+                          "0", "0", "0"};
+    fix_dragforce = static_cast<FixPropertyAtom *>(
+        modify->find_fix_property("dragforce", "property/atom", "vector", 3, 0, style, false));
+    if (!fix_dragforce) fix_dragforce = modify->add_fix_property_atom(11, const_cast<char **>(args), style);
+  }
+}
+
+/* The material points are the fluid, not grains: no pair style may act on them (a granular pair
+   style would make a water column pile up like sand). Same as the input lines 'neigh_modify
+   exclude type T t' for every type t; lines the input already has only repeat an exclusion. */
+void FixMpmFluid::exclude_points_from_pairs() {
+  if (point_type < 1 || point_type > atom->ntypes) return;
+  const std::string T = std::to_string(point_type);
+  for (int t = 1; t <= atom->ntypes; ++t) {
+    const std::string ts = std::to_string(t);
+    char *args[4] = {const_cast<char *>("exclude"), const_cast<char *>("type"), const_cast<char *>(T.c_str()),
+                     const_cast<char *>(ts.c_str())};
+    neighbor->modify_params(4, args);
+  }
+  print("fix mpm/fluid: material points (type " + T + ") excluded from pair interactions (neigh_modify exclude type " +
+        T + " 1.." + std::to_string(atom->ntypes) + ")\n");
+}
+
+/* Before creating the points: an upper estimate of their number (the cells of the grid within the
+   region's bounding box, times the points per cell) against half of the machine's physical memory,
+   so that 'cell 0.002' in a 1 m box stops with a message instead of dying in the allocator. */
+void FixMpmFluid::check_fill_memory(Region *region, const int lo[3], const int hi[3]) {
+  const mpm::Options &o = solver->opt;
+  const mpm::GridSpec &gs = o.grid;
+  double ncells = 1.0;
+  for (int d = 0; d < 3; ++d) {
+    double a = lo[d], b = hi[d];
+    if (region->bboxflag) {
+      const double ext[2][3] = {{region->extent_xlo, region->extent_ylo, region->extent_zlo},
+                                {region->extent_xhi, region->extent_yhi, region->extent_zhi}};
+      a = std::max(a, std::floor((ext[0][d] - gs.origin[d]) / gs.dx));
+      b = std::min(b, std::floor((ext[1][d] - gs.origin[d]) / gs.dx));
+    }
+    ncells *= std::max(0.0, b - a + 1.0);
+  }
+  double npts = ncells * o.fill_ppc[0] * o.fill_ppc[1] * o.fill_ppc[2], total = 0.0;
+  MPI_Allreduce(&npts, &total, 1, MPI_DOUBLE, MPI_SUM, world);
+  // bytes per point: LIGGGHTS' per-atom arrays (sphere style, neighbour bins) and the fix's state
+  // and shape records, about 1 kB; the ranks of one node share its memory
+  const double per_point = 1024.0;
+  const double mem = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  if (mem > 0.0 && total * per_point > 0.5 * mem) {
+    std::ostringstream os;
+    os.precision(3);
+    os << "Fix mpm/fluid: keyword 'fill' would create up to " << total << " material points (keyword 'cell' " << gs.dx
+       << ", " << o.fill_ppc[0] << "x" << o.fill_ppc[1] << "x" << o.fill_ppc[2] << " per cell), about "
+       << total * per_point / 1e9 << " GB, more than half of this machine's " << mem / 1e9
+       << " GB; use a larger cell or fewer points per cell";
+    error->all(FLERR, os.str().c_str());
+  }
+}
+
+void FixMpmFluid::fill_points() {
+  const mpm::Options &o = solver->opt;
+  const mpm::GridSpec &gs = o.grid;
+  // checked here, not at parse time: after read_restart no region is needed
+  const int iregion = domain->find_region(o.fill_region.c_str());
+  if (iregion < 0) guarded([&] { mpm::bad_arg("fill", "an existing region ID", o.fill_region.c_str()); });
+  Region *region = domain->regions[iregion];
+  const double dx = gs.dx;
+  double *spacing = solver->state.spacing;
+  double vol = dx * dx * dx;
+  for (int d = 0; d < 3; ++d) {
+    spacing[d] = dx / o.fill_ppc[d];
+    vol /= o.fill_ppc[d];
+  }
+  const int nlocal_before = atom->nlocal;
+  int lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = std::max(0, static_cast<int>(std::floor((domain->sublo[d] - gs.origin[d]) / dx)) - 1);
+    hi[d] = std::min(gs.ncell[d] - 1, static_cast<int>(std::floor((domain->subhi[d] - gs.origin[d]) / dx)) + 1);
+  }
+  check_fill_memory(region, lo, hi);
+  double x[3];
+  for (int k = lo[2]; k <= hi[2]; ++k)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i)
+        for (int c = 0; c < o.fill_ppc[2]; ++c)
+          for (int b = 0; b < o.fill_ppc[1]; ++b)
+            for (int a = 0; a < o.fill_ppc[0]; ++a) {
+              const int cell[3] = {i, j, k}, sub[3] = {a, b, c};
+              for (int d = 0; d < 3; ++d) x[d] = gs.origin[d] + cell[d] * dx + (sub[d] + 0.5) * spacing[d];
+              if (!region->match(x[0], x[1], x[2])) continue;
+              bool mine = true;
+              for (int d = 0; d < 3; ++d) mine = mine && x[d] >= domain->sublo[d] && x[d] < domain->subhi[d];
+              if (!mine) continue;
+              atom->avec->create_atom(o.fill_type, x);
+              const int n = atom->nlocal - 1;
+              for (int m = 0; m < modify->nfix; ++m) {
+                Fix *f = modify->fix[m];
+                if (f && f->create_attribute && f != this) {
+                  f->pre_set_arrays();
+                  f->set_arrays(n);
+                }
+              }
+              atom->mask[n] |= groupbit;
+              atom->v[n][0] = atom->v[n][1] = atom->v[n][2] = 0.0;
+              atom->rmass[n] = solver->init_point(x, vol, pdata[n]);
+              atom->radius[n] = 0.5 * std::min(spacing[0], std::min(spacing[1], spacing[2]));
+              if (atom->density_flag && atom->density) atom->density[n] = o.eos.rho0;
+            }
+
+  bigint nnew = atom->nlocal - nlocal_before, nall = 0;
+  MPI_Allreduce(&nnew, &nall, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  if (nall == 0) error->all(FLERR, "Fix mpm/fluid: keyword 'fill' created no material points (region empty?)");
+  bigint nlocal = atom->nlocal;
+  MPI_Allreduce(&nlocal, &atom->natoms, 1, MPI_LMP_BIGINT, MPI_SUM, world);
+  atom->tag_extend();
+  if (atom->map_style) {
+    atom->nghost = 0;
+    atom->map_init();
+    atom->map_set();
+  }
+  solver->state.point_mass_ref = o.eos.rho0 * vol;
+  filled = true;
+  std::ostringstream os;
+  os << "fix mpm/fluid: created " << nall << " material points (" << o.fill_ppc[0] << "x" << o.fill_ppc[1] << "x"
+     << o.fill_ppc[2] << " per cell of " << gs.dx << "), grid " << gs.ncell[0] << "x" << gs.ncell[1] << "x"
+     << gs.ncell[2] << " cells\n";
+  print(os.str());
+}
+
+/* The fix's group holds its material points only, and no other atom has their type (the
+   exclusion from the pair styles is by type). Checked before the integrators, so that grains in
+   the group are named as such, not as atoms some integrator also moves. */
+void FixMpmFluid::check_group_atoms() {
+  bigint loc[3] = {0, 0, 0}, glob[3];  // group atoms of other types; of the points' type without state; type shared
+  for (int i = 0; i < atom->nlocal; ++i) {
+    const bool same_type = atom->type[i] == point_type;
+    if (is_point(i)) {
+      if (pdata[i][mpm::C_FLAG] != 1.0) ++loc[same_type ? 1 : 0];
+    } else if (same_type)
+      ++loc[2];
+  }
+  MPI_Allreduce(loc, glob, 3, MPI_LMP_BIGINT, MPI_SUM, world);
+  const std::string G = std::string("group '") + group->names[igroup] + "'";
+  const std::string T = std::to_string(point_type);
+  std::ostringstream os;
+  if (glob[0] > 0)
+    os << "Fix mpm/fluid: " << G << " of the fix holds " << glob[0] << " atoms of other types than the material points' type "
+       << T << " (grains?); give the fix a group of the fill type only (e.g. 'group fluid type " << T << "')";
+  else if (glob[1] > 0)
+    os << "Fix mpm/fluid: " << glob[1] << " atoms of " << G << " have the material points' type " << T
+       << " but no state of this fix (ID '" << id << "'): the restart file is truncated or was written without this fix "
+       << "(or with another fix ID), or another command created atoms of type " << T;
+  else if (glob[2] > 0)
+    os << "Fix mpm/fluid: " << glob[2] << " atoms of type " << T << " are outside " << G
+       << " of the fix: grains must not share the type of the material points (give them another atom type)";
+  if (!os.str().empty()) error->all(FLERR, os.str().c_str());
+}
