@@ -4,7 +4,6 @@ case that must now either run correctly or stop with a message naming the keywor
 
     test_reliability.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR --mpirun "mpirun ..."
 """
-import argparse
 import math
 import os
 import re
@@ -12,7 +11,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from cases import FAILURES, Runner, check, read_csv  # noqa: E402
+from cases import check, driver_main, read_csv  # noqa: E402
 
 # A water column on the floor of a box; grains of type 2 may be added; granular contacts between
 # grains (pair gran); {pre} before the fix (exclusion lines), {fixargs} more keywords.
@@ -369,22 +368,5 @@ def case_coupled_restart(r):
     check(len(a) == len(b) == 5 and a == b, f"split run = uninterrupted run bit for bit (largest difference {diff:.3e})")
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("case")
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--inputs", default=None)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--mpirun", default="mpirun")
-    a = ap.parse_args()
-    r = Runner(a)
-    fn = globals().get("case_" + a.case)
-    if fn is None:
-        sys.exit(f"unknown case {a.case}")
-    fn(r)
-    print(f"{a.case}: {len(FAILURES)} failed checks")
-    return 1 if FAILURES else 0
-
-
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(driver_main(globals()))
