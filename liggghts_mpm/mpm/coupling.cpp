@@ -224,41 +224,50 @@ void FluidSolver::fold_to_mirror(std::vector<double> &a, int stride) {
    fraction phi_j = S_j / V_j (smoothing_step along each direction, smoothing_passes passes). */
 void FluidSolver::smooth_solid_volume() { smooth_node_volume(g_.sol); }
 
-// The same filter for any volume-like quantity at the owned nodes (a: one value per node).
-void FluidSolver::smooth_node_volume(std::vector<double> &a) {
+// The same filter for any volume-like quantity at the owned nodes: a holds `stride` values per
+// node, each smoothed alone (one pass over the nodes and one exchange for all of them).
+void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
   const GridSpec &gs = opt.grid;
   const int passes = smoothing_passes(opt.theta_smooth, gs.dx);
   if (passes <= 0) return;
+  const int r = stride + 1;  // phi (stride values), node volume
   std::vector<double> &phi = g_.phi, &phi_new = g_.phi_new;
-  phi.assign(2 * grid_.size(), 0.0);  // phi, node volume
+  phi.assign(r * grid_.size(), 0.0);
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     const double V = solid_node_volume(i, j, k);
-    phi[2 * n] = V > 0.0 ? a[n] / V : 0.0;
-    phi[2 * n + 1] = V;
+    for (int c = 0; c < stride; ++c) phi[r * n + c] = V > 0.0 ? a[stride * n + c] / V : 0.0;
+    phi[r * n + stride] = V;
   });
-  grid_.forward(phi.data(), 2);
-  phi_new.resize(grid_.size());
+  grid_.forward(phi.data(), r);
+  phi_new.resize(stride * grid_.size());
   for (int pass = 0; pass < passes; ++pass)
     for (int d = 0; d < 3; ++d) {
       if (!gs.periodic[d] && gs.ncell[d] < 2) continue;
       grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-        double Vn[2] = {0, 0}, phin[2] = {0, 0};
+        std::size_t m[2] = {0, 0};
         bool has[2] = {false, false};
+        double Vn[2] = {0, 0};
         for (int q = 0; q < 2; ++q) {
           int idx[3] = {i, j, k};
           idx[d] += 2 * q - 1;
           if (!grid_.in_patch(idx[0], idx[1], idx[2])) continue;
-          const std::size_t m = grid_.index(idx[0], idx[1], idx[2]);
+          m[q] = grid_.index(idx[0], idx[1], idx[2]);
           has[q] = true;
-          Vn[q] = phi[2 * m + 1];
-          phin[q] = phi[2 * m];
+          Vn[q] = phi[r * m[q] + stride];
         }
-        phi_new[n] = smoothing_step(phi[2 * n + 1], phi[2 * n], Vn, phin, has);
+        for (int c = 0; c < stride; ++c) {
+          const double phin[2] = {has[0] ? phi[r * m[0] + c] : 0.0, has[1] ? phi[r * m[1] + c] : 0.0};
+          phi_new[stride * n + c] = smoothing_step(phi[r * n + stride], phi[r * n + c], Vn, phin, has);
+        }
       });
-      grid_.for_owned([&](int, int, int, std::size_t n) { phi[2 * n] = phi_new[n]; });
-      grid_.forward(phi.data(), 2);
+      grid_.for_owned([&](int, int, int, std::size_t n) {
+        for (int c = 0; c < stride; ++c) phi[r * n + c] = phi_new[stride * n + c];
+      });
+      grid_.forward(phi.data(), r);
     }
-  grid_.for_owned([&](int, int, int, std::size_t n) { a[n] = phi[2 * n] * phi[2 * n + 1]; });
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    for (int c = 0; c < stride; ++c) a[stride * n + c] = phi[r * n + c] * phi[r * n + stride];
+  });
 }
 
 // A node within one node of a grid face of a non-periodic dimension (padding nodes included).
@@ -579,14 +588,7 @@ template <int NS>
 void FluidSolver::route_reaction() {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   const double vmin = 1e-12 * opt.grid.dx * opt.grid.dx * opt.grid.dx;
-  if (opt.theta_smooth > 0.0) {
-    std::vector<double> c(grid_.size(), 0.0);
-    for (int d = 0; d < 3; ++d) {
-      grid_.for_owned([&](int, int, int, std::size_t n) { c[n] = g_.rp[3 * n + d]; });
-      smooth_node_volume(c);
-      grid_.for_owned([&](int, int, int, std::size_t n) { g_.rp[3 * n + d] = c[n]; });
-    }
-  }
+  if (opt.theta_smooth > 0.0) smooth_node_volume(g_.rp, 3);
   grid_.for_owned([&](int, int, int, std::size_t n) {
     const double V = g_.rq[3 * n];
     for (int d = 0; d < 3; ++d) {

@@ -131,7 +131,7 @@ class FluidSolver {
   void fold_to_mirror(std::vector<double> &a, int stride);
   bool near_face(int i, int j, int k) const;
   bool near_face(const int base[3], int ns) const;
-  void smooth_node_volume(std::vector<double> &a);
+  void smooth_node_volume(std::vector<double> &a, int stride = 1);
   template <class Fn> void for_nodes(const Stencil &ps, Fn &&fn) const;
 
   bool shape_of(const double *x, Stencil &ps);
