@@ -133,6 +133,11 @@ mpm::FluidSolver &FixMpmFluid::sync() {
 
 void FixMpmFluid::init() {
   const mpm::Options &o = solver->opt;
+  if (restart_time_pending) {
+    time_offset = 0.0;
+    time_offset = restart_time - sim_time();
+    restart_time_pending = false;
+  }
   if (!filled) error->all(FLERR, "Fix mpm/fluid: no material points; use keyword 'fill region-ID nx ny nz type T'");
   check_group_atoms();
   // Material points must not be integrated twice.
@@ -357,9 +362,11 @@ void FixMpmFluid::restart(char *buf) {
   if (list[R_GATE] == 0.0) solver->opt.gate.active = false;
   st.nsub = static_cast<int>(list[R_NSUB]);
   st.theta_initialized = list[R_THETA] != 0.0;
-  // LIGGGHTS' time starts again at 0 here; the fix's time goes on from the saved one
-  time_offset = 0.0;
-  time_offset = list[R_TIME] - sim_time();
+  // LIGGGHTS' time starts again at 0; the fix's time goes on from the saved one. The offset is
+  // taken at the next init(): here LIGGGHTS' timestep may not be the run's yet (a resumed run
+  // reported times 2.5e-6 s early, 250 steps of LIGGGHTS' default step)
+  restart_time = list[R_TIME];
+  restart_time_pending = true;
   point_type = static_cast<int>(list[R_TYPE]);
 }
 

@@ -82,6 +82,8 @@ class FixMpmFluid : public Fix {
   // The fix's own clock: LIGGGHTS' time restarts at 0 after read_restart, the fix's time goes on
   // (saved in the restart file); sim_time() = LIGGGHTS' time + time_offset.
   double time_offset = 0.0;
+  double restart_time = 0.0;          // the fix's time in the restart file, applied at init()
+  bool restart_time_pending = false;
   int point_type = 0;  // atom type of the material points (fill type, or from the restart file)
 };
 

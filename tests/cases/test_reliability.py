@@ -170,7 +170,7 @@ atom_modify sort 0 0
 neighbor 0.02 bin
 neigh_modify delay 0 every 1 check yes
 fix fluid all mpm/fluid cell 0.1 density 1000 bulk 2e6 viscosity 0.01 boundary all freeslip &
-    fill column 2 1 2 type 1 front x gate x 0.8 lower 0.1
+    fill column 2 1 2 type 1 front x gate x 0.8 lower 0.1 output 125 col points p
 fix grav all gravity 9.81 vector 0.0 0.0 -1.0
 timestep 2e-4
 variable steps equal 500
@@ -197,6 +197,14 @@ print "RESULT ${xf} ${ke}"
         check(a.groups() == b.groups(), f"resumed run equals the uninterrupted one (front, ke: {a.groups()} vs {b.groups()})")
     check("gate removed at time 0.1" in p2.stdout or "gate removed at time 0.1" in p0.stdout,
           "the gate opened at 0.1 s")
+    # the HDF5 series: the XDMF index of the resumed run has the uninterrupted run's times (they
+    # jumped back to 0 at the restart before)
+    def xmf_times(d):
+        with open(os.path.join(d, "col.xmf")) as f:
+            return re.findall(r'mpm-step step="(\d+)" time="([^"]+)"', f.read())
+    t0, t1 = xmf_times(d0), xmf_times(d1)
+    print(f"  XDMF (step, time) uninterrupted {t0[-3:]}, resumed {t1[-3:]}")
+    check(len(t0) == 7 and t1 == t0, "XDMF steps and times of the resumed run equal the uninterrupted run's")
 
 
 # Grains on the cut between two ranks (np 2 splits the 0.04 m box at x = 0.02), free in a fluid
