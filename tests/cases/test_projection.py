@@ -11,6 +11,7 @@ import sys
 from collections import defaultdict
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from test_archimedes import ratio as archimedes_ratio  # noqa: E402
 from cases import (check, dambreak_np2_vs_np1, driver_main, pressure_errors, read_csv,  # noqa: E402
                    rms_vs_martin_moyce)
 
@@ -94,15 +95,11 @@ def case_settling(r):
 
 
 def case_archimedes(r):
-    """A random bed held in still water (inputs/archimedes/in.bed, 150 grains) with projection:
-    the fluid force on it is Archimedes' within 2 %, mid-depth and on the floor."""
+    """A random bed held in still water (inputs/archimedes/in.bed, reduced as in test_archimedes.py)
+    with projection: the fluid force on it is Archimedes' within 2 %, mid-depth and on the floor."""
     for name, v in (("mid", {}), ("floor", {"floor": 1})):
-        v = dict({"nbeads": 150, "tsettle": 0.05, "tavg": 0.01, "pressure": "projection"}, **v)
-        d, p = r.run(f"projection_archimedes/{name}", os.path.join(r.inputs, "archimedes", "in.bed"), v)
-        m = re.search(r"RESULT ratio (\S+)", p.stdout)
-        q = float(m.group(1)) if m else float("nan")
-        print(f"  {name}: fluid force / Archimedes = {q:.4f}")
-        check(abs(q - 1.0) < 0.02, f"{name}: within 2 % of Archimedes")
+        q = archimedes_ratio(r, f"projection_{name}", pressure="projection", **v)
+        check(abs(q - 1.0) < 0.02, f"{name}: within 2 % of Archimedes ({q:.4f})")
 
 
 TMPL = """atom_style sphere
