@@ -114,7 +114,6 @@ void FluidSolver::check_grain(int k) const {
 }
 
 void FluidSolver::fluid_fraction() {
-  const GridSpec &gs = opt.grid;
   const int nlocal = pts.nlocal;
   double **x = pts.x;
   const double *radius = pts.radius;
@@ -145,15 +144,11 @@ void FluidSolver::fluid_fraction() {
   // theta by tens of per cent, and the pressure of the points next to the wall with it, by
   // K dtheta/theta). Node volumes: half a cell on the wall, full inside; a padding node takes the
   // fraction of its mirror.
-  auto mirror = [&](int c, int d) {
-    if (gs.periodic[d]) return c;
-    return c < 0 ? -c : (c > gs.ncell[d] ? 2 * gs.ncell[d] - c : c);
-  };
   fold_to_mirror(g_.sol, 1);
   grid_.reverse_sum(g_.sol.data(), 1);
   if (opt.theta_smooth > 0.0) smooth_solid_volume();
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const int mi[3] = {mirror(i, 0), mirror(j, 1), mirror(k, 2)};
+    const int mi[3] = {mirror_node(i, 0), mirror_node(j, 1), mirror_node(k, 2)};
     const double Vj = solid_node_volume(mi[0], mi[1], mi[2]);
     const std::size_t m = grid_.in_patch(mi[0], mi[1], mi[2]) ? grid_.index(mi[0], mi[1], mi[2]) : n;
     g_.th[n] = std::min(1.0, std::max(opt.theta_min, 1.0 - g_.sol[m] / Vj));  // (8-11), (8-14)
@@ -187,12 +182,19 @@ void FluidSolver::fluid_fraction() {
 // The points' density and pressure for the new fluid fraction (their volume is unchanged).
 void FluidSolver::refresh_pressure() { update_stress(0.0, true); }
 
+// The node index c along d reflected at the grid faces (padding nodes -> their mirror inside);
+// c itself in a periodic dimension and inside the grid.
+int FluidSolver::mirror_node(int c, int d) const {
+  const GridSpec &gs = opt.grid;
+  if (gs.periodic[d]) return c;
+  return c < 0 ? -c : (c > gs.ncell[d] ? 2 * gs.ncell[d] - c : c);
+}
+
 /* Walls: what is mapped to a node outside a grid face (patch, partial sums before the reverse sum)
    is folded onto its mirror node inside (reflected shape functions), one direction after the
    other, so a corner's share ends on the inside too. */
 void FluidSolver::fold_to_mirror(std::vector<double> &a, int stride) {
   const GridSpec &gs = opt.grid;
-  auto mirror = [&](int c, int d) { return c < 0 ? -c : (c > gs.ncell[d] ? 2 * gs.ncell[d] - c : c); };
   const IndexBox &pb = grid_.patch();
   for (int d = 0; d < 3; ++d) {
     if (gs.periodic[d]) continue;
@@ -206,7 +208,7 @@ void FluidSolver::fold_to_mirror(std::vector<double> &a, int stride) {
         for (int j = b.lo[1]; j <= b.hi[1]; ++j)
           for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
             int idx[3] = {i, j, k};
-            idx[d] = mirror(idx[d], d);
+            idx[d] = mirror_node(idx[d], d);
             if (!grid_.in_patch(idx[0], idx[1], idx[2])) continue;
             double *from = &a[stride * grid_.index(i, j, k)];
             double *to = &a[stride * grid_.index(idx[0], idx[1], idx[2])];
@@ -599,16 +601,11 @@ void FluidSolver::route_reaction() {
   });
   grid_.forward(g_.rq.data(), 3);
   // padding nodes take their mirror's value, as the fluid fraction does
-  const GridSpec &gs = opt.grid;
-  auto mirror = [&](int c, int d) {
-    if (gs.periodic[d]) return c;
-    return c < 0 ? -c : (c > gs.ncell[d] ? 2 * gs.ncell[d] - c : c);
-  };
   const IndexBox &pb = grid_.patch();
   for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
     for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
       for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-        const int mi[3] = {mirror(i, 0), mirror(j, 1), mirror(k, 2)};
+        const int mi[3] = {mirror_node(i, 0), mirror_node(j, 1), mirror_node(k, 2)};
         if ((mi[0] == i && mi[1] == j && mi[2] == k) || !grid_.in_patch(mi[0], mi[1], mi[2])) continue;
         const std::size_t n = grid_.index(i, j, k), m = grid_.index(mi[0], mi[1], mi[2]);
         for (int d = 0; d < 3; ++d) g_.rq[3 * n + d] = g_.rq[3 * m + d];

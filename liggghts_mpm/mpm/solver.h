@@ -128,6 +128,7 @@ class FluidSolver {
   template <int NS> void point_sums();             // grad_p weak, reaction points: WkRec
   void weak_pressure_gradient();                   // grad_p weak
   template <int NS> void route_reaction();         // reaction points
+  int mirror_node(int c, int d) const;
   void fold_to_mirror(std::vector<double> &a, int stride);
   bool near_face(int i, int j, int k) const;
   bool near_face(const int base[3], int ns) const;
