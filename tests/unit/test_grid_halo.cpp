@@ -106,19 +106,3 @@ TEST(GridHalo, PeriodicAcrossRanks) { run_case({{9, 4, 3}, {true, false, true}, 
 TEST(GridHalo, LinearNoPadding) { run_case({{8, 3, 3}, {false, false, false}, 0, 2, 0.5}); }
 
 }  // namespace
-
-int main(int argc, char **argv) {
-  MPI_Init(&argc, &argv);
-  ::testing::InitGoogleTest(&argc, argv);
-  int me;
-  MPI_Comm_rank(MPI_COMM_WORLD, &me);
-  if (me != 0) {
-    auto &listeners = ::testing::UnitTest::GetInstance()->listeners();
-    delete listeners.Release(listeners.default_result_printer());
-  }
-  int rc = RUN_ALL_TESTS();
-  int any = 0;
-  MPI_Allreduce(&rc, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  MPI_Finalize();
-  return any;
-}
