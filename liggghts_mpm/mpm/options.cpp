@@ -90,6 +90,8 @@ void parse_transfer(Options &o, Args &a, const ParseEnv &) {
 }
 
 void parse_update(Options &o, Args &a, const ParseEnv &) { choice(a, "musl", "usl", o.musl); }
+void parse_free_surface(Options &o, Args &a, const ParseEnv &) { choice(a, "ghost", "node", o.surface_ghost); }
+
 void parse_grad_p(Options &o, Args &a, const ParseEnv &) {
   a.need(1, "grad_p", "'weak', 'fit' or 'nodal'");
   if (strcmp(a.at(1), "weak") == 0)
@@ -298,11 +300,11 @@ void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
 // Keywords that belong to one pressure model only: an error under the other, naming them.
 void check_pressure_model(const Options &o, const std::vector<std::string> &seen) {
   static const char *const eos_only[] = {"bulk", "eos", "antilock", "pmin"};
-  static const char *const projection_only[] = {"tolerance", "max_iterations", "dtheta_source"};
+  static const char *const projection_only[] = {"tolerance", "max_iterations", "dtheta_source", "free_surface"};
   std::string bad;
   for (const std::string &kw : seen)
     for (const char *w : o.projection ? std::vector<const char *>(eos_only, eos_only + 4)
-                                      : std::vector<const char *>(projection_only, projection_only + 3))
+                                      : std::vector<const char *>(projection_only, projection_only + 4))
       if (kw == w && bad.find("'" + kw + "'") == std::string::npos) bad += (bad.empty() ? "'" : ", '") + kw + "'";
   if (bad.empty()) return;
   if (o.projection)
@@ -438,6 +440,8 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_max_iterations, false},
     {"dtheta_source", "yes/no", "-", "", "yes", "'yes' or 'no'",
      nullptr, 0, 0, false, false, &Options::projection_dtheta, nullptr, false},
+    {"free_surface", "ghost | node", "-", "", "ghost", "'ghost' or 'node'",
+     nullptr, 0, 0, false, false, nullptr, parse_free_surface, false},
     {"fill", "region nx ny nz type T", "-", "1..8 points per cell per direction", "required (not after read_restart)",
      "'region-ID nx ny nz type T'", nullptr, 0, 0, false, false, nullptr, parse_fill, false},
     {"hydrostatic", "axis surface g", "length, acceleration", "g >= 0", "none",

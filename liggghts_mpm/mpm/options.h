@@ -73,6 +73,7 @@ struct Options {
   bool projection = false;
   double pressure_tolerance = 1e-8;  // relative residual of the solve
   int pressure_max_iterations = 200;
+  bool surface_ghost = true;         // projection: ghost-fluid free surface (no: p = 0 at EMPTY nodes)
   bool projection_dtheta = true;     // couple: the d(theta)/dt source of the pressure equation
   // reports
   int front_axis = 0;

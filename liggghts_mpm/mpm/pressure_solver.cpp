@@ -143,7 +143,7 @@ bool PressureSolver::assemble_values(const NodeLabels &labels, const double *bet
       for (int side = -1; side <= 1; side += 2) {
         std::size_t m;
         if (!open_face(grid_, labels, i, j, k, d, side, &m)) continue;
-        const double c = geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]);
+        const double c = geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]) * surface_scale(labels, n, m);
         r[0] += c;
         int q[3] = {i, j, k};
         q[d] += side;
@@ -268,7 +268,7 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
         for (int side = -1; side <= 1; side += 2) {
           std::size_t m;
           if (open_face(grid_, labels, i, j, k, d, side, &m) && labels.kind[m] == kEmpty)
-            b += geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]) * p_empty[m];
+            b += geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]) * surface_scale(labels, n, m) * p_empty[m];
         }
     bsum += b;
     x = p[n];

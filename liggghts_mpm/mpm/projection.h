@@ -43,6 +43,8 @@ class Projection {
  private:
   void make_labels(const double *p2g, double mmin, const double *theta);
   std::size_t wall_node(int i, int j, int k) const;
+  double folded_mass(int i, int j, int k) const;
+  void extrapolate_above_surface(const double *p2g, double mmin);
   void extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const;
 
   LocalGrid &grid_;
@@ -51,6 +53,7 @@ class Projection {
   std::unique_ptr<PressureSolver> solver_;
   NodeLabels lab_;
   std::vector<double> u_, theta_, beta_, rhs_, p_, p_ext_, grad_, grad_ext_, inv_rho_;
+  std::vector<double> fold_mass_;   // node mass, owned and halos (ghost surface's fill)
   std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)
   bool have_theta_last_ = false;
   PressureResult last_;

@@ -77,6 +77,7 @@ void NodeLabels::reset(const LocalGrid &grid) {
   kind.assign(grid.size(), kFluid);
   closed.assign(grid.size(), 0);
   wall_u.clear();
+  level.clear();
   const IndexBox &pb = grid.patch();
   for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
     for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
@@ -111,6 +112,7 @@ void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm) {
     if (wall_u.empty()) wall_u.assign(3 * grid.size(), 0.0);
     grid.forward(wall_u.data(), 3);
   }
+  if (!level.empty()) grid.forward(level.data(), 1);
 }
 
 void flux_divergence(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
@@ -142,7 +144,7 @@ void apply_laplacian(const LocalGrid &grid, const NodeLabels &labels, const Proj
   grid.for_owned([&](int, int, int, std::size_t n) { out[n] = 0.0; });
   for_faces(grid, labels, geo, [&](std::size_t n, const Face &f, int, int) {
     if (labels.kind[n] != kFluid || f.wall) return;
-    out[n] += f.area * 0.5 * (beta[n] + beta[f.m]) * (p[f.m] - p[n]) * inv_dx2;
+    out[n] += f.area * 0.5 * (beta[n] + beta[f.m]) * surface_scale(labels, n, f.m) * (p[f.m] - p[n]) * inv_dx2;
   });
 }
 
@@ -154,7 +156,8 @@ void corrected_flux_divergence(const LocalGrid &grid, const NodeLabels &labels,
   for_faces(grid, labels, geo, [&](std::size_t n, const Face &f, int d, int side) {
     double flux = face_flux(labels, n, f, d, u, theta);
     // gradient along +d across the face: (p_upper - p_lower) / dx
-    if (!f.wall) flux -= dt * 0.5 * (beta[n] + beta[f.m]) * side * (p[f.m] - p[n]) * inv_dx;
+    if (!f.wall)
+      flux -= dt * 0.5 * (beta[n] + beta[f.m]) * surface_scale(labels, n, f.m) * side * (p[f.m] - p[n]) * inv_dx;
     div[n] += side * f.area * flux * inv_dx;
   });
 }
@@ -179,7 +182,7 @@ void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const do
     // at an EMPTY node only the faces to FLUID nodes: the gradient extrapolated from the fluid
     // side (a face between two EMPTY nodes carries no pressure information)
     if (!f.wall && !(labels.kind[n] == kEmpty && labels.kind[f.m] == kEmpty)) {
-      sum += side * (p[f.m] - p[n]) * inv_dx;
+      sum += side * surface_scale(labels, n, f.m) * (p[f.m] - p[n]) * inv_dx;
       ++open;
     }
     if (side > 0) grad[3 * n + d] = open ? sum / open : 0.0;

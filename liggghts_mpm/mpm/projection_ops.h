@@ -12,6 +12,7 @@
 // valid on the owned nodes and on one halo layer around them (forward() after
 // writing the owned ones); outputs are written on the owned nodes only.
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -34,6 +35,12 @@ struct NodeLabels {
   std::vector<std::uint8_t> kind;
   std::vector<std::uint8_t> closed;  // bit d: the face to index + e_d is a wall
   std::vector<double> wall_u;
+  // Ghost-fluid free surface (docs/projection.md, "Free surface"): per node the signed distance
+  // to the free surface in units of dx, positive inside the fluid (empty: p = 0 at the EMPTY
+  // nodes themselves). A face between a FLUID node n and an EMPTY node m then holds p = 0 at the
+  // fraction s_f = level_n / (level_n - level_m) of the face's length from n (at least
+  // kMinSurfaceFraction): its coefficient and gradient are divided by s_f (Gibou et al. 2002).
+  std::vector<double> level;
 
   // Every node FLUID with open faces, except the padding nodes behind the box
   // walls (indices < 0 or > ncell in non-periodic dimensions), which are SOLID.
@@ -69,6 +76,20 @@ struct ProjectionGeometry {
     return a;
   }
 };
+
+// Smallest fraction of a cell between a FLUID node and the surface (clamp of the ghost-fluid
+// coefficient 1 / s_f: at most 20x the face's own).
+constexpr double kMinSurfaceFraction = 1e-3;
+
+// 1 / s_f for a face between a FLUID and an EMPTY node when labels.level is set, 1 otherwise.
+inline double surface_scale(const NodeLabels &labels, std::size_t n, std::size_t m) {
+  if (labels.level.empty() || labels.kind[n] == labels.kind[m]) return 1.0;
+  const bool nf = labels.kind[n] == kFluid;
+  if (!nf && labels.kind[m] != kFluid) return 1.0;  // EMPTY-SOLID faces are walls anyway
+  const double lf = nf ? labels.level[n] : labels.level[m], le = nf ? labels.level[m] : labels.level[n];
+  const double s = (lf - le > 0.0) ? lf / (lf - le) : 1.0;
+  return 1.0 / std::min(1.0, std::max(kMinSurfaceFraction, s));
+}
 
 // True if the face of node (i, j, k) towards (i, j, k) + side e_d (side = -1 or
 // +1) is open: both nodes in the patch, neither SOLID, not flagged closed.

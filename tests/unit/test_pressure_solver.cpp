@@ -275,6 +275,43 @@ TEST(PressureSolver, HydrostaticBedExact) {
   EXPECT_GT(ubad, 0.1 * g * dt);
 }
 
+TEST(PressureSolver, GhostSurfaceBetweenNodesExact) {
+  // Ghost-fluid free surface (labels.level): the surface lies a fraction s of a cell above the
+  // last FLUID layer (level +s / -(1 - s) on the two layers), for several s including the clamp.
+  // The hydrostatic field with the surface at its place is then the exact discrete solution, and
+  // the fluid is at rest after the correction, through a random bed.
+  for (double s : {0.9, 0.5, 0.2, 0.01, 1e-4}) {
+    Column C(MPI_COMM_WORLD, 6);
+    Problem &P = C.P;
+    const double rho = 1000.0, g = 9.81, dt = 1e-3;
+    P.lab.level.assign(P.grid.size(), 0.0);
+    P.each_patch([&](int, int, int k, std::size_t n) {
+      P.lab.level[n] = (C.top + s - k) * 0.5;  // any positive multiple of the signed distance
+      P.u[3 * n + 2] = -g * dt;
+    });
+    mpm::pressure_rhs(P.grid, P.lab, P.geo, P.u.data(), P.theta.data(), nullptr, dt, P.rhs.data());
+    mpm::PressureSolver solver(P.grid, MPI_COMM_WORLD, tight(1e-12), P.geo);
+    const mpm::PressureResult r = solver.solve(P.lab, P.beta.data(), P.rhs.data(), P.p.data());
+    const double se = std::max(s, mpm::kMinSurfaceFraction);
+    const double zs = P.x(2, C.top) + se * (P.x(2, 1) - P.x(2, 0)), pmax = rho * g * (zs - P.x(2, 0));
+    const double err = P.max_owned([&](int, int, int k, std::size_t n) {
+      return P.lab.kind[n] == kFluid ? std::fabs(P.p[n] - rho * g * (zs - P.x(2, k))) : 0.0;
+    });
+    std::vector<double> grad(3 * P.grid.size()), inv_rho(P.grid.size(), 1.0 / rho);
+    mpm::pressure_gradient(P.grid, P.lab, P.p.data(), grad.data());
+    mpm::correct_velocity(P.grid, P.lab, grad.data(), inv_rho.data(), dt, P.u.data());
+    // FLUID nodes and the EMPTY layer above them (its velocity comes from the surface face)
+    const double umax = P.max_owned([&](int, int, int k, std::size_t n) {
+      return P.lab.kind[n] != kSolid && k <= C.top + 1 ? std::fabs(P.u[3 * n + 2]) : 0.0;
+    });
+    if (root())
+      std::printf("[ ghost    ] surface %.4g cell above the last FLUID layer: %d PCG iterations, max |p - rho g h| / p_floor = "
+                  "%.2e, max |u| / (g dt) = %.2e\n", s, r.iterations, err / pmax, umax / (g * dt));
+    EXPECT_LT(err, 1e-9 * pmax);
+    EXPECT_LT(umax, 1e-8 * g * dt);
+  }
+}
+
 TEST(PressureSolver, MovingFloorLiftsTheColumn) {
   // The floor (faces between the padding layer k = -1 and k = 0) rises at w; u* = 0.
   // theta uniform (0.6): through a bed of varying theta the fluid's speed would vary as 1 / theta.
