@@ -124,6 +124,43 @@ run {steps}
 """
 
 
+def inviscid_column_ke_rate(width, height, depth, rho=1000.0, g=9.81, terms=20000):
+    """KE / t^2 of a column released from rest at one face (inviscid, early time): p harmonic,
+    p = 0 on the top and the open face x = width, no flux through the floor and the back wall.
+    With p = rho g (h - z) + q, q = sum A_n cosh(k_n x) cos(k_n z), k_n = (2n+1) pi / (2h),
+    q(width, z) = -rho g (h - z) gives A_n cosh(k_n width) = -2 rho g / (h k_n^2); the acceleration is
+    -grad q / rho and int |grad q|^2 dV = depth int q dq/dx dz on the open face
+    = depth (h/2) sum c_n^2 k_n tanh(k_n width). Checked against a finite-difference solve
+    (tools/column_inviscid.py): 17.55 J/s^2 for the C3 column both ways."""
+    s = 0.0
+    for n in range(terms):
+        k = (2 * n + 1) * math.pi / (2 * height)
+        c = -2 * rho * g / (height * k * k)
+        s += c * c * k * math.tanh(k * width)
+    return 0.5 / rho * depth * s * height / 2
+
+
+def case_column(r):
+    """Acceptance 2 of issue #13: the released column (in.column, free-slip walls, gate removed at
+    once) reaches at least 90 % of the inviscid early-time kinetic energy at 0.01 and 0.02 s, at two
+    grids, with the finer grid closer to it."""
+    rate = inviscid_column_ke_rate(0.05, 0.1, 0.1)
+    dev = {}
+    for cells in (20, 40):
+        d, _ = r.run(f"projection_column/g{cells}", os.path.join(r.inputs, "tank", "in.column"),
+                     {"cells": cells, "pressure": "projection", "dt": 5e-5, "wallkind": "freeslip"})
+        s = read_csv(os.path.join(d, "column.csv"))
+        f = []
+        for t in (0.01, 0.02):
+            i = min(range(len(s["t"])), key=lambda j: abs(s["t"][j] - t))
+            f.append(s["ke"][i] / (rate * s["t"][i] ** 2))
+        print(f"  Grid{cells}: kinetic energy / inviscid {f[0]:.3f} at 0.01 s, {f[1]:.3f} at 0.02 s")
+        # measured (ghost surface): Grid20 1.32 / 1.38, Grid40 1.08 / 1.05; node surface 0.52 / 0.39, 0.77 / 0.72
+        check(min(f) >= 0.9, f"Grid{cells}: at least 90 % of the inviscid kinetic energy")
+        dev[cells] = max(abs(x - 1) for x in f)
+    check(dev[40] < dev[20], f"Grid40 closer to the inviscid value than Grid20 ({dev[40]:.3f} < {dev[20]:.3f})")
+
+
 def case_bad_input(r):
     """Bad projection input stops with an error naming the keyword (and the step for a failed solve)."""
     base = "cell 0.5 density 1000 fill col 2 2 2 type 1 pressure projection"
