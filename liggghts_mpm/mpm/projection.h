@@ -39,9 +39,6 @@ class Projection {
   // Takes the state of an earlier solve (s.box must hold every owned node; collective: fills
   // the halos); false (nothing changed) if it does not.
   bool load(const ProjectionState &s);
-  // volume correction of the last solve: largest excess max(0, sum S V / control volume - 1) at
-  // a FLUID node, over all ranks (0 without volume_correction)
-  double volume_excess() const { return excess_max_; }
 
   // nodal pressure of the last solve (owned nodes and halos), the padding nodes behind the box
   // walls with the pressure of the wall node in front (for interpolation to points and grains)
@@ -66,8 +63,8 @@ class Projection {
   std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)
   bool have_theta_last_ = false;
   std::vector<double> vol_;         // volume correction: sum S V with the padding folded back
-  double excess_max_ = 0.0;
   void add_volume_correction(const double *pvol, const double *theta, double h);
+  bool deep_inside(int i, int j, int k) const;
   PressureResult last_;
   MPI_Comm comm_;
 };
