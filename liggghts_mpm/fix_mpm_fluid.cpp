@@ -6,12 +6,15 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <unistd.h>
 
@@ -328,46 +331,96 @@ void FixMpmFluid::unpack_restart(int nlocal, int nth) {
 int FixMpmFluid::size_restart(int) { return NCOL + 1; }
 int FixMpmFluid::maxsize_restart() { return NCOL + 1; }
 
+/* The fix's global restart data. Format 2: R_VERSION = -2 (negative: format 1, written before
+   the pressure projection's state was kept, began with R_FILLED, 0 or 1), the fields of format 1,
+   then the state of the last pressure solve (ProjectionState::pack: a 0 when there is none).
+   Format-1 files are read as before: a `pressure projection` run resumed from one starts its
+   first solve from p = 0 without the d(theta)/dt source (a warning says so). */
 namespace {
 enum { R_FILLED, R_PMASS, R_SP0, R_SP1, R_SP2, R_CLAMPED, R_GATE, R_NSUB, R_THETA, R_TIME, R_TYPE, R_COUNT };
+constexpr double kRestartFormat = 2.0;
 }
 
 void FixMpmFluid::write_restart(FILE *fp) {
   const mpm::SolverState &st = solver->state;
-  double list[R_COUNT];
-  list[R_FILLED] = filled ? 1.0 : 0.0;
-  list[R_PMASS] = st.point_mass_ref;
-  for (int d = 0; d < 3; ++d) list[R_SP0 + d] = st.spacing[d];
-  list[R_CLAMPED] = st.n_clamped;
-  list[R_GATE] = solver->opt.gate.active ? 1.0 : 0.0;
-  list[R_NSUB] = st.nsub;
-  list[R_THETA] = st.theta_initialized ? 1.0 : 0.0;
-  list[R_TIME] = sim_time();
-  list[R_TYPE] = point_type;
+  std::vector<double> list(1 + R_COUNT);
+  double *v = list.data() + 1;
+  list[0] = -kRestartFormat;
+  v[R_FILLED] = filled ? 1.0 : 0.0;
+  v[R_PMASS] = st.point_mass_ref;
+  for (int d = 0; d < 3; ++d) v[R_SP0 + d] = st.spacing[d];
+  v[R_CLAMPED] = st.n_clamped;
+  v[R_GATE] = solver->opt.gate.active ? 1.0 : 0.0;
+  v[R_NSUB] = st.nsub;
+  v[R_THETA] = st.theta_initialized ? 1.0 : 0.0;
+  v[R_TIME] = sim_time();
+  v[R_TYPE] = point_type;
+  mpm::ProjectionState ps;
+  guarded([&] { ps = solver->projection_state(); });  // collective
+  ps.pack(list);
+  if (list.size() * sizeof(double) > static_cast<std::size_t>(INT_MAX))
+    error->all(FLERR, "Fix mpm/fluid: the pressure-projection state of this grid exceeds the 2 GB of a LIGGGHTS "
+                      "restart record; write no restart files (or use a coarser 'cell')");
   if (comm->me == 0) {
-    int size = R_COUNT * sizeof(double);
+    int size = static_cast<int>(list.size() * sizeof(double));
     fwrite(&size, sizeof(int), 1, fp);
-    fwrite(list, sizeof(double), R_COUNT, fp);
+    fwrite(list.data(), sizeof(double), list.size(), fp);
   }
 }
 
 void FixMpmFluid::restart(char *buf) {
   const double *list = reinterpret_cast<const double *>(buf);
+  const bool format1 = list[0] >= 0.0;  // R_FILLED first
+  if (!format1 && list[0] != -kRestartFormat) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: the restart file's fix data has format " << -list[0] << "; this build reads formats 1 and "
+       << kRestartFormat << " (write the restart file again with the build that will read it)";
+    error->all(FLERR, os.str().c_str());
+  }
+  const double *v = format1 ? list : list + 1;
   mpm::SolverState &st = solver->state;
-  filled = list[R_FILLED] != 0.0;
-  st.point_mass_ref = list[R_PMASS];
-  for (int d = 0; d < 3; ++d) st.spacing[d] = list[R_SP0 + d];
-  st.n_clamped = list[R_CLAMPED];
+  filled = v[R_FILLED] != 0.0;
+  st.point_mass_ref = v[R_PMASS];
+  for (int d = 0; d < 3; ++d) st.spacing[d] = v[R_SP0 + d];
+  st.n_clamped = v[R_CLAMPED];
   // a gate removed before the restart stays removed
-  if (list[R_GATE] == 0.0) solver->opt.gate.active = false;
-  st.nsub = static_cast<int>(list[R_NSUB]);
-  st.theta_initialized = list[R_THETA] != 0.0;
+  if (v[R_GATE] == 0.0) solver->opt.gate.active = false;
+  st.nsub = static_cast<int>(v[R_NSUB]);
+  st.theta_initialized = v[R_THETA] != 0.0;
   // LIGGGHTS' time starts again at 0; the fix's time goes on from the saved one. The offset is
   // taken at the next init(): here LIGGGHTS' timestep may not be the run's yet (a resumed run
   // reported times 2.5e-6 s early, 250 steps of LIGGGHTS' default step)
-  restart_time = list[R_TIME];
+  restart_time = v[R_TIME];
   restart_time_pending = true;
-  point_type = static_cast<int>(list[R_TYPE]);
+  point_type = static_cast<int>(v[R_TYPE]);
+  // the last pressure solve (warm start, the grains' gradient, theta for d(theta)/dt)
+  st.projection = mpm::ProjectionState();
+  if (format1) {
+    if (solver->opt.projection && comm->me == 0)
+      error->warning(FLERR, "Fix mpm/fluid: the restart file (format 1) holds no pressure-projection state: the first "
+                            "pressure solve starts from p = 0 without the d(theta)/dt source, so the resumed run "
+                            "differs from an uninterrupted one to the solver tolerance");
+    return;
+  }
+  mpm::ProjectionState ps;
+  guarded([&] { ps.unpack(v + R_COUNT); });
+  if (!ps.valid || !solver->opt.projection) return;
+  const mpm::GridSpec &gs = solver->opt.grid;
+  bool fits = true;
+  for (int d = 0; d < 3; ++d) fits = fits && ps.box.lo[d] == gs.node_lo(d) && ps.box.hi[d] == gs.node_hi(d);
+  if (!fits) {
+    if (comm->me == 0) {
+      std::ostringstream os;
+      os << "Fix mpm/fluid: the restart file's pressure state is for grid nodes " << ps.box.lo[0] << ".." << ps.box.hi[0]
+         << " x " << ps.box.lo[1] << ".." << ps.box.hi[1] << " x " << ps.box.lo[2] << ".." << ps.box.hi[2]
+         << ", this fix's grid has " << gs.node_lo(0) << ".." << gs.node_hi(0) << " x " << gs.node_lo(1) << ".."
+         << gs.node_hi(1) << " x " << gs.node_lo(2) << ".." << gs.node_hi(2)
+         << " (keyword 'cell' or 'grid' changed): the first pressure solve starts from p = 0";
+      error->warning(FLERR, os.str().c_str());
+    }
+    return;
+  }
+  st.projection = std::move(ps);
 }
 
 double FixMpmFluid::memory_usage() {

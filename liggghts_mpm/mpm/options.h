@@ -75,6 +75,7 @@ struct Options {
   int pressure_max_iterations = 200;
   bool surface_ghost = true;         // projection: ghost-fluid free surface (no: p = 0 at EMPTY nodes)
   bool projection_dtheta = true;     // couple: the d(theta)/dt source of the pressure equation
+  double volume_correction = 0.0;    // 1/time: rate at which compressed points are pushed apart (0: off)
   // reports
   int front_axis = 0;
   int height_axis = 2, wall_axis = 0;

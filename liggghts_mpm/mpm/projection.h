@@ -17,6 +17,8 @@
 
 namespace mpm {
 
+struct ProjectionState;
+
 class Projection {
  public:
   // grid: the solver's patch (set up); collective over comm.
@@ -26,10 +28,17 @@ class Projection {
   // mass p2g M <= mmin: those become EMPTY nodes, p = 0). On return V_NEW holds the corrected,
   // wall-conditioned velocity at the owned nodes (not forwarded). theta: nodal fluid fraction
   // (null: 1); dtheta: the d(theta)/dt source with theta of the last solve (none at the first).
-  // Throws
-  // mpm::Error naming the step if the solve does not converge.
+  // pvol: sum S V of the points per node (owned nodes, after the reverse sum), for the
+  // volume correction (keyword volume_correction; null: none). Throws mpm::Error naming the
+  // step if the solve does not converge.
   void project(double *vel, const double *p2g, double mmin, const double *theta, bool dtheta, double h,
-               Boundaries &bc, long step);
+               Boundaries &bc, long step, const double *pvol = nullptr);
+
+  // The state of the last solve on this rank's owned nodes (ProjectionState, solver.h).
+  void save(ProjectionState &s) const;
+  // Takes the state of an earlier solve (s.box must hold every owned node; collective: fills
+  // the halos); false (nothing changed) if it does not.
+  bool load(const ProjectionState &s);
 
   // nodal pressure of the last solve (owned nodes and halos), the padding nodes behind the box
   // walls with the pressure of the wall node in front (for interpolation to points and grains)
@@ -56,6 +65,9 @@ class Projection {
   std::vector<double> fold_mass_;   // node mass, owned and halos (ghost surface's fill)
   std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)
   bool have_theta_last_ = false;
+  std::vector<double> vol_;         // volume correction: sum S V with the padding folded back
+  void add_volume_correction(const double *pvol, const double *theta, double h);
+  bool deep_inside(int i, int j, int k) const;
   PressureResult last_;
   MPI_Comm comm_;
 };

@@ -86,11 +86,39 @@ double FluidSolver::init_point(const double x[3], double vol, double *s) const {
 
 void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], double skin) {
   const int halo = support(opt.shape) + static_cast<int>(std::ceil(skin / opt.grid.dx)) + 1;
+  // projection: the last solve goes on into the new patch (the warm start, the grains' pressure
+  // gradient, the d(theta)/dt source), so that run N; run M equals run N+M: from the old
+  // Projection (its owned box, or the whole grid if a rank's box changed), else from a
+  // restart file
+  ProjectionState last;
+  if (opt.projection && proj_) proj_->save(last);
   grid_.setup(opt.grid, comm_, sublo, subhi, halo);
   g_.assign(grid_.size(), opt.musl, opt.coupled, opt.theta_transport);
   th_prev_valid_ = false;
-  if (opt.projection) proj_.reset(new Projection(grid_, comm_, opt));
+  if (opt.projection) {
+    proj_.reset(new Projection(grid_, comm_, opt));
+    if (last.valid) {
+      const IndexBox &ob = grid_.owned();
+      int same = 1, all = 0;
+      for (int d = 0; d < 3; ++d)
+        if (ob.lo[d] != last.box.lo[d] || ob.hi[d] != last.box.hi[d]) same = 0;
+      MPI_Allreduce(&same, &all, 1, MPI_INT, MPI_MIN, comm_);
+      if (!all) last = gather_global(last, opt.grid, comm_);
+      proj_->load(last);
+    } else if (state.projection.valid) {
+      proj_->load(state.projection);
+    }
+    state.projection = ProjectionState();  // read once
+  }
   grid_ready_ = true;
+}
+
+ProjectionState FluidSolver::projection_state() {
+  if (!opt.projection) return ProjectionState();
+  if (!proj_) return state.projection;
+  ProjectionState local;
+  proj_->save(local);
+  return gather_global(local, opt.grid, comm_);
 }
 
 void FluidSolver::step() {
@@ -222,15 +250,33 @@ void FluidSolver::update_grid(double h) {
     if (!opt.projection) bc.apply(vnew, i, j, k, h);
     for (int d = 0; d < 3; ++d) gv[VelRec::V_NEW + d] = vnew[d];
   });
-  if (opt.projection)
+  if (opt.projection) {
+    const bool vc = opt.volume_correction > 0.0;
+    if (vc) point_volume_to_grid();
     proj_->project(g_.vel.data(), g_.p2g.data(), mmin, opt.coupled ? g_.th.data() : nullptr, opt.projection_dtheta, h,
-                   bc, clock.step);
+                   bc, clock.step, vc ? pvol_.data() : nullptr);
+  }
   grid_.forward(g_.vel.data(), VelRec::N);
 }
 
 /* projection with couple: the grains feel the nodal pressure gradient of the last solve, the
    discrete gradient the fluid felt (grad_p weak's array, read by couple_kernel) */
 void FluidSolver::projection_gradient_to_grains() { g_.gw = proj_->gradient(); }
+
+/* projection + volume_correction: the points' volume on the grid, sum S V with V = m / (theta
+   rho0) (the volume a point holds, with this sub-step's theta), owned nodes after the reverse sum */
+void FluidSolver::point_volume_to_grid() {
+  pvol_.assign(grid_.size(), 0.0);
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  with_stencil(opt.shape, [&](auto ns) {
+    for (const int i : plist_) {
+      const double V = pts.rmass[i] / (pts.state[i][C_THETA] * opt.rho0);
+      for_stencil<decltype(ns)::value>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double,
+                                                               double, double) { pvol_[n] += w * V; });
+    }
+  });
+  grid_.reverse_sum(pvol_.data(), 1);
+}
 
 /* projection: the points' pressure (state column C_P, for output and f_ID[10]) interpolated
    from the nodal pressure of the solve */

@@ -42,6 +42,26 @@ struct Clock {
   double dt = 0.0;    // host time step
 };
 
+// pressure projection: what the next fluid step reads of the last solve (restart files, a new
+// grid patch at the next run): the nodal pressure (the solve's warm start), its nodal gradient
+// (the grains' pressure force of the next step) and theta of the last solve (the d(theta)/dt
+// source), on a box of global node indices, i fastest. Written by Projection::save, read by
+// Projection::load (mpm/projection.cpp, like the functions below).
+struct ProjectionState {
+  bool valid = false;
+  IndexBox box;                  // the nodes held: one rank's owned box, or the whole grid
+  bool have_theta_last = false;  // theta_last holds values (couple, after the first solve)
+  int iterations = 0;            // of the last solve (f_ID[16], f_ID[17])
+  double residual = 0.0;
+  std::vector<double> p, grad, theta_last;  // 1, 3, 1 per node of box
+  // appends the restart block (doubles); unpack reads one at in and returns the doubles read
+  void pack(std::vector<double> &out) const;
+  std::size_t unpack(const double *in);
+};
+// The states of all ranks (their owned boxes) as one state on the whole grid, node_lo..node_hi of
+// spec, on every rank (collective over comm; values copied, not summed).
+ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec, MPI_Comm comm);
+
 // The solver's state that a restart must keep.
 struct SolverState {
   double point_mass_ref = 0.0;    // typical point mass, for the nodal mass threshold
@@ -49,6 +69,7 @@ struct SolverState {
   double n_clamped = 0;           // points put back inside a wall (cumulative)
   int nsub = 1;                   // fluid sub-steps per step (last check)
   bool theta_initialized = false; // fluid mass reduced by the grains' volume once
+  ProjectionState projection;     // from a restart file, until the grid is set up (whole grid)
 };
 
 class FluidSolver {
@@ -76,6 +97,9 @@ class FluidSolver {
   void setup_grid(const double sublo[3], const double subhi[3], double skin);
   bool grid_ready() const { return grid_ready_; }
   const IndexBox &patch() const { return grid_.patch(); }
+  // pressure projection: the state of the last solve on the whole grid (collective), for the
+  // restart file; before the grid is set up, the one read from a restart file (or none)
+  ProjectionState projection_state();
   // First run with grains: the fluid mass reduced to theta rho0 V once; later runs: the nodes'
   // fraction of the grains' present positions (theta_transport).
   void setup_coupling();
@@ -108,6 +132,7 @@ class FluidSolver {
   void couple_fluid_grains(double h);  // coupling: pressure fit, drag exchange (8-25)-(8-29)
   void update_grid(double h);       // (8-35), (8-36), boundary conditions (projection: u*, solve, correction)
   void interpolate_pressure();      // projection: the points' pressure from the nodes
+  void point_volume_to_grid();      // projection + volume_correction: sum S V of the points
   void projection_gradient_to_grains();  // projection + couple: grad p for the grains
   void grid_to_particles();         // G2P (8-37)-(8-40)
   void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
@@ -167,6 +192,7 @@ class FluidSolver {
   void check_grain(int k) const;      // finite position, velocity, radius, mass (fluid_fraction)
   std::unique_ptr<Hdf5Series> series_;
   std::unique_ptr<Projection> proj_;  // pressure projection (opt.projection)
+  std::vector<double> pvol_;          // volume_correction: sum S V of the points per node
   double vmax_ = 0.0;                 // |v|max of the points at the last time-step check
   long last_output_step_ = -1;
 };
