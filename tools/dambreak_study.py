@@ -8,13 +8,16 @@ computes the RMS front and wall-height errors (units of the column width a)
 with tools/dambreak_error.errors().
 
   tools/python tools/dambreak_study.py [--out dambreak-study] [--cells 16 24 32]
-        [--bulk 2e7 2.2e9] [--floor noslip] [--transfer apic] [--tend 3]
+        [--bulk 2e7 2.2e9] [--projection] [--floor noslip] [--transfer apic] [--tend 3]
         [--np N] [--jobs J] [--skip-existing] [--quick]
 
 Time step: automatic (the input's dtfactor*dx/(c + 2 sqrt(g h))) for the weakly
 compressible bulk moduli, an explicit --dt-stiff (default 1e-5 s, as in the
 dissertation) for bulk moduli >= --stiff-bulk (default 1e9 Pa, i.e. real
 water, 2.2e9 Pa); --dt forces one explicit step for every case.
+
+--projection adds the incompressible model (`-var pressure projection`, no bulk modulus; listed
+with bulk 0 in results.csv and as "projection" in the tables and plots).
 
 Writes <out>/results.csv, results.md, error_vs_walltime.png and fronts.png and
 prints the table. --quick: cells 8 12 16, tend 1.0, weak bulk only.
@@ -56,12 +59,19 @@ def say(*args):
 
 
 def bulk_label(k):
+    if k == 0:
+        return "projection"
     s = "%.3g" % k
     return s.replace("e+0", "e").replace("e+", "e")
 
 
+def model_label(k):
+    return "projection" if k == 0 else "K = %s Pa" % bulk_label(k)
+
+
 def case_name(c):
-    name = "MPM%d_K%s_%s" % (c["cells"], bulk_label(c["bulk"]), c["floor"])
+    model = "projection" if c["bulk"] == 0 else "K" + bulk_label(c["bulk"])
+    name = "MPM%d_%s_%s" % (c["cells"], model, c["floor"])
     if c["pass_transfer"]:
         name += "_" + re.sub(r"[^A-Za-z0-9.]+", "", c["transfer"].replace(" ", "-"))
     return name
@@ -147,8 +157,9 @@ def run_case(c, a, defaults):
     if a.np > 1:
         cmd += ["mpirun", "--allow-run-as-root", "--oversubscribe", "-np", str(a.np)]
     cmd += [os.path.abspath(a.exe), "-in", "in.dambreak", "-echo", "none", "-screen", "none",
-            "-var", "cells", str(c["cells"]), "-var", "bulk", repr(c["bulk"]),
+            "-var", "cells", str(c["cells"]),
             "-var", "floor", c["floor"], "-var", "tend", repr(c["tend"]), "-var", "h5every", "0"]
+    cmd += ["-var", "pressure", "projection"] if c["bulk"] == 0 else ["-var", "bulk", repr(c["bulk"])]
     if c["dt_in"] > 0:
         cmd += ["-var", "dt", repr(c["dt_in"])]
     if c["pass_transfer"]:
@@ -200,11 +211,11 @@ def write_outputs(rows, cases, a, width, g):
         w.writeheader()
         for r in rows:
             w.writerow({k: ("" if r.get(k) is None else r[k]) for k in COLUMNS})
-    head = ["case", "cells", "bulk (Pa)", "floor", "transfer", "dt (s)", "points", "steps", "wall (s)",
+    head = ["case", "cells", "bulk (Pa) or model", "floor", "transfer", "dt (s)", "points", "steps", "wall (s)",
             "front RMS / a", "height RMS / a", "status"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
-        vals = [r["case"], str(r["cells"]), "%.3g" % r["bulk"], r["floor"], r["transfer"],
+        vals = [r["case"], str(r["cells"]), bulk_label(r["bulk"]), r["floor"], r["transfer"],
                 fmt(r["dt"], "%.3g"), fmt(r["points"], "%d"), fmt(r["steps_if_known"], "%d"),
                 fmt(r["wall_s"], "%.1f"), fmt(r["front_rms_a"], "%.4f"), fmt(r["height_rms_a"], "%.4f"),
                 r["status"] + ((": " + r["message"]) if r["message"] else "")]
@@ -244,7 +255,7 @@ def plots(rows, cases, a, width, g):
                      and math.isfinite(r["front_rms_a"])], key=lambda r: r["cells"])
         if not ok:
             continue
-        lab = "K = %s Pa" % bulk_label(bulk) + ("" if len(groups) == 1 else ", %s%s" % (
+        lab = model_label(bulk) + ("" if len(groups) == 1 else ", %s%s" % (
             floor, (", " + transfer) if transfer else ""))
         for ax, col in zip(axes, ("front_rms_a", "height_rms_a")):
             x = [r["wall_s"] for r in ok]
@@ -287,7 +298,7 @@ def plots(rows, cases, a, width, g):
             except Exception:  # noqa: BLE001
                 continue
             T = d["t"] * math.sqrt(g / width)
-            lab = "MPM%d, K = %s" % (r["cells"], bulk_label(bulk))
+            lab = "MPM%d, %s" % (r["cells"], model_label(bulk))
             if len(groups) > len({k[0] for k in groups}):
                 lab += ", %s%s" % (floor, (", " + transfer) if transfer else "")
             if r["status"] != "ok":
@@ -323,6 +334,7 @@ def main():
     ap.add_argument("--out", default="dambreak-study", help="output folder (default ./dambreak-study)")
     ap.add_argument("--cells", type=int, nargs="+", default=[16, 24, 32])
     ap.add_argument("--bulk", type=float, nargs="+", default=[2.0e7, 2.2e9], help="bulk moduli (Pa)")
+    ap.add_argument("--projection", action="store_true", help="also run 'pressure projection' (incompressible)")
     ap.add_argument("--floor", choices=["noslip", "freeslip"], default="noslip")
     ap.add_argument("--transfer", nargs="+", default=None,
                     help="passed as -var transfer (e.g. apic, pic, flip 0.99); default: the input's")
@@ -352,7 +364,9 @@ def main():
     pass_transfer = bool(a.transfer)
 
     cases = []
-    for bulk in a.bulk:
+    for bulk in a.bulk + ([0.0] if a.projection else []):
+        if bulk < 0 or (bulk == 0 and not a.projection):
+            sys.exit("--bulk %g: a bulk modulus > 0 (Pa) is needed; for the incompressible model use --projection" % bulk)
         dt_in = a.dt if a.dt > 0 else (a.dt_stiff if bulk >= a.stiff_bulk else 0.0)
         for cells in a.cells:
             c = {"cells": cells, "bulk": bulk, "floor": a.floor, "transfer": transfer, "dt_in": dt_in,
