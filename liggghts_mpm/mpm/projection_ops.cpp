@@ -31,14 +31,32 @@ Face face_of(const LocalGrid &grid, const NodeLabels &lab, const ProjectionGeome
   return f;
 }
 
-// Calls fn(n, f, d, side) for the six faces of every owned non-SOLID node.
-template <class Fn>
-void for_faces(const LocalGrid &grid, const NodeLabels &lab, const ProjectionGeometry &geo, Fn &&fn) {
+// Calls fn(n, f, d, side) for the six faces of every owned non-SOLID node for which
+// want(i, j, k, n) holds.
+template <class Want, class Fn>
+void for_faces_if(const LocalGrid &grid, const NodeLabels &lab, const ProjectionGeometry &geo, Want &&want, Fn &&fn) {
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (lab.kind[n] == kSolid) return;
+    if (lab.kind[n] == kSolid || !want(i, j, k, n)) return;
     for (int d = 0; d < 3; ++d)
       for (int side = -1; side <= 1; side += 2) fn(n, face_of(grid, lab, geo, i, j, k, n, d, side), d, side);
   });
+}
+
+template <class Fn>
+void for_faces(const LocalGrid &grid, const NodeLabels &lab, const ProjectionGeometry &geo, Fn &&fn) {
+  for_faces_if(grid, lab, geo, [](int, int, int, std::size_t) { return true; }, fn);
+}
+
+// An EMPTY node none of whose six neighbours in the patch is FLUID (its pressure gradient is 0).
+bool empty_away_from_fluid(const LocalGrid &grid, const NodeLabels &lab, int i, int j, int k, std::size_t n) {
+  if (lab.kind[n] != kEmpty) return false;
+  for (int d = 0; d < 3; ++d)
+    for (int side = -1; side <= 1; side += 2) {
+      int q[3] = {i, j, k};
+      q[d] += side;
+      if (grid.in_patch(q[0], q[1], q[2]) && lab.kind[grid.index(q[0], q[1], q[2])] == kFluid) return false;
+    }
+  return true;
 }
 
 // Flux theta u along +d through face f of node n (see flux_divergence).
@@ -126,7 +144,14 @@ void flux_divergence(const LocalGrid &grid, const NodeLabels &labels, const Proj
 
 void pressure_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
                   const double *u, const double *theta, const double *theta_prev, double dt, double *rhs) {
-  flux_divergence(grid, labels, geo, u, theta, rhs);
+  // flux_divergence at the FLUID nodes only (the rest of rhs is 0)
+  const double inv_dx = 1.0 / grid.spec().dx;
+  grid.for_owned([&](int, int, int, std::size_t n) { rhs[n] = 0.0; });
+  for_faces_if(
+      grid, labels, geo, [&](int, int, int, std::size_t n) { return labels.kind[n] == kFluid; },
+      [&](std::size_t n, const Face &f, int d, int side) {
+        rhs[n] += side * f.area * face_flux(labels, n, f, d, u, theta) * inv_dx;
+      });
   grid.for_owned([&](int i, int j, int k, std::size_t n) {
     if (labels.kind[n] != kFluid) {
       rhs[n] = 0.0;
@@ -174,7 +199,9 @@ void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const do
   // for_faces visits the faces of a node in the order (x,-), (x,+), (y,-), ...
   double sum = 0.0;
   int open = 0;
-  for_faces(grid, labels, geo, [&](std::size_t n, const Face &f, int d, int side) {
+  for_faces_if(grid, labels, geo,
+               [&](int i, int j, int k, std::size_t n) { return !empty_away_from_fluid(grid, labels, i, j, k, n); },
+               [&](std::size_t n, const Face &f, int d, int side) {
     if (side < 0) {
       sum = 0.0;
       open = 0;
