@@ -681,12 +681,20 @@ bool WallGeometry::crosses(const double a[3], int d, double len, double *w_d) co
       if (e != d && (a[e] < t.lo[e] - eps || a[e] > t.hi[e] + eps)) out = true;
     if (out) continue;
     const int side = walls_[t.mesh].side;
+    const bool one_sided = side == SIDE_NORMAL || side == SIDE_OPPOSITE;
     const double sg = side == SIDE_OPPOSITE ? -1.0 : 1.0;
     double r[3];
     sub3(a, t.p[0], r);
     const double s0 = sg * dot3(r, t.n), s1 = s0 + sg * len * t.n[d];
-    const bool f0 = s0 >= -eps, f1 = s1 >= -eps;
-    if (f0 == f1) continue;
+    if (one_sided) {
+      const bool f0 = s0 >= -eps, f1 = s1 >= -eps;
+      if (f0 == f1) continue;
+    } else {
+      // two-sided: a node in the plane is inside the wall, cut off from both sides
+      const bool on0 = std::fabs(s0) <= eps, on1 = std::fabs(s1) <= eps;
+      if (on0 && on1) continue;
+      if (!on0 && !on1 && (s0 > 0.0) == (s1 > 0.0)) continue;
+    }
     const double f = s0 / (s0 - s1);
     double x[3] = {a[0], a[1], a[2]}, bw[3];
     x[d] += std::min(std::max(f, 0.0), 1.0) * len;

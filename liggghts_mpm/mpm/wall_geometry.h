@@ -147,8 +147,9 @@ class WallGeometry {
 
   // The pressure projection (docs/projection.md, "Mesh walls").
   // Whether the segment from a to a + len e_d (len > 0) crosses a triangle: its ends lie on
-  // different sides of the triangle's plane (an end in the plane counts as on the fluid side; for
-  // two-sided meshes the normal side) and the crossing point inside the triangle (1e-9 in
+  // different sides of the triangle's plane (one-sided meshes: an end in the plane counts as on the
+  // fluid side; two-sided meshes: an end in the plane, the other not, is a crossing, so a node in
+  // a two-sided wall is cut off on both sides) and the crossing point inside the triangle (1e-9 in
   // barycentric weights). *w_d: the wall velocity along d at the crossing (of the first such
   // triangle in the fixed order). len <= margin, else all triangles are scanned.
   bool crosses(const double a[3], int d, double len, double *w_d) const;

@@ -6,8 +6,8 @@ closed grid faces where the triangles cross them, the nodes behind the walls out
 
 CASE: rest (a water column held by a vertical and by inclined plane walls stays at rest with a
 hydrostatic pressure), piston (a floor mesh rising under a column carries it at its speed, nothing
-gets behind it), np2_vs_np1 (both on 2 ranks against 1), archimedes (a held random bed beside a mesh
-wall, eos and projection). The input is tests/data/in.projection_mesh_walls with tests/data/gate.stl.
+gets behind it), np2_vs_np1 (both on 2 ranks against 1), archimedes_eos and archimedes_projection (a held random
+bed beside a mesh wall). The input is tests/data/in.projection_mesh_walls with tests/data/gate.stl.
 """
 import os
 import re
@@ -105,6 +105,23 @@ def case_np2_vs_np1(r):
         dv = max(max(abs(a[k][i] - b[k][i]) for i in (3, 4)) for k in a)
         print(f"  {name}: np2 - np1: positions {dx:.1e} m, pressure {dp:.1e} of max, velocity {dv:.1e} m/s")
         check(dx < 1e-9 and dp < 1e-6 and dv < 1e-6, f"{name}: np2 equals np1 to the solver tolerance")
+
+
+def archimedes(r, pressure):
+    """The reduced random bed of test_archimedes.py (105 grains, cell 1.5 d, mid-depth) against a plane
+    mesh wall (inputs/archimedes/in.bed, meshwall 1: a free-slip plate 0.37 cells off a node plane,
+    the grains touching it): the fluid force on the held grains is Archimedes' within 2 %."""
+    from test_archimedes import ratio
+    q = ratio(r, f"meshwall_{pressure}", pressure=pressure, meshwall=1)
+    check(abs(q - 1.0) < 0.02, f"{pressure}: bed beside a mesh wall within 2 % of Archimedes ({q:.4f})")
+
+
+def case_archimedes_eos(r):
+    archimedes(r, "eos")
+
+
+def case_archimedes_projection(r):
+    archimedes(r, "projection")
 
 
 if __name__ == "__main__":
