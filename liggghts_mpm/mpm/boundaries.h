@@ -26,6 +26,7 @@ class Boundaries {
   // the mesh walls (none: null); the host moves their triangles, then calls walls_moved()
   void set_walls(const WallGeometry *w) { walls_ = w; }
   bool has_walls() const { return walls_ != nullptr; }
+  const WallGeometry *walls() const { return walls_; }
   // after the mesh walls moved (once per fluid step): node constraints are collected anew
   void walls_moved();
 

@@ -1,6 +1,7 @@
 // The pressure model 'projection' of fix mpm/fluid (docs/projection.md): the glue between the
 // solver's grid update and the discrete operators (projection_ops.h) and the hypre solve
-// (pressure_solver.h). Per fluid sub-step: labels from the node mass, the box walls and the gate;
+// (pressure_solver.h). Per fluid sub-step: labels from the node mass, the box walls, the gate and
+// the mesh walls;
 // u* -> solve div(beta grad p) = div(theta u*) / dt -> correction u = u* - (dt / rho) grad p ->
 // wall conditions (Boundaries::apply). Keeps p between steps for the warm start.
 #pragma once
@@ -50,7 +51,20 @@ class Projection {
   double residual() const { return last_.relative_residual; }
 
  private:
-  void make_labels(const double *p2g, double mmin, const double *theta);
+  void make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls);
+  // mesh walls: closes the faces the triangles cross (with the wall velocity), makes the nodes
+  // within 2 cells behind a one-sided wall SOLID, and fills frac_ (fluid-side share of a node's
+  // dual cell, for the surface threshold)
+  void mesh_wall_labels(const WallGeometry &walls);
+  bool behind_mesh(int i, int j, int k, std::size_t n) const;
+  // a[stride n ...] at the nodes behind mesh walls := mean over their face neighbours that are
+  // not SOLID and hold fluid (node mass above mmin; a massless node beyond the 2 cells behind a
+  // wall is EMPTY but carries nothing), then over those already filled, 3 layers; owned nodes
+  // and halos; collective
+  // grad (stride 1 only): extrapolate linearly with this nodal gradient instead
+  void extend_behind(std::vector<double> &a, int stride, const double *p2g, double mmin,
+                     const std::vector<double> *grad = nullptr);
+  void fill_wall_gradient();
   std::size_t wall_node(int i, int j, int k) const;
   double folded_mass(int i, int j, int k) const;
   void extrapolate_above_surface(const double *p2g, double mmin);
@@ -63,6 +77,8 @@ class Projection {
   NodeLabels lab_;
   std::vector<double> u_, theta_, beta_, rhs_, p_, p_ext_, grad_, grad_ext_, inv_rho_;
   std::vector<double> fold_mass_;   // node mass, owned and halos (ghost surface's fill)
+  std::vector<double> frac_, u_ext_;  // mesh walls (make_labels, project)
+  bool mesh_ = false;
   std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)
   bool have_theta_last_ = false;
   std::vector<double> vol_;         // volume correction: sum S V with the padding folded back

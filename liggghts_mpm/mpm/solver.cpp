@@ -44,8 +44,6 @@ std::string FluidSolver::check_points() {
   if (opt.theta_transport && !opt.musl)
     throw Error("Fix mpm/fluid: keyword 'theta_transport yes' needs 'update musl' (the divergence of "
                 "theta u is taken in the MUSL remap)");
-  if (opt.projection && bc.has_walls())
-    throw Error("Fix mpm/fluid: keyword 'pressure projection' does not support keyword 'mesh_wall' yet");
   if (!opt.coupled) return "";
   double dmax = 0.0, gd = 0.0;
   int overlap = 0, go = 0;

@@ -642,4 +642,109 @@ void WallGeometry::side_votes(const double *const *x, int n, double reach, long 
   }
 }
 
+// ---------------------------------------------------------------------------------------------
+// The pressure projection: closed grid faces and the nodes behind the walls
+
+namespace {
+// Barycentric weights of the projection of x onto t's plane; true if inside (tolerance tol).
+bool inside_tri(const WallGeometry::Tri &t, const double x[3], double tol, double b[3]) {
+  double ab[3], ac[3], ap[3];
+  sub3(t.p[1], t.p[0], ab);
+  sub3(t.p[2], t.p[0], ac);
+  sub3(x, t.p[0], ap);
+  const double d00 = dot3(ab, ab), d01 = dot3(ab, ac), d11 = dot3(ac, ac);
+  const double d20 = dot3(ap, ab), d21 = dot3(ap, ac);
+  const double den = d00 * d11 - d01 * d01;
+  if (!(den > 0.0)) return false;
+  b[1] = (d11 * d20 - d01 * d21) / den;
+  b[2] = (d00 * d21 - d01 * d20) / den;
+  b[0] = 1.0 - b[1] - b[2];
+  return b[0] >= -tol && b[1] >= -tol && b[2] >= -tol;
+}
+}  // namespace
+
+bool WallGeometry::crosses(const double a[3], int d, double len, double *w_d) const {
+  if (tris_.empty()) return false;
+  const std::vector<int> *cand = len <= margin_ ? candidates(a) : nullptr;
+  const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+  const double eps = 1e-9 * len;
+  double b[3];
+  b[0] = a[0];
+  b[1] = a[1];
+  b[2] = a[2];
+  b[d] += len;
+  for (int c = 0; c < ncand; ++c) {
+    const Tri &t = tris_[cand ? (*cand)[c] : c];
+    if (b[d] < t.lo[d] - eps || a[d] > t.hi[d] + eps) continue;
+    bool out = false;
+    for (int e = 0; e < 3; ++e)
+      if (e != d && (a[e] < t.lo[e] - eps || a[e] > t.hi[e] + eps)) out = true;
+    if (out) continue;
+    const int side = walls_[t.mesh].side;
+    const bool one_sided = side == SIDE_NORMAL || side == SIDE_OPPOSITE;
+    const double sg = side == SIDE_OPPOSITE ? -1.0 : 1.0;
+    double r[3];
+    sub3(a, t.p[0], r);
+    const double s0 = sg * dot3(r, t.n), s1 = s0 + sg * len * t.n[d];
+    if (one_sided) {
+      const bool f0 = s0 >= -eps, f1 = s1 >= -eps;
+      if (f0 == f1) continue;
+    } else {
+      // two-sided: a node in the plane is inside the wall, cut off from both sides
+      const bool on0 = std::fabs(s0) <= eps, on1 = std::fabs(s1) <= eps;
+      if (on0 && on1) continue;
+      if (!on0 && !on1 && (s0 > 0.0) == (s1 > 0.0)) continue;
+    }
+    const double f = s0 / (s0 - s1);
+    double x[3] = {a[0], a[1], a[2]}, bw[3];
+    x[d] += std::min(std::max(f, 0.0), 1.0) * len;
+    if (!inside_tri(t, x, 1e-9, bw)) continue;
+    *w_d = bw[0] * t.w[0][d] + bw[1] * t.w[1][d] + bw[2] * t.w[2][d];
+    return true;
+  }
+  return false;
+}
+
+int WallGeometry::node_side(const double x[3], double reach, double *dist) const {
+  *dist = reach;
+  if (tris_.empty()) return 0;
+  const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
+  const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+  // nearest distance, then the sides of the triangles at that distance (face hits first)
+  double best = reach * reach;
+  bool any = false, best_face = false;
+  for (int c = 0; c < ncand; ++c) {
+    const Tri &t = tris_[cand ? (*cand)[c] : c];
+    if (beyond_box(t, x, reach)) continue;
+    Hit h;
+    closest_point(t, x, h);
+    if (h.dist2 > best * (1.0 + 1e-9) + 1e-24) continue;
+    if (h.dist2 < best * (1.0 - 1e-9)) best_face = false;
+    best = std::min(best, h.dist2);
+    best_face = best_face || h.face;
+    any = true;
+  }
+  if (!any) return 0;
+  *dist = std::sqrt(best);
+  bool all_back = true, two_sided = false, found = false;
+  for (int c = 0; c < ncand; ++c) {
+    const Tri &t = tris_[cand ? (*cand)[c] : c];
+    if (beyond_box(t, x, reach)) continue;
+    Hit h;
+    closest_point(t, x, h);
+    if (h.dist2 > best * (1.0 + 1e-9) + 1e-24 || (best_face && !h.face)) continue;
+    found = true;
+    const int side = walls_[t.mesh].side;
+    if (side != SIDE_NORMAL && side != SIDE_OPPOSITE) {
+      two_sided = true;
+      continue;
+    }
+    double r[3];
+    sub3(x, h.p, r);
+    if (side * dot3(r, t.n) >= -5e-10 * reach) all_back = false;  // reach 2 dx: the tolerance of crosses()
+  }
+  if (!found || two_sided) return 0;
+  return all_back ? -1 : 1;
+}
+
 }  // namespace mpm

@@ -145,6 +145,19 @@ class WallGeometry {
   // votes[2 k] (normal side) and votes[2 k + 1] (opposite side), k < walls().
   void side_votes(const double *const *x, int n, double reach, long *votes) const;
 
+  // The pressure projection (docs/projection.md, "Mesh walls").
+  // Whether the segment from a to a + len e_d (len > 0) crosses a triangle: its ends lie on
+  // different sides of the triangle's plane (one-sided meshes: an end in the plane counts as on the
+  // fluid side; two-sided meshes: an end in the plane, the other not, is a crossing, so a node in
+  // a two-sided wall is cut off on both sides) and the crossing point inside the triangle (1e-9 in
+  // barycentric weights). *w_d: the wall velocity along d at the crossing (of the first such
+  // triangle in the fixed order). len <= margin, else all triangles are scanned.
+  bool crosses(const double a[3], int d, double len, double *w_d) const;
+  // Side of x with respect to the nearest triangle within 'reach': -1 behind a one-sided mesh
+  // (behind the planes of all equally near triangles; face hits first), +1 in front of one,
+  // 0 none within reach or the nearest is two-sided. *dist: the distance to it (reach if none).
+  int node_side(const double x[3], double reach, double *dist) const;
+
   int walls() const { return static_cast<int>(walls_.size()); }
   const WallSpec &wall(int k) const { return walls_[k]; }
   // Fluid side of wall k (a MeshSide other than SIDE_AUTO).
