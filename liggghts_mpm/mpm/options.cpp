@@ -90,7 +90,10 @@ void parse_transfer(Options &o, Args &a, const ParseEnv &) {
 }
 
 void parse_update(Options &o, Args &a, const ParseEnv &) { choice(a, "musl", "usl", o.musl); }
-void parse_free_surface(Options &o, Args &a, const ParseEnv &) { choice(a, "ghost", "node", o.surface_ghost); }
+void parse_free_surface(Options &o, Args &a, const ParseEnv &) {
+  choice(a, "ghost", "node", o.surface_ghost);
+  o.surface_given = true;
+}
 
 void parse_grad_p(Options &o, Args &a, const ParseEnv &) {
   a.need(1, "grad_p", "'weak', 'fit' or 'nodal'");
@@ -298,7 +301,7 @@ void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
 }
 
 // Keywords that belong to one pressure model only: an error under the other, naming them.
-void check_pressure_model(const Options &o, const std::vector<std::string> &seen) {
+void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
   static const char *const eos_only[] = {"bulk", "eos", "antilock", "pmin"};
   static const char *const projection_only[] = {"tolerance", "max_iterations", "dtheta_source", "free_surface",
                                                  "volume_correction"};
@@ -307,6 +310,15 @@ void check_pressure_model(const Options &o, const std::vector<std::string> &seen
     for (const char *w : o.projection ? std::vector<const char *>(eos_only, eos_only + 4)
                                       : std::vector<const char *>(projection_only, projection_only + 5))
       if (kw == w && bad.find("'" + kw + "'") == std::string::npos) bad += (bad.empty() ? "'" : ", '") + kw + "'";
+  // The ghost-fluid surface finds the surface from the nodal fill, which next to a mesh wall lacks
+  // the mass the B-spline puts behind it (no mirror image of a triangle): measured beside a
+  // vertical and a 30 degree mesh wall, a column at rest moved at 3.5e-3 and 6.6e-2 m/s after 1 s.
+  if (o.projection && o.surface_ghost && std::find(seen.begin(), seen.end(), "mesh_wall") != seen.end()) {
+    if (o.surface_given)
+      throw Error("Fix mpm/fluid: keyword 'free_surface ghost' does not support keyword 'mesh_wall' yet; use "
+                  "'free_surface node' (the default with mesh walls)");
+    o.surface_ghost = false;
+  }
   if (bad.empty()) return;
   if (o.projection)
     throw Error("Fix mpm/fluid: keyword 'pressure projection' does not use keyword(s) " + bad +
@@ -441,7 +453,7 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_max_iterations, false},
     {"dtheta_source", "yes/no", "-", "", "yes", "'yes' or 'no'",
      nullptr, 0, 0, false, false, &Options::projection_dtheta, nullptr, false},
-    {"free_surface", "ghost | node", "-", "", "ghost", "'ghost' or 'node'",
+    {"free_surface", "ghost | node", "-", "", "ghost (node with mesh_wall)", "'ghost' or 'node'",
      nullptr, 0, 0, false, false, nullptr, parse_free_surface, false},
     {"volume_correction", "real", "1/time", ">= 0", "0", "a rate (1/time) >= 0 at which compressed points are pushed apart",
      REAL(volume_correction), 0.0, kInf, false, true, nullptr, nullptr, false},

@@ -74,6 +74,7 @@ struct Options {
   double pressure_tolerance = 1e-8;  // relative residual of the solve
   int pressure_max_iterations = 200;
   bool surface_ghost = true;         // projection: ghost-fluid free surface (no: p = 0 at EMPTY nodes)
+  bool surface_given = false;        // free_surface given (else node with mesh walls)
   bool projection_dtheta = true;     // couple: the d(theta)/dt source of the pressure equation
   double volume_correction = 0.0;    // 1/time: rate at which compressed points are pushed apart (0: off)
   // reports
