@@ -29,8 +29,17 @@ int stencil_offsets[kEntries][3] = {{0, 0, 0}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1
 
 }  // namespace
 
+// fn(i, j, k, flat index) over a box of the grid's patch, i fastest (hypre's box order).
+template <class Fn>
+void for_box(const LocalGrid &grid, const IndexBox &b, Fn &&fn) {
+  for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+    for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+      for (int i = b.lo[0]; i <= b.hi[0]; ++i) fn(i, j, k, grid.index(i, j, k));
+}
+
 struct PressureSolver::Hypre {
-  IndexBox box;  // the owned box the grid was built on
+  IndexBox box;    // the active box the grid was built on (part of the owned box)
+  IndexBox owned;  // the owned box at that time
   bool have_box = false;
   HYPRE_StructGrid grid = nullptr;
   HYPRE_StructStencil stencil = nullptr;
@@ -77,9 +86,8 @@ PressureSolver::PressureSolver(LocalGrid &grid, MPI_Comm comm, const PressureSet
 
 PressureSolver::~PressureSolver() { h_->destroy_all(settings_.preconditioner); }
 
-void PressureSolver::build_grid() {
+void PressureSolver::build_grid(const IndexBox &ob) {
   h_->destroy_all(settings_.preconditioner);
-  const IndexBox &ob = grid_.owned();
   const GridSpec &g = grid_.spec();
   HYPRE_StructGridCreate(comm_, 3, &h_->grid);
   if (!ob.empty()) {
@@ -103,6 +111,7 @@ void PressureSolver::build_grid() {
   HYPRE_StructVectorInitialize(h_->x);
 
   h_->box = ob;
+  h_->owned = grid_.owned();
   h_->have_box = true;
   const std::size_t n = std::size_t(ob.count());
   h_->values.assign(kEntries * n, 0.0);
@@ -133,7 +142,7 @@ bool PressureSolver::unknown(const NodeLabels &labels, int i, int j, int k, std:
 bool PressureSolver::assemble_values(const NodeLabels &labels, const double *beta) {
   std::vector<double> v(h_->values.size(), 0.0);
   std::size_t row = 0;
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+  for_box(grid_, h_->box, [&](int i, int j, int k, std::size_t n) {
     double *r = &v[kEntries * row++];
     if (!unknown(labels, i, j, k, n)) {
       r[0] = 1.0;
@@ -219,12 +228,45 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
   const IndexBox &ob = grid_.owned();
   const double t0 = MPI_Wtime();
 
-  // A new decomposition (load balancing) needs a new hypre grid on every rank.
+  // The hypre grid covers the active box: the FLUID nodes' bounding box in the owned box (the
+  // whole owned extent along periodic dimensions), grown by kActiveMargin nodes so that a moving
+  // fluid does not rebuild it every step. EMPTY and SOLID nodes outside it are identity rows
+  // without couplings, so leaving them out changes nothing (tests: the same answers). A new
+  // decomposition, FLUID outside the box or a box more than twice the needed one rebuild it.
+  IndexBox need;
+  bool any_fluid = false;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (labels.kind[n] != kFluid) return;
+    const int idx[3] = {i, j, k};
+    for (int d = 0; d < 3; ++d) {
+      if (!any_fluid || idx[d] < need.lo[d]) need.lo[d] = idx[d];
+      if (!any_fluid || idx[d] > need.hi[d]) need.hi[d] = idx[d];
+    }
+    any_fluid = true;
+  });
+  int fl = any_fluid ? 1 : 0, gfl = 0;
+  MPI_Allreduce(&fl, &gfl, 1, MPI_INT, MPI_MAX, comm_);
+  IndexBox want;  // empty unless FLUID nodes (the whole owned box if there are none anywhere)
+  if (!gfl) want = ob;
+  if (any_fluid) {
+    const GridSpec &gs = grid_.spec();
+    for (int d = 0; d < 3; ++d) {
+      const bool full = gs.periodic[d] || !settings_.active_box;
+      want.lo[d] = full ? ob.lo[d] : std::max(ob.lo[d], need.lo[d] - kActiveMargin);
+      want.hi[d] = full ? ob.hi[d] : std::min(ob.hi[d], need.hi[d] + kActiveMargin);
+    }
+  }
   int moved = !h.have_box;
-  for (int d = 0; d < 3 && !moved; ++d) moved = ob.lo[d] != h.box.lo[d] || ob.hi[d] != h.box.hi[d];
+  for (int d = 0; d < 3 && !moved; ++d) moved = ob.lo[d] != h.owned.lo[d] || ob.hi[d] != h.owned.hi[d];
+  if (!moved && any_fluid) {
+    for (int d = 0; d < 3; ++d)
+      if (h.box.empty() || need.lo[d] < h.box.lo[d] || need.hi[d] > h.box.hi[d]) moved = 1;
+  }
+  if (!moved && h.box.count() > 2 * want.count() + 64) moved = 1;
   int any_moved = 0;
   MPI_Allreduce(&moved, &any_moved, 1, MPI_INT, MPI_MAX, comm_);
-  if (any_moved) build_grid();
+  if (any_moved) build_grid(want);
+  const IndexBox &ab = h.box;
 
   // Without any EMPTY node the constants are the operator's null space: the rhs is made
   // compatible (mean removed) and the FLUID node of smallest global key is held at 0,
@@ -256,7 +298,7 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
   const double dx2 = grid_.spec().dx * grid_.spec().dx;
   double bsum = 0.0;
   std::size_t row = 0;
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+  for_box(grid_, ab, [&](int i, int j, int k, std::size_t n) {
     double &b = h.bbuf[row];
     double &x = h.xbuf[row];
     ++row;
@@ -278,7 +320,7 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
     MPI_Allreduce(&bsum, &gsum, 1, MPI_DOUBLE, MPI_SUM, comm_);
     const double mean = gsum / double(gcounts[1]);
     row = 0;
-    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    for_box(grid_, ab, [&](int i, int j, int k, std::size_t n) {
       double &b = h.bbuf[row], &x = h.xbuf[row];
       ++row;
       if (labels.kind[n] != kFluid) return;
@@ -288,8 +330,8 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
     res.rhs_mean_removed = -mean / dx2;  // in the units of rhs
   }
 
-  if (!ob.empty()) {
-    int lo[3] = {ob.lo[0], ob.lo[1], ob.lo[2]}, hi[3] = {ob.hi[0], ob.hi[1], ob.hi[2]};
+  if (!ab.empty()) {
+    int lo[3] = {ab.lo[0], ab.lo[1], ab.lo[2]}, hi[3] = {ab.hi[0], ab.hi[1], ab.hi[2]};
     HYPRE_StructVectorSetBoxValues(h.b, lo, hi, h.bbuf.data());
     HYPRE_StructVectorSetBoxValues(h.x, lo, hi, h.xbuf.data());
   }
@@ -299,8 +341,8 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
   HYPRE_StructPCGGetNumIterations(h.pcg, &res.iterations);
   HYPRE_StructPCGGetFinalRelativeResidualNorm(h.pcg, &res.relative_residual);
   HYPRE_ClearAllErrors();  // a non-converged PCG sets hypre's error flag; we report it ourselves
-  if (!ob.empty()) {
-    int lo[3] = {ob.lo[0], ob.lo[1], ob.lo[2]}, hi[3] = {ob.hi[0], ob.hi[1], ob.hi[2]};
+  if (!ab.empty()) {
+    int lo[3] = {ab.lo[0], ab.lo[1], ab.lo[2]}, hi[3] = {ab.hi[0], ab.hi[1], ab.hi[2]};
     HYPRE_StructVectorGetBoxValues(h.x, lo, hi, h.xbuf.data());
   }
   const double t2 = MPI_Wtime();
@@ -316,14 +358,15 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
   }
 
   double psum = 0.0;
-  row = 0;
   grid_.for_owned([&](int, int, int, std::size_t n) {
+    if (labels.kind[n] != kFluid) p[n] = (labels.kind[n] == kEmpty && p_empty) ? p_empty[n] : 0.0;
+  });
+  row = 0;
+  for_box(grid_, ab, [&](int, int, int, std::size_t n) {
     const double x = h.xbuf[row++];
     if (labels.kind[n] == kFluid) {
       p[n] = x;
       psum += x;
-    } else {
-      p[n] = (labels.kind[n] == kEmpty && p_empty) ? p_empty[n] : 0.0;
     }
   });
   if (res.singular) {

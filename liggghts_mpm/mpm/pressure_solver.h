@@ -23,7 +23,11 @@ struct PressureSettings {
   double tolerance = 1e-8;   // relative residual ||b - A p|| / ||b|| (2-norms) at convergence
   int max_iterations = 200;  // PCG iterations
   Preconditioner preconditioner = Preconditioner::PFMG;
+  // hypre's grid covers the FLUID nodes' bounding box (grown by kActiveMargin nodes) of each
+  // rank's owned box, not the whole box (false: the whole owned box, as before)
+  bool active_box = true;
 };
+constexpr int kActiveMargin = 3;
 
 struct PressureResult {
   int iterations = 0;
@@ -71,7 +75,7 @@ class PressureSolver {
 
  private:
   struct Hypre;
-  void build_grid();
+  void build_grid(const IndexBox &box);
   bool assemble_values(const NodeLabels &labels, const double *beta);
   void setup_solver();
   bool any_periodic() const;
