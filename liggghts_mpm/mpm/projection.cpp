@@ -96,24 +96,28 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
    reflection at the walls would give. Without it the nodes next to a wall read a fill 1-3 % low,
    the ghost surface sits lower there and a column at rest starts to circulate (F1: 0.02 m/s after
    1 s, docs/projection.md). Reads fold_mass_ on the owned nodes and halos. */
-double Projection::folded_mass(int i, int j, int k) const {
+double Projection::folded_mass(int i, int j, int k) const { return mirror_sum(fold_mass_, i, j, k); }
+
+/* a at node (i, j, k) plus a at its mirror images behind the box walls (reflected at each
+   non-periodic grid face, corners too), those of them that lie in the patch: the share a
+   B-spline gave to the padding nodes, counted at the node inside. a: owned values and halos. */
+double Projection::mirror_sum(const std::vector<double> &a, int i, int j, int k) const {
   const GridSpec &gs = opt_.grid;
   const int idx[3] = {i, j, k};
-  int img[3][3], nimg[3];
+  int img[3][3], cnt[3];  // per direction: the node's index and its mirror images in the padding
   for (int d = 0; d < 3; ++d) {
-    nimg[d] = 0;
-    img[d][nimg[d]++] = idx[d];
+    img[d][0] = idx[d];
+    cnt[d] = 1;
     if (gs.periodic[d]) continue;
-    if (idx[d] > 0) img[d][nimg[d]++] = -idx[d];                                  // behind the low wall
-    if (idx[d] < gs.ncell[d]) img[d][nimg[d]++] = 2 * gs.ncell[d] - idx[d];      // behind the high wall
+    if (idx[d] > 0 && -idx[d] >= gs.node_lo(d)) img[d][cnt[d]++] = -idx[d];
+    if (idx[d] < gs.ncell[d] && 2 * gs.ncell[d] - idx[d] <= gs.node_hi(d)) img[d][cnt[d]++] = 2 * gs.ncell[d] - idx[d];
   }
-  double m = 0.0;
-  for (int a = 0; a < nimg[0]; ++a)
-    for (int b = 0; b < nimg[1]; ++b)
-      for (int c = 0; c < nimg[2]; ++c)
-        if (grid_.in_patch(img[0][a], img[1][b], img[2][c]))
-          m += fold_mass_[grid_.index(img[0][a], img[1][b], img[2][c])];
-  return m;
+  double sum = 0.0;
+  for (int c = 0; c < cnt[2]; ++c)
+    for (int b = 0; b < cnt[1]; ++b)
+      for (int q = 0; q < cnt[0]; ++q)
+        if (grid_.in_patch(img[0][q], img[1][b], img[2][c])) sum += a[grid_.index(img[0][q], img[1][b], img[2][c])];
+  return sum;
 }
 
 /* Mesh walls (docs/projection.md, "Mesh walls"). A grid face whose segment between its two nodes
@@ -450,20 +454,7 @@ void Projection::add_volume_correction(const double *pvol, const double *theta, 
   const double dx = gs.dx, dx3 = dx * dx * dx, a = std::min(opt_.volume_correction * h, 1.0);
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] != kFluid) return;
-    const int idx[3] = {i, j, k};
-    int img[3][3], cnt[3];  // per direction: the node's index and its mirror images in the padding
-    for (int d = 0; d < 3; ++d) {
-      img[d][0] = idx[d];
-      cnt[d] = 1;
-      if (gs.periodic[d]) continue;
-      if (idx[d] > 0 && -idx[d] >= gs.node_lo(d)) img[d][cnt[d]++] = -idx[d];
-      if (idx[d] < gs.ncell[d] && 2 * gs.ncell[d] - idx[d] <= gs.node_hi(d)) img[d][cnt[d]++] = 2 * gs.ncell[d] - idx[d];
-    }
-    double sum = 0.0;
-    for (int c = 0; c < cnt[2]; ++c)
-      for (int b = 0; b < cnt[1]; ++b)
-        for (int q = 0; q < cnt[0]; ++q)
-          if (grid_.in_patch(img[0][q], img[1][b], img[2][c])) sum += vol_[grid_.index(img[0][q], img[1][b], img[2][c])];
+    const double sum = mirror_sum(vol_, i, j, k);
     const double cv = geo_.volume(i, j, k);
     const double e = sum / (dx3 * cv) - 1.0;
     if (e < 0.0 && !deep_inside(i, j, k)) return;  // a partly filled node under the surface

@@ -67,6 +67,7 @@ class Projection {
   void fill_wall_gradient();
   std::size_t wall_node(int i, int j, int k) const;
   double folded_mass(int i, int j, int k) const;
+  double mirror_sum(const std::vector<double> &a, int i, int j, int k) const;
   void extrapolate_above_surface(const double *p2g, double mmin);
   void extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const;
 
