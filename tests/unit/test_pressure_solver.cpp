@@ -18,6 +18,7 @@
 #include "mpm/grid.h"
 #include "mpm/pressure_solver.h"
 #include "mpm/projection_ops.h"
+#include "mpi_test_util.h"
 
 namespace {
 
@@ -27,16 +28,8 @@ using mpm::kSolid;
 
 const double kPi = 3.14159265358979323846;
 
-int rank_of(MPI_Comm c) {
-  int r;
-  MPI_Comm_rank(c, &r);
-  return r;
-}
-int size_of(MPI_Comm c) {
-  int s;
-  MPI_Comm_size(c, &s);
-  return s;
-}
+using mpm_test::rank_of;
+using mpm_test::size_of;
 bool root() { return rank_of(MPI_COMM_WORLD) == 0; }
 
 // Deterministic value in [0, 1) of a global node (and a seed): the same on
@@ -63,18 +56,7 @@ struct Problem {
   std::vector<double> beta, theta, rhs, p, pe, u;
 
   Problem(const mpm::GridSpec &spec, MPI_Comm c, double split = 0.5, bool half_cells = true) : g(spec), comm(c) {
-    const int me = rank_of(c), np = size_of(c);
-    double lo[3], hi[3];
-    for (int d = 0; d < 3; ++d) {
-      lo[d] = g.origin[d];
-      hi[d] = g.upper(d);
-    }
-    const double L = g.upper(0) - g.origin[0];
-    const double f0 = np == 2 ? (me == 0 ? 0.0 : split) : double(me) / np;
-    const double f1 = np == 2 ? (me == 0 ? split : 1.0) : double(me + 1) / np;
-    lo[0] = g.origin[0] + f0 * L;
-    hi[0] = g.origin[0] + f1 * L;
-    grid.setup(g, c, lo, hi, 2);
+    mpm_test::setup_slabs(grid, g, c, split, 2);
     geo.spec = g;
     geo.half_cells = half_cells;
     lab.reset(grid);

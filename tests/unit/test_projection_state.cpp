@@ -11,19 +11,12 @@
 #include "mpm/options.h"
 #include "mpm/projection.h"
 #include "mpm/solver.h"
+#include "mpi_test_util.h"
 
 namespace {
 
-int size_of(MPI_Comm c) {
-  int s;
-  MPI_Comm_size(c, &s);
-  return s;
-}
-int rank_of(MPI_Comm c) {
-  int r;
-  MPI_Comm_rank(c, &r);
-  return r;
-}
+using mpm_test::rank_of;
+using mpm_test::size_of;
 
 mpm::GridSpec spec(bool periodic_y) {
   mpm::GridSpec g;
@@ -37,18 +30,7 @@ mpm::GridSpec spec(bool periodic_y) {
 
 // slabs along x, rank 0 up to split of the length (2 ranks)
 void setup(mpm::LocalGrid &grid, const mpm::GridSpec &g, double split) {
-  const int me = rank_of(MPI_COMM_WORLD), np = size_of(MPI_COMM_WORLD);
-  double lo[3], hi[3];
-  for (int d = 0; d < 3; ++d) {
-    lo[d] = g.origin[d];
-    hi[d] = g.upper(d);
-  }
-  const double L = g.upper(0) - g.origin[0];
-  const double f0 = np == 2 ? (me == 0 ? 0.0 : split) : double(me) / np;
-  const double f1 = np == 2 ? (me == 0 ? split : 1.0) : double(me + 1) / np;
-  lo[0] = g.origin[0] + f0 * L;
-  hi[0] = g.origin[0] + f1 * L;
-  grid.setup(g, MPI_COMM_WORLD, lo, hi, 3);
+  mpm_test::setup_slabs(grid, g, MPI_COMM_WORLD, split, 3);
 }
 
 double field(int i, int j, int k, int c) { return 1000.0 * c + 100.0 * i + 10.0 * j + k + 0.25; }
