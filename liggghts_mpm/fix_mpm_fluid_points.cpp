@@ -11,6 +11,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -117,6 +119,18 @@ void FixMpmFluid::exclude_points_from_pairs() {
         T + " 1.." + std::to_string(atom->ntypes) + ")\n");
 }
 
+/* The memory this process may use: the machine's physical memory, or the container's limit
+   (cgroup v2 memory.max, cgroup v1 memory.limit_in_bytes) where that is smaller. 0 if unknown. */
+static double usable_memory_bytes() {
+  double mem = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  for (const char *path : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"}) {
+    std::ifstream in(path);
+    double limit = 0.0;
+    if (in >> limit && limit > 0.0 && (mem <= 0.0 || limit < mem)) mem = limit;  // "max" fails to parse: no limit
+  }
+  return mem;
+}
+
 /* Before creating the points: an upper estimate of their number (the cells of the grid within the
    region's bounding box, times the points per cell) against half of the machine's physical memory,
    so that 'cell 0.002' in a 1 m box stops with a message instead of dying in the allocator. */
@@ -134,12 +148,22 @@ void FixMpmFluid::check_fill_memory(Region *region, const int lo[3], const int h
     }
     ncells *= std::max(0.0, b - a + 1.0);
   }
-  double npts = ncells * o.fill_ppc[0] * o.fill_ppc[1] * o.fill_ppc[2], total = 0.0;
+  double npts = ncells * o.fill_ppc[0] * o.fill_ppc[1] * o.fill_ppc[2], total = 0.0, most = 0.0;
   MPI_Allreduce(&npts, &total, 1, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(&npts, &most, 1, MPI_DOUBLE, MPI_MAX, world);
+  // LIGGGHTS counts a rank's atoms in an int, whatever the memory
+  if (most > static_cast<double>(std::numeric_limits<int>::max())) {
+    std::ostringstream os;
+    os.precision(3);
+    os << "Fix mpm/fluid: keyword 'fill' would create up to " << most << " material points on one rank (keyword 'cell' "
+       << gs.dx << ", " << o.fill_ppc[0] << "x" << o.fill_ppc[1] << "x" << o.fill_ppc[2]
+       << " per cell), more than LIGGGHTS' 2147483647 atoms per rank; use a larger cell, fewer points per cell or more ranks";
+    error->all(FLERR, os.str().c_str());
+  }
   // bytes per point: LIGGGHTS' per-atom arrays (sphere style, neighbour bins) and the fix's state
   // and shape records, about 1 kB; the ranks of one node share its memory
   const double per_point = 1024.0;
-  const double mem = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGESIZE));
+  const double mem = usable_memory_bytes();
   if (mem > 0.0 && total * per_point > 0.5 * mem) {
     std::ostringstream os;
     os.precision(3);

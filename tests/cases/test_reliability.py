@@ -330,17 +330,18 @@ run 1
     err = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
     check(p.returncode != 0 and "restart file" in err and "not material points" not in err,
           f"restart without the fix's state -> message about the restart file ({err.strip()[:200]})")
-    # cell 0.002 in a 1 m box: 1.25e8 cells, 2 points per cell; output redirected to a file
+    # cell 0.0005 in a 1 m box: 8e9 cells, 2 points per cell = 1.6e10 points, more than any machine's
+    # memory and more than LIGGGHTS' int count of a rank's atoms; output redirected to a file
     big = COLUMN.format(pre="", fixargs="", steps=1).replace("region box block 0 0.4 0 0.05 0 0.3", "region box block 0 1 0 1 0 1") \
-        .replace("region col block 0 0.1 0 0.05 0 0.2", "region col block 0 1 0 1 0 1").replace("cell 0.025", "cell 0.002") \
+        .replace("region col block 0 0.1 0 0.05 0 0.2", "region col block 0 1 0 1 0 1").replace("cell 0.025", "cell 0.0005") \
         .replace("fill col 2 2 2", "fill col 2 1 1")
     d = r.fresh("group_messages/too_many_points")
     with open(os.path.join(d, "in.script"), "w") as f:
         f.write(big)
     with open(os.path.join(d, "screen.txt"), "w") as out:
         p = subprocess.run([r.exe, "-in", "in.script", "-echo", "none"], cwd=d, stdout=out, stderr=subprocess.STDOUT, timeout=120)
-    screen = open(os.path.join(d, "screen.txt")).read()
-    log = open(os.path.join(d, "log.liggghts")).read() if os.path.exists(os.path.join(d, "log.liggghts")) else ""
+    screen = open(os.path.join(d, "screen.txt"), errors="replace").read()
+    log = open(os.path.join(d, "log.liggghts"), errors="replace").read() if os.path.exists(os.path.join(d, "log.liggghts")) else ""
     err = next((ln for ln in screen.splitlines() if "ERROR" in ln), "")
     check(p.returncode != 0 and "'fill'" in err and "material points" in err and "ERROR" in log,
           f"too many points -> error naming 'fill' and the number, in screen and log ({err.strip()[:200]})")
