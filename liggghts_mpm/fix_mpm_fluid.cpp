@@ -225,20 +225,40 @@ void FixMpmFluid::setup(int) {
       if (atom->mask[k] & couple_groupbit)
         for (int d = 0; d < 3; ++d) atom->f[k][d] += s.opt.fluid_every * pdata[k][mpm::C_FGRAIN + d];
   if (s.opt.out_every > 0 && update->ntimestep % s.opt.out_every == 0) guarded([&] { s.write_output(); });
+  mark_run_start();
+}
+
+// the counters at the start of a run ('run N pre no' skips setup(): post_run marks it as well)
+void FixMpmFluid::mark_run_start() {
+  const mpm::FluidSolver &s = *solver;
   run_time_start[0] = s.time_fluid;
   run_time_start[1] = s.time_couple;
+  run_time_start[2] = s.time_pressure_solver();
+  run_time_start[3] = static_cast<double>(s.pressure_solves());
+  run_time_start[4] = static_cast<double>(s.pressure_iterations_summed());
 }
 
 /* Where the fix's time went in the run just finished (slowest rank), next
    to LIGGGHTS' "Loop time": the fluid's own work and the coupling. */
 void FixMpmFluid::post_run() {
-  double t[2] = {solver->time_fluid - run_time_start[0], solver->time_couple - run_time_start[1]}, g[2];
-  MPI_Allreduce(t, g, 2, MPI_DOUBLE, MPI_MAX, world);
+  const mpm::FluidSolver &s = *solver;
+  double t[3] = {s.time_fluid - run_time_start[0], s.time_couple - run_time_start[1],
+                 s.time_pressure_solver() - run_time_start[2]},
+         g[3];
+  MPI_Allreduce(t, g, 3, MPI_DOUBLE, MPI_MAX, world);
   std::ostringstream os;
   os << "fix mpm/fluid: wall time in this run: fluid " << g[0] << " s";
-  if (solver->opt.coupled) os << ", coupling " << g[1] << " s (" << (g[0] > 0.0 ? g[1] / g[0] : 0.0) << " of the fluid time)";
+  if (s.opt.projection) {
+    // the same on every rank (one collective solve per fluid step)
+    const double nsolve = static_cast<double>(s.pressure_solves()) - run_time_start[3];
+    const double nit = static_cast<double>(s.pressure_iterations_summed()) - run_time_start[4];
+    os << " (pressure solver " << g[2] << " s = " << (g[0] > 0.0 ? g[2] / g[0] : 0.0) << " of it, " << nsolve
+       << " solves, " << (nsolve > 0.0 ? nit / nsolve : 0.0) << " PCG iterations per solve)";
+  }
+  if (s.opt.coupled) os << ", coupling " << g[1] << " s (" << (g[0] > 0.0 ? g[1] / g[0] : 0.0) << " of the fluid time)";
   os << "\n";
   print(os.str());
+  mark_run_start();
 }
 
 /* ----------------------------------------------------------------------

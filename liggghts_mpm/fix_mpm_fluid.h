@@ -61,7 +61,9 @@ class FixMpmFluid : public Fix {
   int couple_groupbit = 0;
   class FixPropertyAtom *fix_dragforce = nullptr;  // per-atom vector 'dragforce' (LIGGGHTS convention)
   bool filled = false;
-  double run_time_start[2] = {0.0, 0.0};  // the solver's fluid and coupling wall time at the setup of the run
+  // the solver's fluid, coupling and pressure-solver wall time, solves and PCG iterations at the setup of the run
+  double run_time_start[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+  void mark_run_start();
   double **pdata = nullptr;  // per-point state rows (mpm::Column)
   int pdata_rows = 0;
   bigint vector_step = -1;   // f_ID[] cached for this step

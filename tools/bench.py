@@ -337,7 +337,7 @@ def callgrind_run(a, tag, cmd):
 def fix_times(text):
     """[(fluid s, coupling s)] of each run, from fix mpm/fluid's summary lines."""
     out = []
-    for m in re.finditer(r"fix mpm/fluid: wall time in this run: fluid (\S+) s(?:, coupling (\S+) s)?", text):
+    for m in re.finditer(r"fix mpm/fluid: wall time in this run: fluid (\S+) s(?: \([^)]*\))?(?:, coupling (\S+) s)?", text):
         out.append((float(m.group(1)), float(m.group(2) or 0.0)))
     return out
 

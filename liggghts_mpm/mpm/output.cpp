@@ -1,4 +1,4 @@
-// The solver's outputs: the global vector f_ID[1..15] and the HDF5 + XDMF series of keyword
+// The solver's outputs: the global vector f_ID[1..18] and the HDF5 + XDMF series of keyword
 // output (points, and grid nodes, gathered on rank 0).
 #include <algorithm>
 #include <cmath>
@@ -17,7 +17,7 @@ void FluidSolver::global_vector(double out[kGlobalSize]) {
   const double *spacing = state.spacing;
   double sum[4] = {0, 0, 0, state.n_clamped};  // mass, kinetic energy, points, clamped
   // |v|max, front, height, p max, wall time of the fluid and of the coupling (slowest rank)
-  double mx[6] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, time_fluid, time_couple};
+  double mx[7] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, time_fluid, time_couple, time_pressure_solver()};
   for (int i = 0; i < pts.nlocal; ++i) {
     if (!is_point(i)) continue;
     const double v2 = v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2];
@@ -37,9 +37,9 @@ void FluidSolver::global_vector(double out[kGlobalSize]) {
         for (int d = 0; d < 3; ++d) fg[d] += pts.state[k][C_FGRAIN + d];
   MPI_Allreduce(fg, gfg, 3, MPI_DOUBLE, MPI_SUM, comm_);
   for (int d = 0; d < 3; ++d) out[10 + d] = gfg[d];
-  double gsum[4], gmx[6];
+  double gsum[4], gmx[7];
   MPI_Allreduce(sum, gsum, 4, MPI_DOUBLE, MPI_SUM, comm_);
-  MPI_Allreduce(mx, gmx, 6, MPI_DOUBLE, MPI_MAX, comm_);
+  MPI_Allreduce(mx, gmx, 7, MPI_DOUBLE, MPI_MAX, comm_);
   out[0] = gsum[0];
   out[1] = gsum[1];
   out[2] = gmx[0];
@@ -54,7 +54,12 @@ void FluidSolver::global_vector(double out[kGlobalSize]) {
   out[14] = gmx[5];
   out[15] = proj_ ? proj_->iterations() : 0.0;
   out[16] = proj_ ? proj_->residual() : 0.0;
+  out[17] = gmx[6];
 }
+
+double FluidSolver::time_pressure_solver() const { return proj_ ? proj_->solver_seconds() : 0.0; }
+long FluidSolver::pressure_solves() const { return proj_ ? proj_->solves() : 0; }
+long FluidSolver::pressure_iterations_summed() const { return proj_ ? proj_->iterations_summed() : 0; }
 
 namespace {
 // rows of all ranks on rank 0 (empty elsewhere)

@@ -1,5 +1,7 @@
 #include "mpm/projection.h"
 
+#include <mpi.h>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -361,7 +363,11 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   pressure_rhs(grid_, lab_, geo_, u_.data(), th, theta_prev, h, rhs_.data());
   if (pvol && opt_.volume_correction > 0.0) add_volume_correction(pvol, theta, h);
   try {
+    const double t0 = MPI_Wtime();
     last_ = solver_->solve(lab_, beta_.data(), rhs_.data(), p_.data());
+    solver_seconds_ += MPI_Wtime() - t0;
+    ++solves_;
+    iterations_summed_ += last_.iterations;
   } catch (const PressureSolveError &e) {
     std::ostringstream os;
     os << "Fix mpm/fluid: the pressure projection did not converge at step " << step << ": " << e.iterations

@@ -49,6 +49,11 @@ class Projection {
   const std::vector<double> &gradient() const { return grad_ext_; }
   int iterations() const { return last_.iterations; }
   double residual() const { return last_.relative_residual; }
+  // since construction, this rank: wall time in the pressure solver (hypre assembly, setup and
+  // PCG), number of solves, PCG iterations summed over them
+  double solver_seconds() const { return solver_seconds_; }
+  long solves() const { return solves_; }
+  long iterations_summed() const { return iterations_summed_; }
 
  private:
   void make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls);
@@ -86,6 +91,8 @@ class Projection {
   void add_volume_correction(const double *pvol, const double *theta, double h);
   bool deep_inside(int i, int j, int k) const;
   PressureResult last_;
+  double solver_seconds_ = 0.0;
+  long solves_ = 0, iterations_summed_ = 0;
   MPI_Comm comm_;
 };
 

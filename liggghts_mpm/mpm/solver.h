@@ -112,15 +112,21 @@ class FluidSolver {
   void step();
   const std::vector<double> &grain_force() const { return grain_force_; }
 
-  // f_ID[1..17] (collective): mass, kinetic energy, |v|max, front, height, sub-steps, stable dt,
+  // f_ID[1..18] (collective): mass, kinetic energy, |v|max, front, height, sub-steps, stable dt,
   // clamped, points, p max, fluid force on the grains (3), wall time of the fluid and coupling,
-  // iterations and relative residual of the last pressure solve (pressure projection; else 0)
-  static constexpr int kGlobalSize = 17;
+  // iterations and relative residual of the last pressure solve (pressure projection; else 0),
+  // wall time in the pressure solver (part of the fluid's)
+  static constexpr int kGlobalSize = 18;
   void global_vector(double out[kGlobalSize]);
   // HDF5 + XDMF output of the points (and grid) fields of keyword output (collective).
   void write_output();
   // wall time of the fluid's own work and of the coupling on this rank (s, cumulative)
   double time_fluid = 0.0, time_couple = 0.0;
+  // pressure projection, this rank, cumulative: wall time in the pressure solver (hypre assembly,
+  // setup, PCG; part of time_fluid), solves and their PCG iterations (0 with eos)
+  double time_pressure_solver() const;
+  long pressure_solves() const;
+  long pressure_iterations_summed() const;
   std::size_t memory_bytes() const;
 
   // The phases of substep, in order; public so that a test (or another model) can run them one by
