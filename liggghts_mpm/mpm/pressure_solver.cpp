@@ -6,6 +6,7 @@
 #include <climits>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -221,12 +222,35 @@ void PressureSolver::setup_solver() {
   HYPRE_StructPCGSetup(h.pcg, h.A, h.b, h.x);
 }
 
-PressureResult PressureSolver::solve(const NodeLabels &labels, const double *beta, const double *rhs,
+PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *beta, const double *rhs,
                                      double *p, const double *p_empty) {
   PressureResult res;
   Hypre &h = *h_;
   const IndexBox &ob = grid_.owned();
   const double t0 = MPI_Wtime();
+
+  // A FLUID node without any open face (walled in by closed faces: seen at the corner nodes of
+  // the box outside the rotating jar's mesh, docs/jar.md "C4 with the projection") has a zero
+  // row: PFMG then returns INF, hypre's PCG stops at once with its error flag and leaves the old
+  // pressure. Such a node takes no part in the solve (an identity row, p = 0, as a SOLID node):
+  // no face connects it to the rest.
+  std::vector<std::size_t> enclosed;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (labels_in.kind[n] != kFluid) return;
+    for (int d = 0; d < 3; ++d)
+      for (int side = -1; side <= 1; side += 2) {
+        std::size_t m;
+        if (open_face(grid_, labels_in, i, j, k, d, side, &m)) return;
+      }
+    enclosed.push_back(n);
+  });
+  NodeLabels walled;
+  if (!enclosed.empty()) {
+    walled = labels_in;
+    for (std::size_t n : enclosed) walled.kind[n] = kSolid;
+  }
+  const NodeLabels &labels = enclosed.empty() ? labels_in : walled;
+  res.enclosed = long(enclosed.size());
 
   // The hypre grid covers the active box: the FLUID nodes' bounding box in the owned box (the
   // whole owned extent along periodic dimensions), grown by kActiveMargin nodes so that a moving
@@ -337,10 +361,21 @@ PressureResult PressureSolver::solve(const NodeLabels &labels, const double *bet
   }
   HYPRE_StructVectorAssemble(h.b);
   HYPRE_StructVectorAssemble(h.x);
+  HYPRE_ClearAllErrors();
   HYPRE_StructPCGSolve(h.pcg, h.A, h.b, h.x);
   HYPRE_StructPCGGetNumIterations(h.pcg, &res.iterations);
   HYPRE_StructPCGGetFinalRelativeResidualNorm(h.pcg, &res.relative_residual);
-  HYPRE_ClearAllErrors();  // a non-converged PCG sets hypre's error flag; we report it ourselves
+  // A non-converged PCG sets HYPRE_ERROR_CONV, which the residual test below reports. Any other
+  // flag (INF or NaN met in the solve: PCG returns at once, leaving x and a stale residual) is
+  // not a solution either.
+  const int herr = HYPRE_GetError() & ~HYPRE_ERROR_CONV;
+  HYPRE_ClearAllErrors();
+  if (herr) {
+    std::ostringstream os;
+    os << "pressure solve failed: hypre error flag " << herr << " (INF or NaN in the matrix, the "
+       << "right-hand side or the preconditioner) after " << res.iterations << " PCG iterations";
+    throw PressureSolveError(os.str(), res.iterations, std::numeric_limits<double>::quiet_NaN());
+  }
   if (!ab.empty()) {
     int lo[3] = {ab.lo[0], ab.lo[1], ab.lo[2]}, hi[3] = {ab.hi[0], ab.hi[1], ab.hi[2]};
     HYPRE_StructVectorGetBoxValues(h.x, lo, hi, h.xbuf.data());

@@ -37,6 +37,7 @@ struct PressureResult {
   double rhs_mean_removed = 0.0;  // singular only: the mean of the rhs made compatible (see solve)
   double setup_seconds = 0.0;  // matrix assembly + preconditioner setup (rebuilt only)
   double solve_seconds = 0.0;  // PCG
+  long enclosed = 0;           // FLUID nodes of this rank without an open face, solved as SOLID (p = 0)
 };
 
 // Thrown when PCG stops above the tolerance; what() names the iterations and

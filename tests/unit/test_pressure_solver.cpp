@@ -257,6 +257,49 @@ TEST(PressureSolver, HydrostaticBedExact) {
   EXPECT_GT(ubad, 0.1 * g * dt);
 }
 
+TEST(PressureSolver, WalledInFluidNodeIsLeftOut) {
+  // A FLUID node whose six faces are all closed (in the rotating jar: box corner nodes outside
+  // the jar mesh, docs/jar.md "C4 with the projection") has a zero row. Before it was left out,
+  // PFMG returned INF, PCG stopped at once with hypre's error flag and the old pressure (here 0)
+  // stood as the answer. Now: p = 0 there, the rest of the bed hydrostatic (the node is an
+  // obstacle; u* = -g dt is still exactly projected to rest), and enclosed = 1 on its rank.
+  Column C(MPI_COMM_WORLD, 6);
+  Problem &P = C.P;
+  const double rho = 1000.0, g = 9.81, dt = 1e-3;
+  const int c[3] = {4, 2, 3};
+  P.grid.for_owned([&](int i, int j, int k, std::size_t) {
+    const int q[3] = {i, j, k};
+    for (int d = 0; d < 3; ++d) {
+      int a[3] = {c[0], c[1], c[2]};
+      a[d] -= 1;
+      if (q[0] == c[0] && q[1] == c[1] && q[2] == c[2]) P.lab.close_face(P.grid, i, j, k, d);
+      if (q[0] == a[0] && q[1] == a[1] && q[2] == a[2]) P.lab.close_face(P.grid, i, j, k, d);
+    }
+  });
+  P.lab.exchange(P.grid, MPI_COMM_WORLD);
+  for (std::size_t n = 0; n < P.grid.size(); ++n) P.u[3 * n + 2] = -g * dt;
+  mpm::pressure_rhs(P.grid, P.lab, P.geo, P.u.data(), P.theta.data(), nullptr, dt, P.rhs.data());
+  P.grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (i == c[0] && j == c[1] && k == c[2]) P.rhs[n] = 1e3;  // any value: the row has no coupling
+  });
+  mpm::PressureSolver solver(P.grid, MPI_COMM_WORLD, tight(1e-12), P.geo);
+  mpm::PressureResult r;
+  ASSERT_NO_THROW(r = solver.solve(P.lab, P.beta.data(), P.rhs.data(), P.p.data()));
+  long enclosed = r.enclosed, genclosed = 0;
+  MPI_Allreduce(&enclosed, &genclosed, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  const double zs = P.x(2, C.top + 1), pmax = rho * g * (zs - P.x(2, 0));
+  const double err = P.max_owned([&](int i, int j, int k, std::size_t n) {
+    if (P.lab.kind[n] != kFluid) return 0.0;
+    if (i == c[0] && j == c[1] && k == c[2]) return std::fabs(P.p[n]);
+    return std::fabs(P.p[n] - rho * g * (zs - P.x(2, k)));
+  });
+  if (root())
+    std::printf("[ walled   ] one FLUID node walled in: %d PCG iterations, max |p - rho g h| / p_floor = %.2e, enclosed %ld\n",
+                r.iterations, err / pmax, genclosed);
+  EXPECT_EQ(genclosed, 1);
+  EXPECT_LT(err, 1e-9 * pmax);
+}
+
 TEST(PressureSolver, GhostSurfaceBetweenNodesExact) {
   // Ghost-fluid free surface (labels.level): the surface lies a fraction s of a cell above the
   // last FLUID layer (level +s / -(1 - s) on the two layers), for several s including the clamp.
