@@ -81,6 +81,11 @@ def case_ghost_refused(r):
     check(not os.path.exists(os.path.join(d, "mesh_walls_projection.csv")) or
           len(read_csv(os.path.join(d, "mesh_walls_projection.csv")).get("t", [])) == 0,
           "no output rows written")
+    d, p = r.run("projection_mesh/volume_correction", INPUT, {"extra": "volume_correction 10"}, expect_ok=False,
+                 extra_files=(STL,))
+    msg = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
+    check(p.returncode != 0 and "volume_correction" in msg and "mesh_wall" in msg and "10" in msg,
+          f"volume_correction with mesh_wall: an error naming both keywords and the value (got: {msg.strip()[:160]})")
     d, p, s = run(r, "node_explicit", extra="free_surface node", tend=0.1)
     check(p.returncode == 0 and max(s["vmax"]) < 1e-4, "free_surface node with mesh_wall runs (at rest)")
 
