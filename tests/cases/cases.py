@@ -436,7 +436,7 @@ def case_every(r):
 def case_buoyancy_floor(r):
     """A grain at rest in a fluid at rest gets Archimedes' force, also next to the floor (cell = 3 d).
     grad_p weak (the gradient the fluid itself feels at the nodes) is exact there: measured 0.9995,
-    1.0017, 1.0013, 1.0008. The default grad_p nodal (the derivative of the fluid's energy) is good
+    1.0017, 1.0013, 1.0008 (now the default). grad_p nodal (the derivative of the fluid's energy) is good
     away from the floor (1.0310 at 6 mm, 1.0036 at 12 mm) but not next to it (0.57 at 0.5 mm,
     1.15 at 1.5 mm: the anti-locked pressure's staircase at the wall); the text's grad_p fit gave
     up to 20 % there (docs/background/well_balanced.md)."""

@@ -41,22 +41,42 @@ ROWS = [(f"{where}_{cell}{'_smooth' if sm else ''}", dict(v, floor=fl, **({"extr
         for sm in (False, True)]
 
 
-def rows(r, where):
+def rows(r, *names):
     for name, v in ROWS:
-        if name.startswith(where):
+        if name in names:
             q = ratio(r, name, **v)
             check(abs(q - 1.0) < TOL, f"{name}: within {TOL:.0%} of Archimedes ({q:.4f})")
 
 
-def case_bed_mid(r):
-    """default coupling, the bed mid-depth: cell 1.5 d / 3 d x theta_smooth 0 / 0.004"""
-    rows(r, "mid")
+def case_bed_mid_c15(r):
+    """default coupling, the bed mid-depth, cell 1.5 d"""
+    rows(r, "mid_c1.5")
 
 
-def case_bed_floor(r):
-    """default coupling, the bed on the floor: cell 1.5 d / 3 d x theta_smooth 0 / 0.004; and the
-    former default there at cell 3 d, which this case must tell apart"""
-    rows(r, "floor")
+def case_bed_mid_c15_smooth(r):
+    """default coupling, the bed mid-depth, cell 1.5 d, theta_smooth 0.004"""
+    rows(r, "mid_c1.5_smooth")
+
+
+def case_bed_mid_c3(r):
+    """default coupling, the bed mid-depth (3 cells of water), cell 3 d, theta_smooth 0 / 0.004"""
+    rows(r, "mid_c3", "mid_c3_smooth")
+
+
+def case_bed_floor_c15(r):
+    """default coupling, the bed on the floor, cell 1.5 d"""
+    rows(r, "floor_c1.5")
+
+
+def case_bed_floor_c15_smooth(r):
+    """default coupling, the bed on the floor, cell 1.5 d, theta_smooth 0.004"""
+    rows(r, "floor_c1.5_smooth")
+
+
+def case_bed_floor_c3(r):
+    """default coupling, the bed on the floor, cell 3 d, theta_smooth 0 / 0.004; and the former
+    default grad_p nodal there, which this case must tell apart"""
+    rows(r, "floor_c3", "floor_c3_smooth")
     qn = ratio(r, "floor_c3_nodal", floor=1, extra="grad_p nodal", **CELL3)
     check(abs(qn - 1.0) > TOL, f"grad_p nodal on the floor at cell 3 d is off by more than {TOL:.0%} ({qn:.4f})")
 
