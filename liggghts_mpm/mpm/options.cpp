@@ -492,7 +492,7 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, &Options::wall_traction, nullptr, true},
     {"theta_transport", "yes/no", "-", "", "no", "'yes' or 'no'",
      nullptr, 0, 0, false, false, &Options::theta_transport, nullptr, true},
-    {"grad_p", "nodal | weak | fit", "-", "", "nodal", "'weak', 'fit' or 'nodal'",
+    {"grad_p", "weak | nodal | fit", "-", "", "weak", "'weak', 'fit' or 'nodal'",
      nullptr, 0, 0, false, false, nullptr, parse_grad_p, false},
     {"reaction", "points | direct", "-", "", "points", "'points' or 'direct'",
      nullptr, 0, 0, false, false, nullptr, parse_reaction, false},

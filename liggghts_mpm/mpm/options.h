@@ -52,10 +52,11 @@ struct Options {
   bool musl = true;
   bool antilock = true;
   bool wall_traction = true;        // (8-23) at grid-face walls for bspline2
-  // grad p at the grains: the gradient of the nodal mean pressures (nodal, default: the
-  // derivative of the fluid's energy; at a grid face the nodes' linear fit), the gradient the
-  // fluid feels at the nodes, -(internal force)/volume (weak), or fitted nodal gradients (fit)
-  GradP grad_p = GradP::Nodal;
+  // grad p at the grains: the gradient the fluid feels at the nodes, -(internal force)/volume
+  // (at least half a cell), as the points see it (weak, default: Archimedes at rest also at walls
+  // and under a free surface), the gradient of the nodal mean pressures (nodal: the derivative of
+  // the fluid's energy; at a grid face the nodes' linear fit), or fitted nodal gradients (fit)
+  GradP grad_p = GradP::Weak;
   // the grains' pressure reaction goes to the fluid through its points (points, default: the
   // kernel the displaced fluid mass went through) or straight to the nodes (direct, the text's)
   bool reaction_points = true;

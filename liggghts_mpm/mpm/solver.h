@@ -158,6 +158,8 @@ class FluidSolver {
   template <int NS> void couple_kernel(double h);
   template <int NS> void point_sums();             // grad_p weak, reaction points: WkRec
   void weak_pressure_gradient();                   // grad_p weak
+  void weak_face_copy();                           // grad_p weak: face and padding nodes
+  template <int NS> void smooth_weak_gradient();   // grad_p weak: the points' view of it
   template <int NS> void route_reaction();         // reaction points
   int mirror_node(int c, int d) const;
   void fold_to_mirror(std::vector<double> &a, int stride);

@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 """Grains held in still water feel Archimedes' force (issue #13, acceptance 4): a random bed
 (inputs/archimedes/in.bed, reduced), the fluid force on the grains against rho g sum V, a bound from
-the inputs alone. Mid-depth with the default coupling, on the floor with grad_p weak (with and
-without theta_smooth) within 2 %; the default on the floor closer than the text's coupling
-(grad_p fit, reaction direct), which must be off by more than 2 % so that the case can tell them
-apart (docs/background/well_balanced.md).
+the inputs alone. With `pressure eos` and the default coupling (grad_p weak: the fluid's own nodal
+gradient as its points see it, reaction points) within 2 % mid-depth and resting on the floor, at
+cells of 1.5 and 3 grain diameters (at 3 d the water is 3 cells deep: the bed lies within 1.5 cells
+of the floor and of the free surface), with and without theta_smooth (measured 0.9963-1.0008,
+docs/projection.md "Archimedes with eos"). The former default grad_p nodal must miss on the floor by
+more than 2 % (0.77 at cell 3 d), so that the case can tell the two apart.
 
     test_archimedes.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR [--mpirun "..."]
 """
@@ -31,19 +33,52 @@ def ratio(r, case, **v):
     return q
 
 
-def case_bed(r):
-    # default coupling (grad_p nodal, reaction points): balanced inside the fluid
-    q = ratio(r, "mid", **{})
-    check(abs(q - 1.0) < TOL, f"mid-depth, default coupling: within {TOL:.0%} of Archimedes ({q:.4f})")
-    # on the floor only grad_p weak is balanced (the anti-locked pressure's staircase at the wall)
-    for name, extra in (("floor_weak", "grad_p weak"), ("floor_weak_smooth", "grad_p weak theta_smooth 0.004")):
-        q = ratio(r, name, floor=1, extra=extra)
-        check(abs(q - 1.0) < TOL, f"{name}: within {TOL:.0%} of Archimedes ({q:.4f})")
-    # the default on the floor is closer than the text's coupling, which this case can tell apart
-    qd = ratio(r, "floor_default", floor=1)
-    qt = ratio(r, "floor_text", floor=1, extra="grad_p fit reaction direct")
-    check(abs(qt - 1.0) > TOL, f"text's coupling on the floor is off by more than {TOL:.0%} ({qt:.4f})")
-    check(abs(qd - 1.0) < abs(qt - 1.0), f"default on the floor closer than the text's ({qd:.4f} vs {qt:.4f})")
+# cell 3 d: 600 grains asked (437 inserted), the bed as high as the 150 grains' at cell 1.5 d
+CELL3 = {"nbeads": 600, "cellf": 3}
+ROWS = [(f"{where}_{cell}{'_smooth' if sm else ''}", dict(v, floor=fl, **({"extra": "theta_smooth 0.004"} if sm else {})))
+        for where, fl in (("mid", 0), ("floor", 1))
+        for cell, v in (("c1.5", {}), ("c3", CELL3))
+        for sm in (False, True)]
+
+
+def rows(r, *names):
+    for name, v in ROWS:
+        if name in names:
+            q = ratio(r, name, **v)
+            check(abs(q - 1.0) < TOL, f"{name}: within {TOL:.0%} of Archimedes ({q:.4f})")
+
+
+def case_bed_mid_c15(r):
+    """default coupling, the bed mid-depth, cell 1.5 d"""
+    rows(r, "mid_c1.5")
+
+
+def case_bed_mid_c15_smooth(r):
+    """default coupling, the bed mid-depth, cell 1.5 d, theta_smooth 0.004"""
+    rows(r, "mid_c1.5_smooth")
+
+
+def case_bed_mid_c3(r):
+    """default coupling, the bed mid-depth (3 cells of water), cell 3 d, theta_smooth 0 / 0.004"""
+    rows(r, "mid_c3", "mid_c3_smooth")
+
+
+def case_bed_floor_c15(r):
+    """default coupling, the bed on the floor, cell 1.5 d"""
+    rows(r, "floor_c1.5")
+
+
+def case_bed_floor_c15_smooth(r):
+    """default coupling, the bed on the floor, cell 1.5 d, theta_smooth 0.004"""
+    rows(r, "floor_c1.5_smooth")
+
+
+def case_bed_floor_c3(r):
+    """default coupling, the bed on the floor, cell 3 d, theta_smooth 0 / 0.004; and the former
+    default grad_p nodal there, which this case must tell apart"""
+    rows(r, "floor_c3", "floor_c3_smooth")
+    qn = ratio(r, "floor_c3_nodal", floor=1, extra="grad_p nodal", **CELL3)
+    check(abs(qn - 1.0) > TOL, f"grad_p nodal on the floor at cell 3 d is off by more than {TOL:.0%} ({qn:.4f})")
 
 
 if __name__ == "__main__":
