@@ -373,6 +373,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
     os << "Fix mpm/fluid: the pressure projection did not converge at step " << step << ": " << e.iterations
        << " PCG iterations (keyword 'max_iterations' " << opt_.pressure_max_iterations << "), relative residual "
        << e.residual << " (keyword 'tolerance' " << opt_.pressure_tolerance << ")";
+    if (std::isnan(e.residual)) os << "; " << e.what();  // hypre failed (INF or NaN), not a slow convergence
     throw Error(os.str());
   }
   // for the points and grains: the padding nodes behind the box walls carry the pressure (and
