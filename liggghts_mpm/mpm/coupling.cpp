@@ -599,23 +599,9 @@ void FluidSolver::weak_face_copy() {
    of rho g on alternate layers, and a bed between them read 1.020 of Archimedes. rp is scratch. */
 template <int NS>
 void FluidSolver::smooth_weak_gradient() {
-  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   const double vmin = 1e-12 * opt.grid.dx * opt.grid.dx * opt.grid.dx;
-  std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
-  double *const acc = g_.rp.data();
-  const double *const gw = g_.gw.data();
-  for (const int i : plist_) {
-    const Stencil &ps = shapes_[i];
-    Row4 q = {0, 0, 0, 0};
-    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-      q += w * Row4{gw[3 * n], gw[3 * n + 1], gw[3 * n + 2], 0.0};
-    });
-    const Row4 vq = pts.state[i][C_VOL] * q;
-    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-      for (int d = 0; d < 3; ++d) acc[3 * n + d] += w * vq[d];
-    });
-  }
-  grid_.reverse_sum(g_.rp.data(), 3);
+  through_points<NS>(g_.gw.data(), g_.rp);
+  const double *const acc = g_.rp.data();
   grid_.for_owned([&](int, int, int, std::size_t n) {
     const double V = g_.wk[WkRec::N * n + WkRec::V];
     for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = V > vmin ? acc[3 * n + d] / V : 0.0;
@@ -632,7 +618,6 @@ void FluidSolver::smooth_weak_gradient() {
    sum_j R_j = sum_i r_i (momentum kept). A node with a reaction but no fluid point keeps it. */
 template <int NS>
 void FluidSolver::route_reaction() {
-  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   const double vmin = 1e-12 * opt.grid.dx * opt.grid.dx * opt.grid.dx;
   if (opt.theta_smooth > 0.0) smooth_node_volume(g_.rp, 3);
   grid_.for_owned([&](int, int, int, std::size_t n) {
@@ -654,9 +639,18 @@ void FluidSolver::route_reaction() {
         const std::size_t n = grid_.index(i, j, k), m = grid_.index(mi[0], mi[1], mi[2]);
         for (int d = 0; d < 3; ++d) g_.rq[3 * n + d] = g_.rq[3 * m + d];
       }
-  std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
-  double *const rr = g_.rp.data();
-  const double *const q = g_.rq.data();
+  through_points<NS>(g_.rq.data(), g_.rp);
+  const double *const rr = g_.rp.data();
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    for (int d = 0; d < 3; ++d) g_.rx[3 * n + d] += rr[3 * n + d];
+  });
+}
+
+template <int NS>
+void FluidSolver::through_points(const double *q, std::vector<double> &out) {
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  std::fill(out.begin(), out.end(), 0.0);
+  double *const o = out.data();
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     Row4 qp = {0, 0, 0, 0};
@@ -665,13 +659,10 @@ void FluidSolver::route_reaction() {
     });
     const Row4 vq = pts.state[i][C_VOL] * qp;
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-      for (int d = 0; d < 3; ++d) rr[3 * n + d] += w * vq[d];
+      for (int d = 0; d < 3; ++d) o[3 * n + d] += w * vq[d];
     });
   }
-  grid_.reverse_sum(g_.rp.data(), 3);
-  grid_.for_owned([&](int, int, int, std::size_t n) {
-    for (int d = 0; d < 3; ++d) g_.rx[3 * n + d] += rr[3 * n + d];
-  });
+  grid_.reverse_sum(out.data(), 3);
 }
 
 }  // namespace mpm
