@@ -699,7 +699,9 @@ bool WallGeometry::crosses(const double a[3], int d, double len, double *w_d) co
     double x[3] = {a[0], a[1], a[2]}, bw[3];
     x[d] += std::min(std::max(f, 0.0), 1.0) * len;
     if (!inside_tri(t, x, 1e-9, bw)) continue;
-    *w_d = bw[0] * t.w[0][d] + bw[1] * t.w[1][d] + bw[2] * t.w[2][d];
+    double w[3];
+    for (int e = 0; e < 3; ++e) w[e] = bw[0] * t.w[0][e] + bw[1] * t.w[1][e] + bw[2] * t.w[2][e];
+    *w_d = dot3(w, t.n) * t.n[d];
     return true;
   }
   return false;
