@@ -71,6 +71,7 @@ class Projection {
                      const std::vector<double> *grad = nullptr);
   void fill_wall_gradient();
   std::size_t wall_node(int i, int j, int k) const;
+  void mirror_normal(double *v, int i, int j, int k, const double *p2g, double mmin) const;
   double folded_mass(int i, int j, int k) const;
   double mirror_sum(const std::vector<double> &a, int i, int j, int k) const;
   void extrapolate_above_surface(const double *p2g, double mmin);
