@@ -325,14 +325,6 @@ void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
                   "'free_surface node' (the default with mesh walls)");
     o.surface_ghost = false;
   }
-  // The volume correction counts the points' volume on the grid without the part behind a mesh
-  // triangle either: with 'volume_correction 10' the columns at rest of mpm_case.projection_mesh_rest
-  // moved at 8.4e-3 / 1.0e-2 / 6.0e-2 m/s after 1 s beside a vertical / 30 / 60 degree mesh wall
-  // (2e-12 to 6e-12 without it), and the rising mesh floor of _piston lost the column's mean velocity.
-  if (o.projection && o.volume_correction > 0.0 && std::find(seen.begin(), seen.end(), "mesh_wall") != seen.end())
-    throw Error("Fix mpm/fluid: keyword 'volume_correction' " + fmt_number(o.volume_correction) +
-                " (1/time) does not support keyword 'mesh_wall' yet (points beside a mesh wall at rest would move); "
-                "use 'volume_correction 0' (the default) with mesh walls");
   if (bad.empty()) return;
   if (o.projection)
     throw Error("Fix mpm/fluid: keyword 'pressure projection' does not use keyword(s) " + bad +
