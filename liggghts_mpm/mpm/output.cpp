@@ -68,36 +68,39 @@ int point_field_size(const std::string &f) { return f == "v" ? 3 : f == "tau" ? 
 void FluidSolver::write_output() {
   if (last_output_step_ == clock.step) return;
   last_output_step_ = clock.step;
+  // the ranks meet first (they would at the first collective call anyway), so that time_output is
+  // the output's own and not the wait for a rank still in the preceding step
+  MPI_Barrier(comm_);
   const double t0 = MPI_Wtime();
   const GridSpec &gs = opt.grid;
   const std::vector<std::string> &pfields = opt.out_point_fields, &gfields = opt.out_grid_fields;
 
   // This rank's points and owned real grid nodes (not the padding): Hdf5Series places them.
+  // Field by field, so that each name is looked up once, not once per point.
+  std::vector<int> mine;
+  for (int i = 0; i < pts.nlocal; ++i)
+    if (is_point(i)) mine.push_back(i);
   PointBlock pb;
-  for (int i = 0; i < pts.nlocal; ++i) pb.n += is_point(i);
+  pb.n = mine.size();
   pb.xyz.reserve(3 * pb.n);
+  for (int i : mine) pb.xyz.insert(pb.xyz.end(), pts.x[i], pts.x[i] + 3);
   for (const auto &f : pfields) {
     pb.fields.push_back({f, point_field_size(f), {}});
-    pb.fields.back().data.reserve(pb.n * point_field_size(f));
-  }
-  for (int i = 0; i < pts.nlocal; ++i) {
-    if (!is_point(i)) continue;
-    const double *s = pts.state[i];
-    for (int d = 0; d < 3; ++d) pb.xyz.push_back(pts.x[i][d]);
-    for (Field &fl : pb.fields) {
-      std::vector<double> &out = fl.data;
-      const std::string &f = fl.name;
-      if (f == "v") for (int d = 0; d < 3; ++d) out.push_back(pts.v[i][d]);
-      else if (f == "p") out.push_back(s[C_P]);
-      else if (f == "rho") out.push_back(s[C_RHO]);
-      else if (f == "vol") out.push_back(s[C_VOL]);
-      else if (f == "tau") for (int c = 0; c < 6; ++c) out.push_back(s[C_TAU + c]);
-      else if (f == "theta") out.push_back(s[C_THETA]);
-      else if (f == "id") out.push_back(static_cast<double>(pts.tag[i]));
-      else if (f == "type") out.push_back(static_cast<double>(pts.type[i]));
-      else if (f == "affine") for (int c = 0; c < 9; ++c) out.push_back(s[C_AFF + c]);
-      else if (f == "mass") out.push_back(pts.rmass[i]);
-    }
+    std::vector<double> &out = pb.fields.back().data;
+    out.reserve(pb.n * point_field_size(f));
+    auto state = [&](int c0, int nc) {
+      for (int i : mine) out.insert(out.end(), pts.state[i] + c0, pts.state[i] + c0 + nc);
+    };
+    if (f == "v") for (int i : mine) out.insert(out.end(), pts.v[i], pts.v[i] + 3);
+    else if (f == "p") state(C_P, 1);
+    else if (f == "rho") state(C_RHO, 1);
+    else if (f == "vol") state(C_VOL, 1);
+    else if (f == "tau") state(C_TAU, 6);
+    else if (f == "theta") state(C_THETA, 1);
+    else if (f == "affine") state(C_AFF, 9);
+    else if (f == "id") for (int i : mine) out.push_back(static_cast<double>(pts.tag[i]));
+    else if (f == "type") for (int i : mine) out.push_back(static_cast<double>(pts.type[i]));
+    else if (f == "mass") for (int i : mine) out.push_back(pts.rmass[i]);
   }
 
   GridBlock gb;
@@ -116,16 +119,18 @@ void FluidSolver::write_output() {
     }
     if (gb.count[0] == 0 || gb.count[1] == 0 || gb.count[2] == 0)
       for (int d = 0; d < 3; ++d) gb.lo[d] = gb.count[d] = 0;  // owns no node
-    for (const auto &f : gfields) gb.fields.push_back({f, f == "v" ? 3 : 1, {}});
-    for (int k = lo[2]; k <= hi[2]; ++k)
-      for (int j = lo[1]; j <= hi[1]; ++j)
-        for (int i = lo[0]; i <= hi[0]; ++i) {
-          const std::size_t n = grid_.index(i, j, k);
-          for (Field &fl : gb.fields) {
-            if (fl.name == "mass") fl.data.push_back(g_.p2g[P2gRec::N * n + P2gRec::M]);
-            else for (int d = 0; d < 3; ++d) fl.data.push_back(g_.vel[VelRec::N * n + VelRec::V_NEW + d]);
+    for (const auto &f : gfields) {
+      gb.fields.push_back({f, f == "v" ? 3 : 1, {}});
+      std::vector<double> &out = gb.fields.back().data;
+      const bool mass = f == "mass";
+      for (int k = lo[2]; k <= hi[2]; ++k)
+        for (int j = lo[1]; j <= hi[1]; ++j)
+          for (int i = lo[0]; i <= hi[0]; ++i) {
+            const std::size_t n = grid_.index(i, j, k);
+            if (mass) out.push_back(g_.p2g[P2gRec::N * n + P2gRec::M]);
+            else out.insert(out.end(), &g_.vel[VelRec::N * n + VelRec::V_NEW], &g_.vel[VelRec::N * n + VelRec::V_NEW] + 3);
           }
-        }
+    }
   }
 
   try {  // collective: a failure on any rank throws the same message on every rank
