@@ -236,16 +236,18 @@ void FixMpmFluid::mark_run_start() {
   run_time_start[2] = s.time_pressure_solver();
   run_time_start[3] = static_cast<double>(s.pressure_solves());
   run_time_start[4] = static_cast<double>(s.pressure_iterations_summed());
+  run_time_start[5] = s.time_output;
+  run_time_start[6] = static_cast<double>(s.n_outputs);
 }
 
 /* Where the fix's time went in the run just finished (slowest rank), next
    to LIGGGHTS' "Loop time": the fluid's own work and the coupling. */
 void FixMpmFluid::post_run() {
   const mpm::FluidSolver &s = *solver;
-  double t[3] = {s.time_fluid - run_time_start[0], s.time_couple - run_time_start[1],
-                 s.time_pressure_solver() - run_time_start[2]},
-         g[3];
-  MPI_Allreduce(t, g, 3, MPI_DOUBLE, MPI_MAX, world);
+  double t[4] = {s.time_fluid - run_time_start[0], s.time_couple - run_time_start[1],
+                 s.time_pressure_solver() - run_time_start[2], s.time_output - run_time_start[5]},
+         g[4];
+  MPI_Allreduce(t, g, 4, MPI_DOUBLE, MPI_MAX, world);
   std::ostringstream os;
   os << "fix mpm/fluid: wall time in this run: fluid " << g[0] << " s";
   if (s.opt.projection) {
@@ -256,6 +258,8 @@ void FixMpmFluid::post_run() {
        << " solves, " << (nsolve > 0.0 ? nit / nsolve : 0.0) << " PCG iterations per solve)";
   }
   if (s.opt.coupled) os << ", coupling " << g[1] << " s (" << (g[0] > 0.0 ? g[1] / g[0] : 0.0) << " of the fluid time)";
+  const double nout = static_cast<double>(s.n_outputs) - run_time_start[6];  // the same on every rank
+  if (nout > 0.0) os << ", output " << g[3] << " s (" << nout << " files, " << g[3] / nout << " s per file)";
   os << "\n";
   print(os.str());
   mark_run_start();

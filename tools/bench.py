@@ -13,7 +13,8 @@ Sections (all by default):
             points, CPU MLS-MPM in float64) on 1 and 2 threads in the same run, and the ratios to
             it. Taichi runs in its own venv, .venv-bench (tools/requirements-bench.txt, created on
             first use); if it cannot be installed or imported the Taichi rows are nan with the
-            reason in the note, and the rest still runs (--no-taichi skips it).
+            reason in the note, and the rest still runs (--no-taichi skips it). Then the write
+            time per HDF5 output (hdf5_write_s_per_output: --np ranks; _1rank) in runs of their own.
   coupling  C3 tank (inputs/tank/in.tank) at Grid40 x 8 (32000 points, 7762 beads), a short segment
             (dry phase 20 steps, 50 coupled settling + 50 lift steps), one rank: the fix's own
             timers (f_ID[14], f_ID[15], printed after each run) split the wall time into the
@@ -109,12 +110,12 @@ def lig(a, np_):
 
 # ---------------------------------------------------------------- 3-D pure-fluid dam break
 
-def mpm_run(a, cells, np_, balance, nsteps, tag, rss=False):
+def mpm_run(a, cells, np_, balance, nsteps, tag, rss=False, h5every=0):
     d = os.path.join(a.out, "mpm3d", tag)
     shutil.rmtree(d, ignore_errors=True)
     cmd = lig(a, np_) + ["-in", os.path.join(TOP, "inputs", "bench", "in.dambreak3d"), "-echo", "none",
                          "-var", "cells", str(cells), "-var", "nsteps", str(nsteps), "-var", "warm", "10",
-                         "-var", "balance", str(balance)]
+                         "-var", "balance", str(balance), "-var", "h5every", str(h5every)]
     wall, out, peak = run(cmd, d, rss=rss)
     lt = loop_times(out)
     points = int(re.search(r"created (\d+) material points", out).group(1))
@@ -124,6 +125,10 @@ def mpm_run(a, cells, np_, balance, nsteps, tag, rss=False):
     m = re.search(r"imbalance (\S+) -> (\S+)\)", out)
     if m:
         r["imbalance"] = "%s -> %s" % (m.group(1), m.group(2))
+    if h5every > 0:  # the fix's output time in the timed run (slowest rank), printed after it
+        w = re.findall(r"output \S+ s \((\d+) files, (\S+) s per file\)", out)[-1]
+        r["h5_files"], r["h5_s_per_file"] = int(w[0]), float(w[1])
+        r["h5_file_bytes"] = max(os.path.getsize(os.path.join(d, f)) for f in os.listdir(d) if f.endswith(".h5"))
     RUNS.append(r)
     say("    %-22s %8d points, %4d steps: loop %.3f s, %.3g point-steps/s%s" %
         (tag, points, nsteps, loop, r["point_steps_per_s"], ", imbalance " + r["imbalance"] if m else ""))
@@ -169,6 +174,7 @@ def section_mpm(a):
             "peak RSS minus the 512-point run, divided by the extra points (grid included)")
         if c == 23:
             section_taichi(a, s1, sb, nsteps)
+            section_hdf5(a, c)
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -191,6 +197,22 @@ def section_mpm(a):
         plt.close(fig)
     except ImportError:
         pass
+
+
+def section_hdf5(a, cells):
+    """Write time per HDF5 output of the 3-D dam break (points v p rho id, grid mass v), every 10
+    steps of 60 timed ones, on 1 rank and on --np ranks; separate runs, the other figures are
+    timed without output."""
+    lib = subprocess.run(["ldd", a.exe], stdout=subprocess.PIPE, text=True).stdout
+    how = "parallel HDF5 (MPI-IO, each rank its rows)" if re.search(r"libhdf5_(openmpi|mpich)", lib) \
+        else "serial HDF5 (rank 0 gathers and writes)"
+    for np_, metric in ((a.np, "hdf5_write_s_per_output"), (1, "hdf5_write_s_per_output_1rank")):
+        r = mpm_run(a, cells, np_, 1 if np_ > 1 else 0, 60, "c%d_np%d_hdf5" % (cells, np_), h5every=10)
+        say("    %-22s %d files of %.1f MB: %.4f s per file" % ("", r["h5_files"], r["h5_file_bytes"] / 1e6,
+                                                                r["h5_s_per_file"]))
+        add(metric, r["h5_s_per_file"], "s",
+            "%d points, %d rank(s), %s; %d files of %.1f MB in 60 steps (page cache, no fsync); wall time of "
+            "the fix's output call, slowest rank" % (r["points"], np_, how, r["h5_files"], r["h5_file_bytes"] / 1e6))
 
 
 # ---------------------------------------------------------------- Taichi reference

@@ -1,6 +1,7 @@
 #include "mpm/hdf5_series.h"
 
 #include <hdf5.h>
+#include <mpi.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -20,8 +21,37 @@ const char *kSignature = "<!-- written by mpm::Hdf5Series -->";
 const char *kBegin = "<!-- mpm-step ";
 const char *kEnd = "<!-- /mpm-step -->";
 
-[[noreturn]] void fail(const std::string &file, const std::string &what) {
-  throw std::runtime_error("Hdf5Series: " + file + ": " + what);
+std::string message(const std::string &file, const std::string &what) { return "Hdf5Series: " + file + ": " + what; }
+
+[[noreturn]] void fail(const std::string &file, const std::string &what) { throw std::runtime_error(message(file, what)); }
+
+// Throws, on every rank of comm, the message of the lowest rank whose msg is not empty; returns
+// if all are empty. Every rank calls it at the same point: a failure on one rank stops them all
+// there, before the next collective call could wait for it.
+void agree(MPI_Comm comm, const std::string &msg) {
+  int me, np;
+  MPI_Comm_rank(comm, &me);
+  MPI_Comm_size(comm, &np);
+  int bad = msg.empty() ? np : me, first = np;
+  MPI_Allreduce(&bad, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == np) return;
+  int len = static_cast<int>(msg.size());
+  MPI_Bcast(&len, 1, MPI_INT, first, comm);
+  std::string m = msg;
+  m.resize(len);
+  MPI_Bcast(&m[0], len, MPI_CHAR, first, comm);
+  throw std::runtime_error(m);
+}
+
+// The message of the std::runtime_error fn throws, empty if it returns.
+template <class Fn>
+std::string caught(Fn &&fn) {
+  try {
+    fn();
+  } catch (const std::runtime_error &e) {
+    return e.what();
+  }
+  return {};
 }
 
 // Collects the HDF5 error stack descriptions (auto printing is switched off).
@@ -69,8 +99,9 @@ class Handle {
 
 struct H5Writer {
   std::string file;  // for messages
+  MPI_Comm comm;     // the ranks that make every HDF5 call together (MPI-IO) or MPI_COMM_SELF
   long long ok(long long r, const std::string &what) const {
-    if (r < 0) fail(file, what + " failed" + h5_detail());
+    agree(comm, r < 0 ? message(file, what + " failed" + h5_detail()) : std::string());
     return r;
   }
   void attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype, hsize_t n, const void *v) const {
@@ -80,15 +111,40 @@ struct H5Writer {
     ok(H5Awrite(a.get(), mtype, v), std::string("writing attribute ") + name);
     ok(a.close(), std::string("closing attribute ") + name);
   }
-  void dataset(hid_t loc, const std::string &path, const std::vector<hsize_t> &dims, const double *v) const {
+  // Data set of dims; this rank writes v into the box start, count (its rows, its grid nodes).
+  void dataset(hid_t loc, const std::string &path, const std::vector<hsize_t> &dims, const std::vector<hsize_t> &start,
+               const std::vector<hsize_t> &count, const double *v) const {
     const std::string name = path.substr(path.rfind('/') + 1);
-    Handle sp(ok(H5Screate_simple(int(dims.size()), dims.data(), nullptr), "dataspace for " + path), H5Sclose);
-    Handle d(ok(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, sp.get(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+    const int rank = static_cast<int>(dims.size());
+    Handle sp(ok(H5Screate_simple(rank, dims.data(), nullptr), "dataspace for " + path), H5Sclose);
+    Handle dcpl(ok(H5Pcreate(H5P_DATASET_CREATE), "creating property list for " + path), H5Pclose);
+#ifdef MPM_HDF5_PARALLEL
+    // the ranks' boxes tile the data set: no fill values written before the data
+    ok(H5Pset_fill_time(dcpl.get(), H5D_FILL_TIME_NEVER), "setting the fill time of " + path);
+#endif
+    Handle d(ok(H5Dcreate2(loc, name.c_str(), H5T_IEEE_F64LE, sp.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
                 "creating dataset " + path), H5Dclose);
-    hsize_t count = 1;
-    for (hsize_t x : dims) count *= x;
-    if (count > 0)
-      ok(H5Dwrite(d.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v), "writing dataset " + path);
+    hsize_t total = 1, mine = 1;
+    for (int i = 0; i < rank; ++i) {
+      total *= dims[i];
+      mine *= count[i];
+    }
+    if (total > 0) {  // the same on every rank
+      const hsize_t one = 1;
+      Handle ms(ok(H5Screate_simple(mine > 0 ? rank : 1, mine > 0 ? count.data() : &one, nullptr),
+                   "memory dataspace for " + path), H5Sclose);
+      // one ok() on every rank: each is an agreement of all ranks
+      ok(mine > 0 ? H5Sselect_hyperslab(sp.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr)
+                  : std::min(H5Sselect_none(sp.get()), H5Sselect_none(ms.get())),
+         "selecting this rank's part of " + path);
+      Handle xfer(ok(H5Pcreate(H5P_DATASET_XFER), "creating transfer list for " + path), H5Pclose);
+#ifdef MPM_HDF5_PARALLEL
+      ok(H5Pset_dxpl_mpio(xfer.get(), H5FD_MPIO_COLLECTIVE), "collective transfer for " + path);
+#endif
+      const double dummy = 0.0;
+      ok(H5Dwrite(d.get(), H5T_NATIVE_DOUBLE, ms.get(), sp.get(), xfer.get(), mine > 0 ? v : &dummy),
+         "writing dataset " + path);
+    }
     ok(d.close(), "closing dataset " + path);
   }
 };
@@ -145,18 +201,205 @@ void check_fields(const std::string &file, const std::vector<Field> &fields, std
   }
 }
 
+// One HDF5 step file: attributes, this rank's points (rows offset.. of n_all) and its box of grid
+// nodes (lo, cnt). comm: the ranks that write it together (MPI-IO), or MPI_COMM_SELF alone.
+void write_file(const std::string &tmp, const std::string &path, MPI_Comm comm, long step, double time,
+                const PointBlock &pts, hsize_t n_all, hsize_t offset, const GridBlock *grid, const int lo[3],
+                const int cnt[3]) {
+  QuietH5 quiet;
+  H5Writer w{path, comm};
+  Handle fapl(w.ok(H5Pcreate(H5P_FILE_ACCESS), "creating file access list"), H5Pclose);
+#if H5_VERSION_GE(1, 10, 7)
+  // no flock(): it fails on some parallel file systems and blocks concurrent viewers
+  w.ok(H5Pset_file_locking(fapl.get(), false, true), "disabling file locking");
+#endif
+#ifdef MPM_HDF5_PARALLEL
+  w.ok(H5Pset_fapl_mpio(fapl.get(), comm, MPI_INFO_NULL), "selecting MPI-IO");
+#endif
+  Handle f(w.ok(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), "creating file " + tmp), H5Fclose);
+  const long long step64 = step;
+  w.attr(f.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, &time);
+  w.attr(f.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &step64);
+  {
+    Handle g(w.ok(H5Gcreate2(f.get(), "points", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "creating group /points"),
+             H5Gclose);
+    const hsize_t n = pts.n;
+    w.dataset(g.get(), "/points/xyz", {n_all, 3}, {offset, 0}, {n, 3}, pts.xyz.data());
+    for (const Field &fl : pts.fields) {
+      const hsize_t nc = hsize_t(fl.ncomp);
+      if (fl.ncomp == 1)
+        w.dataset(g.get(), "/points/" + fl.name, {n_all}, {offset}, {n}, fl.data.data());
+      else
+        w.dataset(g.get(), "/points/" + fl.name, {n_all, nc}, {offset, 0}, {n, nc}, fl.data.data());
+    }
+    w.ok(g.close(), "closing group /points");
+  }
+  if (grid) {
+    Handle g(w.ok(H5Gcreate2(f.get(), "grid", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "creating group /grid"),
+             H5Gclose);
+    const long long n64[3] = {grid->n[0], grid->n[1], grid->n[2]};
+    w.attr(g.get(), "n", H5T_STD_I64LE, H5T_NATIVE_LLONG, 3, n64);
+    w.attr(g.get(), "origin", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 3, grid->origin);
+    w.attr(g.get(), "spacing", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 3, grid->spacing);
+    const std::vector<hsize_t> dims = {hsize_t(grid->n[2]), hsize_t(grid->n[1]), hsize_t(grid->n[0])};
+    const std::vector<hsize_t> start = {hsize_t(lo[2]), hsize_t(lo[1]), hsize_t(lo[0])};
+    const std::vector<hsize_t> count = {hsize_t(cnt[2]), hsize_t(cnt[1]), hsize_t(cnt[0])};
+    for (const Field &fl : grid->fields) {
+      std::vector<hsize_t> d = dims, s = start, c = count;
+      if (fl.ncomp > 1) {
+        d.push_back(hsize_t(fl.ncomp));
+        s.push_back(0);
+        c.push_back(hsize_t(fl.ncomp));
+      }
+      w.dataset(g.get(), "/grid/" + fl.name, d, s, c, fl.data.data());
+    }
+    w.ok(g.close(), "closing group /grid");
+  }
+  w.ok(f.close(), "closing file " + tmp);
+}
+
+// This step's block of the XDMF index (between marker comments), for n_all points in all.
+std::string step_block(long step, double time, const std::string &fname, std::size_t n_all,
+                       const std::vector<Field> &pfields, const GridBlock *grid) {
+  const std::string n = std::to_string(n_all);
+  std::ostringstream x;
+  const bool coll = grid != nullptr || n_all == 0;  // empty point sets are left out of the index
+  const std::string in = coll ? "        " : "      ";
+  x << kBegin << "step=\"" << step << "\" time=\"" << num(time) << "\" file=\"" << xml_escape(fname)
+    << "\" -->\n";
+  if (coll) x << "      <Grid Name=\"step_" << step << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
+              << "        <Time Value=\"" << num(time) << "\"/>\n";
+  if (n_all > 0) {
+    x << in << "<Grid Name=\"" << "points"
+      << "\" GridType=\"Uniform\">\n";
+    if (!coll) x << in << "  <Time Value=\"" << num(time) << "\"/>\n";
+    x << in << "  <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n << "\" NodesPerElement=\"1\"/>\n"
+      << in << "  <Geometry GeometryType=\"XYZ\">\n"
+      << in << "    " << data_item(n + " 3", fname + ":/points/xyz") << "\n"
+      << in << "  </Geometry>\n";
+    for (const Field &fl : pfields)
+      x << in << "  <Attribute Name=\"" << xml_escape(fl.name) << "\" AttributeType=\"" << attr_type(fl.ncomp)
+        << "\" Center=\"Node\">\n"
+        << in << "    " << data_item(fl.ncomp == 1 ? n : n + " " + std::to_string(fl.ncomp),
+                                     fname + ":/points/" + fl.name) << "\n"
+        << in << "  </Attribute>\n";
+    x << in << "</Grid>\n";
+  }
+  if (grid) {
+    const std::string dims =
+        std::to_string(grid->n[2]) + " " + std::to_string(grid->n[1]) + " " + std::to_string(grid->n[0]);
+    auto zyx = [](const double *v) { return num(v[2]) + " " + num(v[1]) + " " + num(v[0]); };
+    x << in << "<Grid Name=\"grid\" GridType=\"Uniform\">\n"
+      << in << "  <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << dims << "\"/>\n"
+      << in << "  <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
+      << in << "    <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">"
+      << zyx(grid->origin) << "</DataItem>\n"
+      << in << "    <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">"
+      << zyx(grid->spacing) << "</DataItem>\n"
+      << in << "  </Geometry>\n";
+    for (const Field &fl : grid->fields)
+      x << in << "  <Attribute Name=\"" << xml_escape(fl.name) << "\" AttributeType=\"" << attr_type(fl.ncomp)
+        << "\" Center=\"Node\">\n"
+        << in << "    " << data_item(fl.ncomp == 1 ? dims : dims + " " + std::to_string(fl.ncomp),
+                                     fname + ":/grid/" + fl.name) << "\n"
+        << in << "  </Attribute>\n";
+    x << in << "</Grid>\n";
+  }
+  if (coll) x << "      </Grid>\n";
+  x << "      " << kEnd;
+  return x.str();
+}
+
+// What every rank must give alike: step, time, the fields and the grid.
+std::string layout(long step, double time, const PointBlock &pts, const GridBlock *grid) {
+  std::ostringstream os;
+  os << step << ' ' << num(time) << " points";
+  for (const Field &f : pts.fields) os << ' ' << f.name << ':' << f.ncomp;
+  if (grid) {
+    os << " grid " << grid->n[0] << ' ' << grid->n[1] << ' ' << grid->n[2];
+    for (int d = 0; d < 3; ++d) os << ' ' << num(grid->origin[d]) << ' ' << num(grid->spacing[d]);
+    for (const Field &f : grid->fields) os << ' ' << f.name << ':' << f.ncomp;
+  }
+  return os.str();
+}
+
+#ifndef MPM_HDF5_PARALLEL
+// rows of all ranks on rank 0, in rank order (empty elsewhere)
+std::vector<double> gather_rows(const std::vector<double> &mine, MPI_Comm comm) {
+  int me, np;
+  MPI_Comm_rank(comm, &me);
+  MPI_Comm_size(comm, &np);
+  int n = static_cast<int>(mine.size());
+  std::vector<int> counts(np), displs(np, 0);
+  MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
+  std::vector<double> all;
+  if (me == 0) {
+    for (int q = 1; q < np; ++q) displs[q] = displs[q - 1] + counts[q - 1];
+    all.resize(displs.back() + counts.back());
+  }
+  MPI_Gatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm);
+  return all;
+}
+
+PointBlock gather_points(const PointBlock &p, MPI_Comm comm) {
+  PointBlock all;
+  all.xyz = gather_rows(p.xyz, comm);
+  all.n = all.xyz.size() / 3;
+  for (const Field &f : p.fields) all.fields.push_back(Field{f.name, f.ncomp, gather_rows(f.data, comm)});
+  return all;
+}
+
+// The boxes (lo, cnt) of all ranks placed into the whole grid on rank 0.
+GridBlock gather_grid(const GridBlock &g, const int lo[3], const int cnt[3], MPI_Comm comm) {
+  int me, np;
+  MPI_Comm_rank(comm, &me);
+  MPI_Comm_size(comm, &np);
+  GridBlock all{{g.n[0], g.n[1], g.n[2]},
+                {g.origin[0], g.origin[1], g.origin[2]},
+                {g.spacing[0], g.spacing[1], g.spacing[2]},
+                {}};
+  const int mine[6] = {lo[0], lo[1], lo[2], cnt[0], cnt[1], cnt[2]};
+  std::vector<int> boxes(6 * np);
+  MPI_Gather(mine, 6, MPI_INT, boxes.data(), 6, MPI_INT, 0, comm);
+  const std::size_t nn = std::size_t(g.n[0]) * g.n[1] * g.n[2];
+  for (const Field &f : g.fields) {
+    const std::vector<double> rows = gather_rows(f.data, comm);
+    const std::size_t nc = std::size_t(f.ncomp);
+    all.fields.push_back(Field{f.name, f.ncomp, std::vector<double>(me == 0 ? nn * nc : 0, 0.0)});
+    std::vector<double> &out = all.fields.back().data;
+    std::size_t r = 0;
+    for (int q = 0; q < np && me == 0; ++q) {
+      const int *b = &boxes[6 * q];
+      for (int k = b[2]; k < b[2] + b[5]; ++k)
+        for (int j = b[1]; j < b[1] + b[4]; ++j)
+          for (int i = b[0]; i < b[0] + b[3]; ++i, r += nc)
+            std::copy(&rows[r], &rows[r] + nc, &out[((std::size_t(k) * g.n[1] + j) * g.n[0] + i) * nc]);
+    }
+  }
+  return all;
+}
+#endif
+
 }  // namespace
 
-Hdf5Series::Hdf5Series(const std::string &prefix) : prefix_(prefix), xmf_path_(prefix + ".xmf") {
+Hdf5Series::Hdf5Series(const std::string &prefix, MPI_Comm comm)
+    : prefix_(prefix), xmf_path_(prefix + ".xmf"), comm_(comm) {
+  MPI_Comm_rank(comm_, &me_);
+  MPI_Comm_size(comm_, &nprocs_);
   const std::size_t slash = prefix.rfind('/');
   base_ = slash == std::string::npos ? prefix : prefix.substr(slash + 1);
-  if (base_.empty()) fail(prefix, "output prefix must name a file, not a directory");
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : prefix.substr(0, slash));
-  struct stat st;
-  if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
-    fail(xmf_path_, "output directory '" + dir + "' does not exist");
-  if (access(dir.c_str(), W_OK | X_OK) != 0) fail(xmf_path_, "output directory '" + dir + "' is not writable");
-  load_existing();
+  std::string err;
+  if (me_ == 0)  // the index is rank 0's
+    err = caught([&] {
+      if (base_.empty()) fail(prefix, "output prefix must name a file, not a directory");
+      const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : prefix.substr(0, slash));
+      struct stat st;
+      if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+        fail(xmf_path_, "output directory '" + dir + "' does not exist");
+      if (access(dir.c_str(), W_OK | X_OK) != 0) fail(xmf_path_, "output directory '" + dir + "' is not writable");
+      load_existing();
+    });
+  agree(comm_, err);
 }
 
 std::string Hdf5Series::step_path(long step) const {
@@ -198,134 +441,79 @@ void Hdf5Series::load_existing() {
 }
 
 void Hdf5Series::write_step(long step, double time, const PointBlock &pts, const GridBlock *grid) {
+  const double t0 = MPI_Wtime();
   const std::string path = step_path(step);
   const std::string fname = path.substr(path.rfind('/') + 1);
-  // ---- validate everything before touching the disk
-  if (step < 0) fail(path, "negative step number");
-  if (pts.xyz.size() != 3 * pts.n)
-    fail(path, "points xyz size " + std::to_string(pts.xyz.size()) + " != 3 x " + std::to_string(pts.n));
-  check_fields(path, pts.fields, pts.n, "points", true);
-  std::size_t nn = 0;
-  if (grid) {
-    for (int d = 0; d < 3; ++d)
-      if (grid->n[d] < 1) fail(path, "grid node count must be >= 1 in every direction");
-    nn = std::size_t(grid->n[0]) * grid->n[1] * grid->n[2];
-    check_fields(path, grid->fields, nn, "grid", false);
+  // ---- validate everything (each rank its part, then together) before touching the disk
+  int lo[3] = {0, 0, 0}, cnt[3] = {0, 0, 0};
+  unsigned long long mine[2] = {pts.n, 0}, all[2] = {0, 0}, offset = 0;  // points, grid nodes
+  agree(comm_, caught([&] {
+          if (step < 0) fail(path, "negative step number");
+          if (pts.xyz.size() != 3 * pts.n)
+            fail(path, "points xyz size " + std::to_string(pts.xyz.size()) + " != 3 x " + std::to_string(pts.n));
+          check_fields(path, pts.fields, pts.n, "points", true);
+          if (!grid) return;
+          for (int d = 0; d < 3; ++d) {
+            if (grid->n[d] < 1) fail(path, "grid node count must be >= 1 in every direction");
+            lo[d] = grid->count[d] < 0 ? 0 : grid->lo[d];
+            cnt[d] = grid->count[d] < 0 ? grid->n[d] : grid->count[d];
+            if (lo[d] < 0 || lo[d] + cnt[d] > grid->n[d]) fail(path, "grid box outside the grid");
+          }
+          mine[1] = static_cast<unsigned long long>(cnt[0]) * cnt[1] * cnt[2];
+          check_fields(path, grid->fields, mine[1], "grid", false);
+        }));
+  if (nprocs_ > 1) {
+    std::string sig = layout(step, time, pts, grid), sig0 = sig;
+    int len = static_cast<int>(sig0.size());
+    MPI_Bcast(&len, 1, MPI_INT, 0, comm_);
+    sig0.resize(len);
+    MPI_Bcast(&sig0[0], len, MPI_CHAR, 0, comm_);
+    agree(comm_, sig == sig0 ? std::string() : message(path, "step, time, fields or grid differ from rank 0's"));
   }
+  MPI_Allreduce(mine, all, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, comm_);
+  MPI_Exscan(&mine[0], &offset, 1, MPI_UNSIGNED_LONG_LONG, MPI_SUM, comm_);
+  if (me_ == 0) offset = 0;  // MPI_Exscan leaves rank 0's undefined
+  const std::size_t n_all = all[0];
+  if (grid && all[1] != std::size_t(grid->n[0]) * grid->n[1] * grid->n[2])  // the same on every rank
+    fail(path, "the ranks' grid boxes hold " + std::to_string(all[1]) + " nodes, the grid " +
+                   std::to_string(std::size_t(grid->n[0]) * grid->n[1] * grid->n[2]));
 
   // ---- HDF5 step file, written to <file>.tmp and renamed into place
   const std::string tmp = path + ".tmp";
-  {
-    QuietH5 quiet;
-    H5Writer w{path};
-    try {
-      Handle fapl(w.ok(H5Pcreate(H5P_FILE_ACCESS), "creating file access list"), H5Pclose);
-#if H5_VERSION_GE(1, 10, 7)
-      // no flock(): it fails on some parallel file systems and blocks concurrent viewers
-      w.ok(H5Pset_file_locking(fapl.get(), false, true), "disabling file locking");
+  std::string err;
+#ifdef MPM_HDF5_PARALLEL
+  // every rank its rows of the same data sets; write_file's checks stop all ranks together
+  err = caught([&] { write_file(tmp, path, comm_, step, time, pts, n_all, offset, grid, lo, cnt); });
+#else
+  if (nprocs_ > 1) {  // rank 0 gathers and writes alone
+    const PointBlock pall = gather_points(pts, comm_);
+    const GridBlock gall = grid ? gather_grid(*grid, lo, cnt, comm_) : GridBlock{};
+    const int whole[3] = {grid ? grid->n[0] : 0, grid ? grid->n[1] : 0, grid ? grid->n[2] : 0}, zero[3] = {0, 0, 0};
+    if (me_ == 0)
+      err = caught([&] {
+        write_file(tmp, path, MPI_COMM_SELF, step, time, pall, n_all, 0, grid ? &gall : nullptr, zero, whole);
+      });
+  } else {
+    err = caught([&] { write_file(tmp, path, MPI_COMM_SELF, step, time, pts, n_all, 0, grid, lo, cnt); });
+  }
 #endif
-      Handle f(w.ok(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), "creating file " + tmp),
-               H5Fclose);
-      const long long step64 = step;
-      w.attr(f.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, &time);
-      w.attr(f.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &step64);
-      {
-        Handle g(w.ok(H5Gcreate2(f.get(), "points", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "creating group /points"),
-                 H5Gclose);
-        const hsize_t n = pts.n;
-        w.dataset(g.get(), "/points/xyz", {n, 3}, pts.xyz.data());
-        for (const Field &fl : pts.fields)
-          w.dataset(g.get(), "/points/" + fl.name,
-                    fl.ncomp == 1 ? std::vector<hsize_t>{n} : std::vector<hsize_t>{n, hsize_t(fl.ncomp)},
-                    fl.data.data());
-        w.ok(g.close(), "closing group /points");
-      }
-      if (grid) {
-        Handle g(w.ok(H5Gcreate2(f.get(), "grid", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "creating group /grid"),
-                 H5Gclose);
-        const long long n64[3] = {grid->n[0], grid->n[1], grid->n[2]};
-        w.attr(g.get(), "n", H5T_STD_I64LE, H5T_NATIVE_LLONG, 3, n64);
-        w.attr(g.get(), "origin", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 3, grid->origin);
-        w.attr(g.get(), "spacing", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 3, grid->spacing);
-        std::vector<hsize_t> dims = {hsize_t(grid->n[2]), hsize_t(grid->n[1]), hsize_t(grid->n[0])};
-        for (const Field &fl : grid->fields) {
-          std::vector<hsize_t> d = dims;
-          if (fl.ncomp > 1) d.push_back(hsize_t(fl.ncomp));
-          w.dataset(g.get(), "/grid/" + fl.name, d, fl.data.data());
-        }
-        w.ok(g.close(), "closing group /grid");
-      }
-      w.ok(f.close(), "closing file " + tmp);
-    } catch (...) {
-      std::remove(tmp.c_str());
-      throw;
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    std::remove(tmp.c_str());
-    fail(path, std::string("renaming temporary file failed: ") + std::strerror(err));
-  }
+  if (me_ == 0 && err.empty() && std::rename(tmp.c_str(), path.c_str()) != 0)
+    err = message(path, std::string("renaming temporary file failed: ") + std::strerror(errno));
+  MPI_Barrier(comm_);  // every rank has closed the file (or failed) before rank 0 removes it
+  if (me_ == 0 && !err.empty()) std::remove(tmp.c_str());
+  agree(comm_, err);
 
-  // ---- XDMF block for this step
-  const std::string n = std::to_string(pts.n);
-  std::ostringstream x;
-  const bool coll = grid != nullptr || pts.n == 0;  // empty point sets are left out of the index
-  const std::string in = coll ? "        " : "      ";
-  x << kBegin << "step=\"" << step << "\" time=\"" << num(time) << "\" file=\"" << xml_escape(fname)
-    << "\" -->\n";
-  if (coll) x << "      <Grid Name=\"step_" << step << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
-              << "        <Time Value=\"" << num(time) << "\"/>\n";
-  if (pts.n > 0) {
-    x << in << "<Grid Name=\"" << "points"
-      << "\" GridType=\"Uniform\">\n";
-    if (!coll) x << in << "  <Time Value=\"" << num(time) << "\"/>\n";
-    x << in << "  <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << n << "\" NodesPerElement=\"1\"/>\n"
-      << in << "  <Geometry GeometryType=\"XYZ\">\n"
-      << in << "    " << data_item(n + " 3", fname + ":/points/xyz") << "\n"
-      << in << "  </Geometry>\n";
-    for (const Field &fl : pts.fields)
-      x << in << "  <Attribute Name=\"" << xml_escape(fl.name) << "\" AttributeType=\"" << attr_type(fl.ncomp)
-        << "\" Center=\"Node\">\n"
-        << in << "    " << data_item(fl.ncomp == 1 ? n : n + " " + std::to_string(fl.ncomp),
-                                     fname + ":/points/" + fl.name) << "\n"
-        << in << "  </Attribute>\n";
-    x << in << "</Grid>\n";
+  // ---- the index (rank 0): replace this step, drop later (abandoned) steps
+  if (me_ == 0) {
+    std::vector<Entry> old = entries_;
+    entries_.erase(std::remove_if(entries_.begin(), entries_.end(), [&](const Entry &e) { return e.step >= step; }),
+                   entries_.end());
+    entries_.push_back(Entry{step, time, fname, step_block(step, time, fname, n_all, pts.fields, grid)});
+    err = caught([&] { write_xmf(); });
+    if (!err.empty()) entries_.swap(old);
   }
-  if (grid) {
-    const std::string dims =
-        std::to_string(grid->n[2]) + " " + std::to_string(grid->n[1]) + " " + std::to_string(grid->n[0]);
-    auto zyx = [](const double *v) { return num(v[2]) + " " + num(v[1]) + " " + num(v[0]); };
-    x << in << "<Grid Name=\"grid\" GridType=\"Uniform\">\n"
-      << in << "  <Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << dims << "\"/>\n"
-      << in << "  <Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
-      << in << "    <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">"
-      << zyx(grid->origin) << "</DataItem>\n"
-      << in << "    <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">"
-      << zyx(grid->spacing) << "</DataItem>\n"
-      << in << "  </Geometry>\n";
-    for (const Field &fl : grid->fields)
-      x << in << "  <Attribute Name=\"" << xml_escape(fl.name) << "\" AttributeType=\"" << attr_type(fl.ncomp)
-        << "\" Center=\"Node\">\n"
-        << in << "    " << data_item(fl.ncomp == 1 ? dims : dims + " " + std::to_string(fl.ncomp),
-                                     fname + ":/grid/" + fl.name) << "\n"
-        << in << "  </Attribute>\n";
-    x << in << "</Grid>\n";
-  }
-  if (coll) x << "      </Grid>\n";
-  x << "      " << kEnd;
-
-  // ---- update the index: replace this step, drop later (abandoned) steps
-  std::vector<Entry> old = entries_;
-  entries_.erase(std::remove_if(entries_.begin(), entries_.end(), [&](const Entry &e) { return e.step >= step; }),
-                 entries_.end());
-  entries_.push_back(Entry{step, time, fname, x.str()});
-  try {
-    write_xmf();
-  } catch (...) {
-    entries_.swap(old);
-    throw;
-  }
+  agree(comm_, err);
+  last_seconds_ = MPI_Wtime() - t0;
 }
 
 void Hdf5Series::write_xmf() const {

@@ -1,5 +1,5 @@
 // The solver's outputs: the global vector f_ID[1..18] and the HDF5 + XDMF series of keyword
-// output (points, and grid nodes, gathered on rank 0).
+// output (points, and grid nodes; each rank gives its own, mpm/hdf5_series.h writes them).
 #include <algorithm>
 #include <cmath>
 
@@ -62,112 +62,85 @@ long FluidSolver::pressure_solves() const { return proj_ ? proj_->solves() : 0; 
 long FluidSolver::pressure_iterations_summed() const { return proj_ ? proj_->iterations_summed() : 0; }
 
 namespace {
-// rows of all ranks on rank 0 (empty elsewhere)
-std::vector<double> gather_rows(const std::vector<double> &mine, MPI_Comm comm, int me, int nprocs) {
-  int n = static_cast<int>(mine.size());
-  std::vector<int> counts(nprocs), displs(nprocs, 0);
-  MPI_Gather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, comm);
-  std::vector<double> all;
-  if (me == 0) {
-    for (int q = 1; q < nprocs; ++q) displs[q] = displs[q - 1] + counts[q - 1];
-    all.resize(displs.back() + counts.back());
-  }
-  MPI_Gatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, 0, comm);
-  return all;
-}
-
 int point_field_size(const std::string &f) { return f == "v" ? 3 : f == "tau" ? 6 : f == "affine" ? 9 : 1; }
 }  // namespace
 
 void FluidSolver::write_output() {
   if (last_output_step_ == clock.step) return;
   last_output_step_ = clock.step;
+  // the ranks meet first (they would at the first collective call anyway), so that time_output is
+  // the output's own and not the wait for a rank still in the preceding step
+  MPI_Barrier(comm_);
+  const double t0 = MPI_Wtime();
   const GridSpec &gs = opt.grid;
   const std::vector<std::string> &pfields = opt.out_point_fields, &gfields = opt.out_grid_fields;
-  int stride = 3;
-  for (const auto &f : pfields) stride += point_field_size(f);
 
-  std::vector<double> buf;
-  for (int i = 0; i < pts.nlocal; ++i) {
-    if (!is_point(i)) continue;
-    const double *s = pts.state[i];
-    for (int d = 0; d < 3; ++d) buf.push_back(pts.x[i][d]);
-    for (const auto &f : pfields) {
-      if (f == "v") for (int d = 0; d < 3; ++d) buf.push_back(pts.v[i][d]);
-      else if (f == "p") buf.push_back(s[C_P]);
-      else if (f == "rho") buf.push_back(s[C_RHO]);
-      else if (f == "vol") buf.push_back(s[C_VOL]);
-      else if (f == "tau") for (int c = 0; c < 6; ++c) buf.push_back(s[C_TAU + c]);
-      else if (f == "theta") buf.push_back(s[C_THETA]);
-      else if (f == "id") buf.push_back(static_cast<double>(pts.tag[i]));
-      else if (f == "type") buf.push_back(static_cast<double>(pts.type[i]));
-      else if (f == "affine") for (int c = 0; c < 9; ++c) buf.push_back(s[C_AFF + c]);
-      else if (f == "mass") buf.push_back(pts.rmass[i]);
-    }
+  // This rank's points and owned real grid nodes (not the padding): Hdf5Series places them.
+  // Field by field, so that each name is looked up once, not once per point.
+  std::vector<int> mine;
+  for (int i = 0; i < pts.nlocal; ++i)
+    if (is_point(i)) mine.push_back(i);
+  PointBlock pb;
+  pb.n = mine.size();
+  pb.xyz.reserve(3 * pb.n);
+  for (int i : mine) pb.xyz.insert(pb.xyz.end(), pts.x[i], pts.x[i] + 3);
+  for (const auto &f : pfields) {
+    pb.fields.push_back({f, point_field_size(f), {}});
+    std::vector<double> &out = pb.fields.back().data;
+    out.reserve(pb.n * point_field_size(f));
+    auto state = [&](int c0, int nc) {
+      for (int i : mine) out.insert(out.end(), pts.state[i] + c0, pts.state[i] + c0 + nc);
+    };
+    if (f == "v") for (int i : mine) out.insert(out.end(), pts.v[i], pts.v[i] + 3);
+    else if (f == "p") state(C_P, 1);
+    else if (f == "rho") state(C_RHO, 1);
+    else if (f == "vol") state(C_VOL, 1);
+    else if (f == "tau") state(C_TAU, 6);
+    else if (f == "theta") state(C_THETA, 1);
+    else if (f == "affine") state(C_AFF, 9);
+    else if (f == "id") for (int i : mine) out.push_back(static_cast<double>(pts.tag[i]));
+    else if (f == "type") for (int i : mine) out.push_back(static_cast<double>(pts.type[i]));
+    else if (f == "mass") for (int i : mine) out.push_back(pts.rmass[i]);
   }
-  const std::vector<double> all = gather_rows(buf, comm_, me_, nprocs_);
 
-  // Grid: owned real nodes (not the padding) as (global index, values).
   GridBlock gb;
-  std::vector<double> gall;
   const bool want_grid = !gfields.empty();
-  int gstride = 1;
-  for (const auto &f : gfields) gstride += (f == "v") ? 3 : 1;
   if (want_grid) {
-    std::vector<double> gbuf;
-    int nn[3];
-    for (int d = 0; d < 3; ++d) nn[d] = gs.periodic[d] ? gs.ncell[d] : gs.ncell[d] + 1;
     const IndexBox &ob = grid_.owned();
-    for (int k = std::max(ob.lo[2], 0); k <= std::min(ob.hi[2], nn[2] - 1); ++k)
-      for (int j = std::max(ob.lo[1], 0); j <= std::min(ob.hi[1], nn[1] - 1); ++j)
-        for (int i = std::max(ob.lo[0], 0); i <= std::min(ob.hi[0], nn[0] - 1); ++i) {
-          const std::size_t n = grid_.index(i, j, k);
-          gbuf.push_back(static_cast<double>((static_cast<long>(k) * nn[1] + j) * nn[0] + i));
-          for (const auto &f : gfields) {
-            if (f == "mass") gbuf.push_back(g_.p2g[P2gRec::N * n + P2gRec::M]);
-            else for (int d = 0; d < 3; ++d) gbuf.push_back(g_.vel[VelRec::N * n + VelRec::V_NEW + d]);
-          }
-        }
-    gall = gather_rows(gbuf, comm_, me_, nprocs_);
+    int lo[3], hi[3];
     for (int d = 0; d < 3; ++d) {
-      gb.n[d] = nn[d];
+      gb.n[d] = gs.periodic[d] ? gs.ncell[d] : gs.ncell[d] + 1;
       gb.origin[d] = gs.origin[d];
       gb.spacing[d] = gs.dx;
+      lo[d] = std::max(ob.lo[d], 0);
+      hi[d] = std::min(ob.hi[d], gb.n[d] - 1);
+      gb.lo[d] = lo[d];
+      gb.count[d] = std::max(hi[d] - lo[d] + 1, 0);
+    }
+    if (gb.count[0] == 0 || gb.count[1] == 0 || gb.count[2] == 0)
+      for (int d = 0; d < 3; ++d) gb.lo[d] = gb.count[d] = 0;  // owns no node
+    for (const auto &f : gfields) {
+      gb.fields.push_back({f, f == "v" ? 3 : 1, {}});
+      std::vector<double> &out = gb.fields.back().data;
+      const bool mass = f == "mass";
+      for (int k = lo[2]; k <= hi[2]; ++k)
+        for (int j = lo[1]; j <= hi[1]; ++j)
+          for (int i = lo[0]; i <= hi[0]; ++i) {
+            const std::size_t n = grid_.index(i, j, k);
+            if (mass) out.push_back(g_.p2g[P2gRec::N * n + P2gRec::M]);
+            else out.insert(out.end(), &g_.vel[VelRec::N * n + VelRec::V_NEW], &g_.vel[VelRec::N * n + VelRec::V_NEW] + 3);
+          }
     }
   }
 
-  if (me_ != 0) return;
-  PointBlock pb;
-  pb.n = all.size() / stride;
-  pb.xyz.resize(3 * pb.n);
-  for (const auto &f : pfields) pb.fields.push_back({f, point_field_size(f), std::vector<double>(pb.n * point_field_size(f))});
-  for (std::size_t p = 0; p < pb.n; ++p) {
-    const double *r = &all[p * stride];
-    for (int d = 0; d < 3; ++d) pb.xyz[3 * p + d] = r[d];
-    int off = 3;
-    for (auto &fl : pb.fields) {
-      for (int c = 0; c < fl.ncomp; ++c) fl.data[p * fl.ncomp + c] = r[off + c];
-      off += fl.ncomp;
-    }
-  }
-  if (want_grid) {
-    const std::size_t nn = std::size_t(gb.n[0]) * gb.n[1] * gb.n[2];
-    for (const auto &f : gfields) gb.fields.push_back({f, f == "v" ? 3 : 1, std::vector<double>(nn * (f == "v" ? 3 : 1), 0.0)});
-    for (std::size_t r = 0; r + gstride <= gall.size(); r += gstride) {
-      const std::size_t n = static_cast<std::size_t>(gall[r]);
-      int off = 1;
-      for (auto &fl : gb.fields) {
-        for (int c = 0; c < fl.ncomp; ++c) fl.data[n * fl.ncomp + c] = gall[r + off + c];
-        off += fl.ncomp;
-      }
-    }
-  }
-  try {
-    if (!series_) series_.reset(new Hdf5Series(opt.out_prefix));
+  try {  // collective: a failure on any rank throws the same message on every rank
+    if (!series_) series_.reset(new Hdf5Series(opt.out_prefix, comm_));
     series_->write_step(clock.step, clock.time, pb, want_grid ? &gb : nullptr);
   } catch (const std::exception &e) {
-    throw LocalError(std::string("Fix mpm/fluid: keyword 'output': ") + e.what());
+    throw Error(std::string("Fix mpm/fluid: keyword 'output': ") + e.what());
   }
+  time_output += MPI_Wtime() - t0;
+  ++n_outputs;
 }
 
 }  // namespace mpm

@@ -120,6 +120,9 @@ class FluidSolver {
   void global_vector(double out[kGlobalSize]);
   // HDF5 + XDMF output of the points (and grid) fields of keyword output (collective).
   void write_output();
+  // wall time in write_output on this rank (s, cumulative) and the step files written
+  double time_output = 0.0;
+  long n_outputs = 0;
   // wall time of the fluid's own work and of the coupling on this rank (s, cumulative)
   double time_fluid = 0.0, time_couple = 0.0;
   // pressure projection, this rank, cumulative: wall time in the pressure solver (hypre assembly,

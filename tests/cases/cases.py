@@ -8,6 +8,7 @@ only, so that CTest needs no virtual environment.
     cases.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR --mpirun "mpirun ..."
 """
 import argparse
+import array
 import math
 import os
 import re
@@ -325,6 +326,87 @@ def case_hdf5_output(r):
     xmf = open(os.path.join(d, "dambreak.xmf")).read()
     check(all(f in xmf for f in h5), "the XDMF index references every step file")
     check('Name="p"' in xmf and 'Name="v"' in xmf and 'Name="tau"' not in xmf, "only the requested fields")
+
+
+def h5dump(args, what):
+    """Runs Debian's h5dump (package hdf5-tools) with args; its output."""
+    if not shutil.which("h5dump"):
+        raise RuntimeError("h5dump not found: install the Debian package 'hdf5-tools' (tools/install_deps.sh)")
+    p = subprocess.run(["h5dump"] + args, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"h5dump {what}: {p.stdout[-300:]}")
+    return p.stdout
+
+
+def h5_layout(path):
+    """Groups, data sets (type, shape) and attribute values of an HDF5 file, as h5dump prints them
+    (full precision), without the line naming the file."""
+    return h5dump(["-A", "-m", "%.17g", path], path).split("\n", 1)[1]
+
+
+def h5_doubles(path, dataset, tmp):
+    """The values of one data set of doubles, in file order."""
+    h5dump(["-d", dataset, "-b", "LE", "-o", tmp, path], f"{path}:{dataset}")
+    a = array.array("d")
+    with open(tmp, "rb") as f:
+        a.frombytes(f.read())
+    if sys.byteorder != "little":
+        a.byteswap()
+    return a
+
+
+def h5_series_same(d1, d2, prefix, rel):
+    """The HDF5 series prefix of run folders d1 and d2: the same files, index and layout; the same
+    points (rows sorted by their id, values within rel of the field's largest magnitude) and grid
+    (node by node). Returns the largest relative difference and the step files."""
+    files = sorted(f for f in os.listdir(d1) if f.startswith(prefix + "_") and f.endswith(".h5"))
+    check(files == sorted(f for f in os.listdir(d2) if f.startswith(prefix + "_") and f.endswith(".h5")),
+          f"the same {len(files)} step files")
+    check(not [f for f in os.listdir(d2) if f.endswith(".tmp")], "no temporary file left")
+    x1, x2 = (open(os.path.join(d, prefix + ".xmf")).read() for d in (d1, d2))
+    check(x1 == x2, "the same XDMF index")
+    worst = 0.0
+    tmp = os.path.join(d2, "dataset.bin")
+    for f in files:
+        a, b = os.path.join(d1, f), os.path.join(d2, f)
+        la = h5_layout(a)
+        check(la == h5_layout(b), f"{f}: the same groups, data sets, shapes and attributes")
+        sets = re.findall(r'^( *)(GROUP|DATASET) "([^"]+)"', la, re.M)
+        path, names = [], []
+        for ind, kind, name in sets:  # full names from the indentation
+            path = path[:len(ind) // 3] + [name]
+            if kind == "DATASET":
+                names.append("/" + "/".join(path[1:]))
+        ids = [h5_doubles(p, "/points/id", tmp) for p in (a, b)]
+        n = len(ids[0])
+        order = [sorted(range(n), key=lambda i, v=v: v[i]) for v in ids]
+        for name in names:
+            va, vb = h5_doubles(a, name, tmp), h5_doubles(b, name, tmp)
+            check(len(va) == len(vb), f"{f}:{name}: the same number of values")
+            if name.startswith("/points/") and n > 0:
+                k = len(va) // n
+                va = [va[i * k + c] for i in order[0] for c in range(k)]
+                vb = [vb[i * k + c] for i in order[1] for c in range(k)]
+            scale = max([abs(v) for v in va] + [1e-300])
+            diff = max([abs(u - v) for u, v in zip(va, vb)] + [0.0]) / scale
+            worst = max(worst, diff)
+            check(diff <= rel, f"{f}:{name}: the same values to {rel:g} of the largest ({diff:.1e})")
+    return worst, files
+
+
+def case_hdf5_np2_vs_np1(r):
+    """The HDF5 series of 2 ranks (parallel HDF5: each rank its rows) holds the same as 1 rank's."""
+    v = dict(cells=8, length=12.0, tend=2.0, h5every=500, extra="id grid mass v")
+    d1, _ = r.dambreak("hdf5_np2_vs_np1/np1", **v)
+    d2, _ = r.dambreak("hdf5_np2_vs_np1/np2", np=2, **v)
+    worst, files = h5_series_same(d1, d2, "dambreak", 1e-9)
+    print(f"  {len(files)} step files; largest difference {worst:.1e} of a field's largest value")
+    check(len(files) >= 4, f"several step files ({len(files)})")
+    last = os.path.join(d2, files[-1])
+    xyz = h5_doubles(last, "/points/xyz", os.path.join(d2, "dataset.bin"))
+    check(max(xyz[0::3]) > 6.0 and min(xyz[0::3]) < 6.0, "the last file holds points of both ranks (x = 6 cuts)")
+    ids = h5_doubles(last, "/points/id", os.path.join(d2, "dataset.bin"))
+    check(sorted(ids) == [float(i) for i in range(1, len(ids) + 1)], f"every point once ({len(ids)} ids)")
 
 
 def schiller_naumann_settling(d, rhop, rhof, nu, g, t_end, n=20000):

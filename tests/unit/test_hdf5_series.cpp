@@ -1,11 +1,15 @@
-// Tests for mpm::Hdf5Series (serial HDF5 + XDMF time-series writer).
+// Tests for mpm::Hdf5Series (HDF5 + XDMF time-series writer): alone (MPI_COMM_SELF) and with the
+// points and grid boxes split over the ranks of MPI_COMM_WORLD (run on 1 and 2 ranks).
 #include "mpm/hdf5_series.h"
 
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <mpi.h>
 #include <stdlib.h>
 
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -337,4 +341,143 @@ TEST(Hdf5Series, ZeroPoints) {
   EXPECT_EQ(count(x, "3DCoRectMesh"), 1);
   Hdf5Series again(tmp.path() + "/z");
   EXPECT_EQ(again.entries().size(), 2u);
+}
+
+// ---- all ranks of MPI_COMM_WORLD write one series together
+
+namespace {
+
+int world_rank() {
+  int r;
+  MPI_Comm_rank(MPI_COMM_WORLD, &r);
+  return r;
+}
+
+int world_size() {
+  int s;
+  MPI_Comm_size(MPI_COMM_WORLD, &s);
+  return s;
+}
+
+// A folder made by rank 0, its path known to every rank, removed by rank 0.
+class SharedDir {
+ public:
+  SharedDir() {
+    if (world_rank() == 0) tmp_.reset(new TempDir);
+    std::string p = tmp_ ? tmp_->path() : std::string();
+    int len = static_cast<int>(p.size());
+    MPI_Bcast(&len, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    p.resize(len);
+    MPI_Bcast(&p[0], len, MPI_CHAR, 0, MPI_COMM_WORLD);
+    path_ = p;
+  }
+  ~SharedDir() { MPI_Barrier(MPI_COMM_WORLD); }
+  const std::string &path() const { return path_; }
+ private:
+  std::unique_ptr<TempDir> tmp_;
+  std::string path_;
+};
+
+// rank r's points: rows [first(r), first(r+1)) of the whole set; rank 1 has none
+std::size_t first_row(int r) {
+  std::size_t n = 0;
+  for (int q = 0; q < r; ++q) n += q == 1 ? 0 : 4 + q;
+  return n;
+}
+
+PointBlock rows_of(const PointBlock &all, std::size_t a, std::size_t b) {
+  PointBlock p;
+  p.n = b - a;
+  p.xyz.assign(all.xyz.begin() + 3 * a, all.xyz.begin() + 3 * b);
+  for (const Field &f : all.fields)
+    p.fields.push_back(Field{f.name, f.ncomp, std::vector<double>(f.data.begin() + a * f.ncomp, f.data.begin() + b * f.ncomp)});
+  return p;
+}
+
+// rank r's grid box: z layers [4r/np, 4(r+1)/np) of the 3 x 2 x 4 grid of make_grid
+GridBlock box_of(const GridBlock &all, int r, int np) {
+  GridBlock g{{all.n[0], all.n[1], all.n[2]}, {all.origin[0], all.origin[1], all.origin[2]},
+              {all.spacing[0], all.spacing[1], all.spacing[2]}, {}};
+  const int z0 = all.n[2] * r / np, z1 = all.n[2] * (r + 1) / np;
+  g.lo[2] = z0;
+  g.count[0] = all.n[0];
+  g.count[1] = all.n[1];
+  g.count[2] = z1 - z0;
+  const std::size_t layer = std::size_t(all.n[0]) * all.n[1];
+  for (const Field &f : all.fields)
+    g.fields.push_back(Field{f.name, f.ncomp, std::vector<double>(f.data.begin() + z0 * layer * f.ncomp,
+                                                                  f.data.begin() + z1 * layer * f.ncomp)});
+  return g;
+}
+
+std::string what_of(const std::function<void()> &fn) {
+  try {
+    fn();
+  } catch (const std::runtime_error &e) {
+    return e.what();
+  }
+  return "(no exception)";
+}
+
+}  // namespace
+
+TEST(Hdf5SeriesRanks, EachRankItsRowsAndGridBox) {
+  const int me = world_rank(), np = world_size();
+  SharedDir dir;
+  const PointBlock all = make_points(first_row(np), 3.0);
+  const GridBlock grid = make_grid(5.0);
+  Hdf5Series s(dir.path() + "/w", MPI_COMM_WORLD);
+  const PointBlock mine = rows_of(all, first_row(me), first_row(me + 1));
+  const GridBlock box = box_of(grid, me, np);
+  s.write_step(3, 0.25, mine, &box);
+  s.write_step(4, 0.5, mine, nullptr);
+  EXPECT_GT(s.last_write_seconds(), 0.0);
+  if (me == 0) {
+    check_step_file(s.step_path(3), 3, 0.25, all, &grid);
+    check_step_file(s.step_path(4), 4, 0.5, all, nullptr);
+    const std::string x = slurp(s.xdmf_path());
+    EXPECT_EQ(count(x, "NumberOfElements=\"" + std::to_string(all.n) + "\""), 2);
+    EXPECT_EQ(count(x, "<Grid "), 1 + 3 + 1);
+    EXPECT_EQ(s.entries().size(), 2u);
+    for (auto &e : fs::directory_iterator(dir.path())) EXPECT_NE(e.path().extension(), ".tmp") << e.path();
+  }
+  Hdf5Series again(dir.path() + "/w", MPI_COMM_WORLD);  // restart: rank 0 reads the index
+  if (me == 0) EXPECT_EQ(again.entries().size(), 2u);
+}
+
+TEST(Hdf5SeriesRanks, FailureOnOneRankStopsEveryRankWithOneMessage) {
+  const int me = world_rank(), np = world_size();
+  SharedDir dir;
+  Hdf5Series s(dir.path() + "/f", MPI_COMM_WORLD);
+  s.write_step(0, 0.0, make_points(2, 0.0), nullptr);
+  // the last rank's field has a wrong size: every rank throws that rank's message
+  PointBlock p = make_points(2, 0.0);
+  if (me == np - 1) p.fields[0].data.pop_back();
+  const std::string m1 = what_of([&] { s.write_step(1, 0.1, p, nullptr); });
+  EXPECT_NE(m1.find("f_000000001.h5: points field 'f1': data size 1 != 2 x 1"), std::string::npos) << m1;
+  // a grid on rank 0 only (np 2), boxes that leave a hole (np 1)
+  GridBlock g = make_grid(0.0);
+  g.count[0] = 2;
+  g.count[1] = 2;
+  g.count[2] = 4;
+  g.fields.clear();
+  const std::string m2 = what_of([&] { s.write_step(2, 0.2, make_points(2, 0.0), me == 0 ? &g : nullptr); });
+  EXPECT_NE(m2.find(np > 1 ? "differ from rank 0's" : "the ranks' grid boxes hold 16 nodes, the grid 24"),
+            std::string::npos) << m2;
+  // HDF5 fails to create the file (a folder in its place): every rank stops, the index is kept
+  if (me == 0) fs::create_directory(s.step_path(5) + ".tmp");
+  MPI_Barrier(MPI_COMM_WORLD);
+  const std::string m3 = what_of([&] { s.write_step(5, 0.5, make_points(2, 0.0), nullptr); });
+  EXPECT_NE(m3.find("f_000000005.h5: creating file"), std::string::npos) << m3;
+  if (me == 0) {
+    EXPECT_EQ(s.entries().size(), 1u);
+    EXPECT_FALSE(fs::exists(s.step_path(1)));
+    EXPECT_FALSE(fs::exists(s.step_path(5)));
+  }
+  // and the series goes on
+  s.write_step(6, 0.6, make_points(2, 0.0), nullptr);
+  if (me == 0) EXPECT_EQ(s.entries().size(), 2u);
+  // a missing folder is found by rank 0 and reported on every rank
+  const std::string m4 = what_of([&] { Hdf5Series(dir.path() + "/no/such/x", MPI_COMM_WORLD); });
+  EXPECT_NE(m4.find("does not exist"), std::string::npos) << m4;
 }
