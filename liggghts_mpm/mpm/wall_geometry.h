@@ -150,8 +150,10 @@ class WallGeometry {
   // different sides of the triangle's plane (one-sided meshes: an end in the plane counts as on the
   // fluid side; two-sided meshes: an end in the plane, the other not, is a crossing, so a node in
   // a two-sided wall is cut off on both sides) and the crossing point inside the triangle (1e-9 in
-  // barycentric weights). *w_d: the wall velocity along d at the crossing (of the first such
-  // triangle in the fixed order). len <= margin, else all triangles are scanned.
+  // barycentric weights). *w_d: the d component of the wall velocity's normal part, (w . n) n_d,
+  // at the crossing (of the first such triangle in the fixed order): a wall moving along itself
+  // is no source of fluid (docs/projection.md, "Mesh walls"). len <= margin, else all triangles
+  // are scanned.
   bool crosses(const double a[3], int d, double len, double *w_d) const;
   // Side of x with respect to the nearest triangle within 'reach': -1 behind a one-sided mesh
   // (behind the planes of all equally near triangles; face hits first), +1 in front of one,
