@@ -148,7 +148,7 @@ void FluidSolver::fluid_fraction() {
   grid_.reverse_sum(g_.sol.data(), 1);
   if (opt.theta_smooth > 0.0) smooth_solid_volume();
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const int mi[3] = {mirror_node(i, 0), mirror_node(j, 1), mirror_node(k, 2)};
+    const int mi[3] = {opt.grid.mirror(i, 0), opt.grid.mirror(j, 1), opt.grid.mirror(k, 2)};
     const double Vj = solid_node_volume(mi[0], mi[1], mi[2]);
     const std::size_t m = grid_.in_patch(mi[0], mi[1], mi[2]) ? grid_.index(mi[0], mi[1], mi[2]) : n;
     g_.th[n] = std::min(1.0, std::max(opt.theta_min, 1.0 - g_.sol[m] / Vj));  // (8-11), (8-14)
@@ -182,14 +182,6 @@ void FluidSolver::fluid_fraction() {
 // The points' density and pressure for the new fluid fraction (their volume is unchanged).
 void FluidSolver::refresh_pressure() { update_stress(0.0, true); }
 
-// The node index c along d reflected at the grid faces (padding nodes -> their mirror inside);
-// c itself in a periodic dimension and inside the grid.
-int FluidSolver::mirror_node(int c, int d) const {
-  const GridSpec &gs = opt.grid;
-  if (gs.periodic[d]) return c;
-  return c < 0 ? -c : (c > gs.ncell[d] ? 2 * gs.ncell[d] - c : c);
-}
-
 /* Walls: what is mapped to a node outside a grid face (patch, partial sums before the reverse sum)
    is folded onto its mirror node inside (reflected shape functions), one direction after the
    other, so a corner's share ends on the inside too. */
@@ -208,7 +200,7 @@ void FluidSolver::fold_to_mirror(std::vector<double> &a, int stride) {
         for (int j = b.lo[1]; j <= b.hi[1]; ++j)
           for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
             int idx[3] = {i, j, k};
-            idx[d] = mirror_node(idx[d], d);
+            idx[d] = gs.mirror(idx[d], d);
             if (!grid_.in_patch(idx[0], idx[1], idx[2])) continue;
             double *from = &a[stride * grid_.index(i, j, k)];
             double *to = &a[stride * grid_.index(idx[0], idx[1], idx[2])];
@@ -280,30 +272,24 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
         --lo[d];
         ++hi[d];
       }
-      int b0[3], b1[3];  // owned nodes inside the box
+      IndexBox b;  // owned nodes inside the box
       for (int e = 0; e < 3; ++e) {
-        b0[e] = std::max(ob.lo[e], lo[e]);
-        b1[e] = std::min(ob.hi[e], hi[e]);
+        b.lo[e] = std::max(ob.lo[e], lo[e]);
+        b.hi[e] = std::min(ob.hi[e], hi[e]);
       }
-      for (int k = b0[2]; k <= b1[2]; ++k)
-        for (int j = b0[1]; j <= b1[1]; ++j)
-          for (int i = b0[0]; i <= b1[0]; ++i) {
-            const std::size_t n = grid_.index(i, j, k);
-            const int id = d == 0 ? i : d == 1 ? j : k;
-            const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
-            const std::size_t m[2] = {has[0] ? n - step[d] : 0, has[1] ? n + step[d] : 0};
-            const double Vn[2] = {has[0] ? phi[r * m[0] + stride] : 0.0, has[1] ? phi[r * m[1] + stride] : 0.0};
-            for (int c = 0; c < stride; ++c) {
-              const double phin[2] = {has[0] ? phi[r * m[0] + c] : 0.0, has[1] ? phi[r * m[1] + c] : 0.0};
-              phi_new[stride * n + c] = smoothing_step(phi[r * n + stride], phi[r * n + c], Vn, phin, has);
-            }
-          }
-      for (int k = b0[2]; k <= b1[2]; ++k)
-        for (int j = b0[1]; j <= b1[1]; ++j)
-          for (int i = b0[0]; i <= b1[0]; ++i) {
-            const std::size_t n = grid_.index(i, j, k);
-            for (int c = 0; c < stride; ++c) phi[r * n + c] = phi_new[stride * n + c];
-          }
+      grid_.for_box(b, [&](int i, int j, int k, std::size_t n) {
+        const int id = d == 0 ? i : d == 1 ? j : k;
+        const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
+        const std::size_t m[2] = {has[0] ? n - step[d] : 0, has[1] ? n + step[d] : 0};
+        const double Vn[2] = {has[0] ? phi[r * m[0] + stride] : 0.0, has[1] ? phi[r * m[1] + stride] : 0.0};
+        for (int c = 0; c < stride; ++c) {
+          const double phin[2] = {has[0] ? phi[r * m[0] + c] : 0.0, has[1] ? phi[r * m[1] + c] : 0.0};
+          phi_new[stride * n + c] = smoothing_step(phi[r * n + stride], phi[r * n + c], Vn, phin, has);
+        }
+      });
+      grid_.for_box(b, [&](int, int, int, std::size_t n) {
+        for (int c = 0; c < stride; ++c) phi[r * n + c] = phi_new[stride * n + c];
+      });
       grid_.forward(phi.data(), r);
     }
   grid_.for_owned([&](int, int, int, std::size_t n) {
@@ -673,7 +659,7 @@ void FluidSolver::route_reaction() {
   for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
     for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
       for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-        const int mi[3] = {mirror_node(i, 0), mirror_node(j, 1), mirror_node(k, 2)};
+        const int mi[3] = {opt.grid.mirror(i, 0), opt.grid.mirror(j, 1), opt.grid.mirror(k, 2)};
         if ((mi[0] == i && mi[1] == j && mi[2] == k) || !grid_.in_patch(mi[0], mi[1], mi[2])) continue;
         const std::size_t n = grid_.index(i, j, k), m = grid_.index(mi[0], mi[1], mi[2]);
         for (int d = 0; d < 3; ++d) g_.rq[3 * n + d] = g_.rq[3 * m + d];

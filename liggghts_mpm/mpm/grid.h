@@ -31,6 +31,12 @@ struct GridSpec {
   // Global node index range: non-periodic 0-pad .. ncell+pad, periodic 0 .. ncell-1.
   int node_lo(int d) const { return periodic[d] ? 0 : -pad; }
   int node_hi(int d) const { return periodic[d] ? ncell[d] - 1 : ncell[d] + pad; }
+  // Index c along d reflected at the wall it lies behind (-c, or 2 ncell - c); c itself inside the
+  // box or along a periodic d.
+  int mirror(int c, int d) const {
+    if (periodic[d]) return c;
+    return c < 0 ? -c : (c > ncell[d] ? 2 * ncell[d] - c : c);
+  }
 };
 
 // Owned node index range along one dimension of the subdomain [sublo, subhi).
@@ -60,12 +66,17 @@ class LocalGrid {
            k >= patch_.lo[2] && k <= patch_.hi[2];
   }
 
-  // Calls fn(i, j, k, n) for every owned node (global indices, flat patch index).
+  // Calls fn(i, j, k, n) for every node of box b (in the patch; global indices, flat patch index).
+  template <class Fn>
+  void for_box(const IndexBox &b, Fn &&fn) const {
+    for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+      for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+        for (int i = b.lo[0]; i <= b.hi[0]; ++i) fn(i, j, k, index(i, j, k));
+  }
+  // Calls fn(i, j, k, n) for every owned node.
   template <class Fn>
   void for_owned(Fn &&fn) const {
-    for (int k = owned_.lo[2]; k <= owned_.hi[2]; ++k)
-      for (int j = owned_.lo[1]; j <= owned_.hi[1]; ++j)
-        for (int i = owned_.lo[0]; i <= owned_.hi[0]; ++i) fn(i, j, k, index(i, j, k));
+    for_box(owned_, fn);
   }
 
   // Adds the halo partial sums of data (stride doubles per node) into their owners.

@@ -300,12 +300,6 @@ void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
   a.iarg = env.mesh_wall(a.narg, a.arg, a.iarg);
 }
 
-static std::string fmt_number(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
-
 // Keywords that belong to one pressure model only: an error under the other, naming them.
 void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
   static const char *const eos_only[] = {"bulk", "eos", "antilock", "pmin"};

@@ -446,18 +446,8 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
    wall and linear near it: Grid20 0 put back, fronts within 3 mm (docs/tank.md). */
 void Projection::mirror_normal(double *v, int i, int j, int k, const double *p2g, double mmin) const {
   const GridSpec &gs = opt_.grid;
-  int q[3] = {i, j, k};
-  bool out[3] = {false, false, false};
-  for (int d = 0; d < 3; ++d) {
-    if (gs.periodic[d]) continue;
-    if (q[d] < 0) {
-      q[d] = -q[d];
-      out[d] = true;
-    } else if (q[d] > gs.ncell[d]) {
-      q[d] = 2 * gs.ncell[d] - q[d];
-      out[d] = true;
-    }
-  }
+  const int q[3] = {gs.mirror(i, 0), gs.mirror(j, 1), gs.mirror(k, 2)};
+  const bool out[3] = {q[0] != i, q[1] != j, q[2] != k};
   if (!grid_.in_patch(q[0], q[1], q[2])) return;
   const std::size_t mn = grid_.index(q[0], q[1], q[2]);
   const double mm = p2g[P2gRec::N * mn + P2gRec::M];

@@ -166,7 +166,6 @@ class FluidSolver {
   template <int NS> void route_reaction();         // reaction points
   // out_j = sum_p S_jp V_p sum_i S_ip q_i (3 per node, folded): a nodal field as the points see it
   template <int NS> void through_points(const double *q, std::vector<double> &out);
-  int mirror_node(int c, int d) const;
   void fold_to_mirror(std::vector<double> &a, int stride);
   bool near_face(int i, int j, int k) const;
   bool near_face(const int base[3], int ns) const;
