@@ -25,6 +25,16 @@ std::string message(const std::string &file, const std::string &what) { return "
 
 [[noreturn]] void fail(const std::string &file, const std::string &what) { throw std::runtime_error(message(file, what)); }
 
+// root's s on every rank of comm (collective)
+std::string broadcast(MPI_Comm comm, int root, const std::string &s) {
+  int len = static_cast<int>(s.size());
+  MPI_Bcast(&len, 1, MPI_INT, root, comm);
+  std::string out = s;
+  out.resize(len);
+  MPI_Bcast(&out[0], len, MPI_CHAR, root, comm);
+  return out;
+}
+
 // Throws, on every rank of comm, the message of the lowest rank whose msg is not empty; returns
 // if all are empty. Every rank calls it at the same point: a failure on one rank stops them all
 // there, before the next collective call could wait for it.
@@ -35,12 +45,7 @@ void agree(MPI_Comm comm, const std::string &msg) {
   int bad = msg.empty() ? np : me, first = np;
   MPI_Allreduce(&bad, &first, 1, MPI_INT, MPI_MIN, comm);
   if (first == np) return;
-  int len = static_cast<int>(msg.size());
-  MPI_Bcast(&len, 1, MPI_INT, first, comm);
-  std::string m = msg;
-  m.resize(len);
-  MPI_Bcast(&m[0], len, MPI_CHAR, first, comm);
-  throw std::runtime_error(m);
+  throw std::runtime_error(broadcast(comm, first, msg));
 }
 
 // The message of the std::runtime_error fn throws, empty if it returns.
@@ -267,6 +272,14 @@ std::string step_block(long step, double time, const std::string &fname, std::si
   const std::string in = coll ? "        " : "      ";
   x << kBegin << "step=\"" << step << "\" time=\"" << num(time) << "\" file=\"" << xml_escape(fname)
     << "\" -->\n";
+  // a node-centred field of group (points, grid) with dims entries (and ncomp components each)
+  auto attribute = [&](const Field &fl, const std::string &dims, const char *group) {
+    x << in << "  <Attribute Name=\"" << xml_escape(fl.name) << "\" AttributeType=\"" << attr_type(fl.ncomp)
+      << "\" Center=\"Node\">\n"
+      << in << "    " << data_item(fl.ncomp == 1 ? dims : dims + " " + std::to_string(fl.ncomp),
+                                   fname + ":/" + group + "/" + fl.name) << "\n"
+      << in << "  </Attribute>\n";
+  };
   if (coll) x << "      <Grid Name=\"step_" << step << "\" GridType=\"Collection\" CollectionType=\"Spatial\">\n"
               << "        <Time Value=\"" << num(time) << "\"/>\n";
   if (n_all > 0) {
@@ -277,12 +290,7 @@ std::string step_block(long step, double time, const std::string &fname, std::si
       << in << "  <Geometry GeometryType=\"XYZ\">\n"
       << in << "    " << data_item(n + " 3", fname + ":/points/xyz") << "\n"
       << in << "  </Geometry>\n";
-    for (const Field &fl : pfields)
-      x << in << "  <Attribute Name=\"" << xml_escape(fl.name) << "\" AttributeType=\"" << attr_type(fl.ncomp)
-        << "\" Center=\"Node\">\n"
-        << in << "    " << data_item(fl.ncomp == 1 ? n : n + " " + std::to_string(fl.ncomp),
-                                     fname + ":/points/" + fl.name) << "\n"
-        << in << "  </Attribute>\n";
+    for (const Field &fl : pfields) attribute(fl, n, "points");
     x << in << "</Grid>\n";
   }
   if (grid) {
@@ -297,12 +305,7 @@ std::string step_block(long step, double time, const std::string &fname, std::si
       << in << "    <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" Format=\"XML\">"
       << zyx(grid->spacing) << "</DataItem>\n"
       << in << "  </Geometry>\n";
-    for (const Field &fl : grid->fields)
-      x << in << "  <Attribute Name=\"" << xml_escape(fl.name) << "\" AttributeType=\"" << attr_type(fl.ncomp)
-        << "\" Center=\"Node\">\n"
-        << in << "    " << data_item(fl.ncomp == 1 ? dims : dims + " " + std::to_string(fl.ncomp),
-                                     fname + ":/grid/" + fl.name) << "\n"
-        << in << "  </Attribute>\n";
+    for (const Field &fl : grid->fields) attribute(fl, dims, "grid");
     x << in << "</Grid>\n";
   }
   if (coll) x << "      </Grid>\n";
@@ -463,11 +466,7 @@ void Hdf5Series::write_step(long step, double time, const PointBlock &pts, const
           check_fields(path, grid->fields, mine[1], "grid", false);
         }));
   if (nprocs_ > 1) {
-    std::string sig = layout(step, time, pts, grid), sig0 = sig;
-    int len = static_cast<int>(sig0.size());
-    MPI_Bcast(&len, 1, MPI_INT, 0, comm_);
-    sig0.resize(len);
-    MPI_Bcast(&sig0[0], len, MPI_CHAR, 0, comm_);
+    const std::string sig = layout(step, time, pts, grid), sig0 = broadcast(comm_, 0, sig);
     agree(comm_, sig == sig0 ? std::string() : message(path, "step, time, fields or grid differ from rank 0's"));
   }
   MPI_Allreduce(mine, all, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, comm_);
