@@ -304,11 +304,11 @@ void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
 void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
   static const char *const eos_only[] = {"bulk", "eos", "antilock", "pmin"};
   static const char *const projection_only[] = {"tolerance", "max_iterations", "dtheta_source", "free_surface",
-                                                 "volume_correction"};
+                                                 "volume_correction", "pressure_average"};
   std::string bad;
   for (const std::string &kw : seen)
     for (const char *w : o.projection ? std::vector<const char *>(eos_only, eos_only + 4)
-                                      : std::vector<const char *>(projection_only, projection_only + 5))
+                                      : std::vector<const char *>(projection_only, projection_only + 6))
       if (kw == w && bad.find("'" + kw + "'") == std::string::npos) bad += (bad.empty() ? "'" : ", '") + kw + "'";
   // The ghost-fluid surface finds the surface from the nodal fill, which next to a mesh wall lacks
   // the mass the B-spline puts behind it (no mirror image of a triangle): measured beside a
@@ -457,6 +457,8 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_free_surface, false},
     {"volume_correction", "real", "1/time", ">= 0", "0", "a rate (1/time) >= 0 at which compressed points are pushed apart",
      REAL(volume_correction), 0.0, kInf, false, true, nullptr, nullptr, false},
+    {"pressure_average", "real", "time", ">= 0", "0", "a time constant >= 0 of the averaged pressure f_ID[19]",
+     REAL(pressure_average), 0.0, kInf, false, true, nullptr, nullptr, false},
     {"fill", "region nx ny nz type T", "-", "1..8 points per cell per direction", "required (not after read_restart)",
      "'region-ID nx ny nz type T'", nullptr, 0, 0, false, false, nullptr, parse_fill, false},
     {"hydrostatic", "axis surface g", "length, acceleration", "g >= 0", "none",

@@ -17,7 +17,8 @@ void FluidSolver::global_vector(double out[kGlobalSize]) {
   const double *spacing = state.spacing;
   double sum[4] = {0, 0, 0, state.n_clamped};  // mass, kinetic energy, points, clamped
   // |v|max, front, height, p max, wall time of the fluid and of the coupling (slowest rank)
-  double mx[7] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, time_fluid, time_couple, time_pressure_solver()};
+  double mx[8] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, time_fluid, time_couple, time_pressure_solver(),
+                  proj_ ? proj_->largest_average_pressure() : -HUGE_VAL};
   for (int i = 0; i < pts.nlocal; ++i) {
     if (!is_point(i)) continue;
     const double v2 = v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2];
@@ -37,9 +38,9 @@ void FluidSolver::global_vector(double out[kGlobalSize]) {
         for (int d = 0; d < 3; ++d) fg[d] += pts.state[k][C_FGRAIN + d];
   MPI_Allreduce(fg, gfg, 3, MPI_DOUBLE, MPI_SUM, comm_);
   for (int d = 0; d < 3; ++d) out[10 + d] = gfg[d];
-  double gsum[4], gmx[7];
+  double gsum[4], gmx[8];
   MPI_Allreduce(sum, gsum, 4, MPI_DOUBLE, MPI_SUM, comm_);
-  MPI_Allreduce(mx, gmx, 7, MPI_DOUBLE, MPI_MAX, comm_);
+  MPI_Allreduce(mx, gmx, 8, MPI_DOUBLE, MPI_MAX, comm_);
   out[0] = gsum[0];
   out[1] = gsum[1];
   out[2] = gmx[0];
@@ -55,6 +56,7 @@ void FluidSolver::global_vector(double out[kGlobalSize]) {
   out[15] = proj_ ? proj_->iterations() : 0.0;
   out[16] = proj_ ? proj_->residual() : 0.0;
   out[17] = gmx[6];
+  out[18] = std::isfinite(gmx[7]) ? gmx[7] : 0.0;
 }
 
 double FluidSolver::time_pressure_solver() const { return proj_ ? proj_->solver_seconds() : 0.0; }

@@ -376,6 +376,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
     if (std::isnan(e.residual)) os << "; " << e.what();  // hypre failed (INF or NaN), not a slow convergence
     throw Error(os.str());
   }
+  average_pressure(h);
   // for the points and grains: the padding nodes behind the box walls carry the pressure (and
   // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
   // they would lower the pressure of the points next to a wall by half a cell's hydrostatic step)
@@ -510,6 +511,30 @@ bool Projection::deep_inside(int i, int j, int k) const {
 
 /* ---------------------------------------------------------------------- state of the last solve */
 
+/* The pressure a sensor of finite response time reads (keyword pressure_average tau). Under the
+   projection an impact or a transfer event that must change the velocity within one fluid step h
+   gives a pressure of order rho |du| dx / h for that step: the pressure impulse (its integral over
+   time) converges as h shrinks, the single-step peak does not (docs/tank.md). The exponential
+   average pa += (1 - exp(-h / tau)) (p - pa) responds to an impulse I with I / tau, independent of
+   h, and to a steady pressure with that pressure. Nodes hold a fixed place, as a wall sensor. */
+void Projection::average_pressure(double h) {
+  const double tau = opt_.pressure_average;
+  if (tau > 0.0) {
+    if (p_avg_.empty()) p_avg_.assign(grid_.size(), 0.0);
+    const double a = have_avg_ ? -std::expm1(-h / tau) : 1.0;  // the first solve starts the average
+    grid_.for_owned([&](int, int, int, std::size_t n) { p_avg_[n] += a * (p_[n] - p_avg_[n]); });
+    have_avg_ = true;
+  }
+  largest_pressure();
+}
+
+void Projection::largest_pressure() {
+  const std::vector<double> &a = have_avg_ ? p_avg_ : p_;
+  double mx = -HUGE_VAL;
+  grid_.for_owned([&](int, int, int, std::size_t n) { mx = std::max(mx, a[n]); });
+  p_avg_max_ = mx;
+}
+
 void Projection::save(ProjectionState &s) const {
   s.valid = true;
   s.box = grid_.owned();
@@ -520,11 +545,14 @@ void Projection::save(ProjectionState &s) const {
   s.p.resize(nb);
   s.grad.resize(3 * nb);
   s.theta_last.resize(have_theta_last_ ? nb : 0);
+  s.have_avg = have_avg_;
+  s.p_avg.resize(have_avg_ ? nb : 0);
   std::size_t q = 0;
   grid_.for_owned([&](int, int, int, std::size_t n) {  // k, j, i with i fastest: the box's order
     s.p[q] = p_[n];
     for (int d = 0; d < 3; ++d) s.grad[3 * q + d] = grad_[3 * n + d];
     if (have_theta_last_) s.theta_last[q] = theta_last_[n];
+    if (have_avg_) s.p_avg[q] = p_avg_[n];
     ++q;
   });
 }
@@ -554,6 +582,15 @@ bool Projection::load(const ProjectionState &s) {
     });
     grid_.forward(theta_last_.data(), 1);
   }
+  // the averaged pressure goes on only if this run averages too (else it starts at the next solve)
+  have_avg_ = s.have_avg && opt_.pressure_average > 0.0;
+  if (have_avg_) {
+    p_avg_.assign(grid_.size(), 0.0);
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+      p_avg_[n] = s.p_avg[static_cast<std::size_t>(((k - b.lo[2]) * ey + (j - b.lo[1])) * ex + (i - b.lo[0]))];
+    });
+  }
+  largest_pressure();
   last_.iterations = s.iterations;
   last_.relative_residual = s.residual;
   // the padding nodes' copies, as after a solve (their labels are SOLID from the grid alone)
@@ -564,7 +601,7 @@ bool Projection::load(const ProjectionState &s) {
 }
 
 namespace {
-constexpr double kStateVersion = 1.0;  // layout of ProjectionState::pack
+constexpr double kStateVersion = 2.0;  // layout of ProjectionState::pack (1: without p_avg)
 }
 
 void ProjectionState::pack(std::vector<double> &out) const {
@@ -578,12 +615,14 @@ void ProjectionState::pack(std::vector<double> &out) const {
   out.insert(out.end(), p.begin(), p.end());
   out.insert(out.end(), grad.begin(), grad.end());
   out.insert(out.end(), theta_last.begin(), theta_last.end());
+  out.push_back(have_avg ? 1.0 : 0.0);
+  out.insert(out.end(), p_avg.begin(), p_avg.end());
 }
 
 std::size_t ProjectionState::unpack(const double *in) {
   *this = ProjectionState();
   if (in[0] == 0.0) return 1;
-  if (in[0] != kStateVersion) {
+  if (in[0] != kStateVersion && in[0] != 1.0) {
     std::ostringstream os;
     os << "Fix mpm/fluid: the restart file holds a pressure-projection state of layout " << in[0]
        << "; this build reads layout " << kStateVersion;
@@ -604,6 +643,13 @@ std::size_t ProjectionState::unpack(const double *in) {
     theta_last.assign(in + m, in + m + nb);
     m += nb;
   }
+  if (in[0] >= 2.0) {
+    have_avg = in[m++] != 0.0;
+    if (have_avg) {
+      p_avg.assign(in + m, in + m + nb);
+      m += nb;
+    }
+  }
   valid = true;
   return m;
 }
@@ -623,10 +669,13 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
   int th = local.have_theta_last ? 1 : 0, allth = 0;
   MPI_Allreduce(&th, &allth, 1, MPI_INT, MPI_MIN, comm);
   g.have_theta_last = allth != 0;
+  int av = local.have_avg ? 1 : 0, allav = 0;
+  MPI_Allreduce(&av, &allav, 1, MPI_INT, MPI_MIN, comm);
+  g.have_avg = allav != 0;
   g.iterations = local.iterations;
   g.residual = local.residual;
-  // every rank's box and values (p, grad, theta per node), copied into place on every rank
-  const int per = g.have_theta_last ? 5 : 4;
+  // every rank's box and values (p, grad, theta, p_avg per node), copied into place on every rank
+  const int per = 4 + (g.have_theta_last ? 1 : 0) + (g.have_avg ? 1 : 0);
   std::vector<double> mine;
   const std::size_t nb = static_cast<std::size_t>(local.box.count());
   mine.reserve(per * nb);
@@ -634,6 +683,7 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
     mine.push_back(local.p[q]);
     for (int d = 0; d < 3; ++d) mine.push_back(local.grad[3 * q + d]);
     if (g.have_theta_last) mine.push_back(local.theta_last[q]);
+    if (g.have_avg) mine.push_back(local.p_avg[q]);
   }
   std::vector<int> boxes(6 * nprocs), counts(nprocs), displs(nprocs);
   const int mybox[6] = {local.box.lo[0], local.box.lo[1], local.box.lo[2], local.box.hi[0], local.box.hi[1], local.box.hi[2]};
@@ -651,6 +701,7 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
   g.p.assign(ng, 0.0);
   g.grad.assign(3 * ng, 0.0);
   g.theta_last.assign(g.have_theta_last ? ng : 0, 1.0);
+  g.p_avg.assign(g.have_avg ? ng : 0, 0.0);
   const long gx = g.box.hi[0] - g.box.lo[0] + 1, gy = g.box.hi[1] - g.box.lo[1] + 1;
   for (int r = 0; r < nprocs; ++r) {
     const int *b = &boxes[6 * r];
@@ -662,6 +713,7 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
           g.p[n] = all[q++];
           for (int d = 0; d < 3; ++d) g.grad[3 * n + d] = all[q++];
           if (g.have_theta_last) g.theta_last[n] = all[q++];
+          if (g.have_avg) g.p_avg[n] = all[q++];
         }
   }
   return g;

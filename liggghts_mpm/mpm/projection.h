@@ -47,6 +47,9 @@ class Projection {
   // nodal pressure gradient of the last solve, the one the fluid felt (owned nodes and halos;
   // padding nodes with the wall node's): for the grains
   const std::vector<double> &gradient() const { return grad_ext_; }
+  // largest nodal pressure of the last solve on this rank's owned nodes, averaged in time
+  // (keyword pressure_average tau: exponential average with time constant tau; 0: as solved)
+  double largest_average_pressure() const { return p_avg_max_; }
   int iterations() const { return last_.iterations; }
   double residual() const { return last_.relative_residual; }
   // since construction, this rank: wall time in the pressure solver (hypre assembly, setup and
@@ -91,6 +94,11 @@ class Projection {
   std::vector<double> vol_;         // volume correction: sum S V with the padding folded back
   void add_volume_correction(const double *pvol, const double *theta, double h);
   bool deep_inside(int i, int j, int k) const;
+  std::vector<double> p_avg_;       // pressure_average: the nodal pressure averaged in time
+  bool have_avg_ = false;
+  double p_avg_max_ = 0.0;
+  void average_pressure(double h);
+  void largest_pressure();  // p_avg_max_ from p_avg_ (averaging) or p_
   PressureResult last_;
   double solver_seconds_ = 0.0;
   long solves_ = 0, iterations_summed_ = 0;

@@ -53,7 +53,8 @@ struct ProjectionState {
   bool have_theta_last = false;  // theta_last holds values (couple, after the first solve)
   int iterations = 0;            // of the last solve (f_ID[16], f_ID[17])
   double residual = 0.0;
-  std::vector<double> p, grad, theta_last;  // 1, 3, 1 per node of box
+  bool have_avg = false;         // p_avg holds values (pressure_average, after the first solve)
+  std::vector<double> p, grad, theta_last, p_avg;  // 1, 3, 1, 1 per node of box
   // appends the restart block (doubles); unpack reads one at in and returns the doubles read
   void pack(std::vector<double> &out) const;
   std::size_t unpack(const double *in);
@@ -116,7 +117,7 @@ class FluidSolver {
   // clamped, points, p max, fluid force on the grains (3), wall time of the fluid and coupling,
   // iterations and relative residual of the last pressure solve (pressure projection; else 0),
   // wall time in the pressure solver (part of the fluid's)
-  static constexpr int kGlobalSize = 18;
+  static constexpr int kGlobalSize = 19;
   void global_vector(double out[kGlobalSize]);
   // HDF5 + XDMF output of the points (and grid) fields of keyword output (collective).
   void write_output();

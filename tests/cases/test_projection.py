@@ -350,7 +350,7 @@ variable steps equal 200
 if "${{mode}} == 1" then "variable steps equal 100"
 dump d all custom 100 all.dump id type x y z vx vy vz f_f[10]
 dump_modify d sort id format "%d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g"
-thermo_style custom step f_f[1] f_f[2] f_f[16] f_f[17]
+thermo_style custom step f_f[1] f_f[2] f_f[16] f_f[17] f_f[19]
 thermo_modify format float %.17g
 thermo 50
 run ${{steps}} upto
@@ -358,7 +358,7 @@ if "${{mode}} == 1" then "write_restart r.bin"
 """
 
 FLUID_ONLY = dict(lx=0.4, ly=0.025, lz=0.3, cx=0.1, cz=0.2, grains="", skin=0.005, group="all", cell=0.025,
-                  ppc="2 1 2", more="", nve="", dt=2e-3)
+                  ppc="2 1 2", more="pressure_average 0.05", nve="", dt=2e-3)
 # 5 grains (d 2 mm, 2500 kg/m3) falling through the lower half of a box of water, cell 2.5 mm
 COUPLED = dict(lx=0.04, ly=0.02, lz=0.03, cx=0.04, cz=0.02, skin=0.001, group="fluid", cell=0.0025, ppc="1 1 1",
                grains="\n".join(["create_atoms 2 single 0.0195 0.010 0.010 units box",
@@ -367,7 +367,7 @@ COUPLED = dict(lx=0.04, ly=0.02, lz=0.03, cx=0.04, cz=0.02, skin=0.001, group="f
                                   "create_atoms 2 single 0.0180 0.009 0.011 units box",
                                   "create_atoms 2 single 0.0220 0.011 0.009 units box",
                                   "set type 2 diameter 0.002 density 2500", "group grains type 2", "group fluid type 1"]),
-               more="couple grains", nve="fix nve grains nve/sphere", dt=1e-4)
+               more="couple grains pressure_average 0.005", nve="fix nve grains nve/sphere", dt=1e-4)
 
 
 def dump_frame(path):
@@ -423,10 +423,44 @@ def case_drop(r):
     check(max(s["mass"]) == min(s["mass"]), "fluid mass exact")
 
 
+def case_impact(r):
+    """The pressure of an impact (keyword pressure_average, f_fluid[19]): the block of 'drop' (0.5 m
+    high, falling 0.5 m: U = sqrt(2 g 0.5) = 3.13 m/s) hits the floor at t = 0.32 s. The incompressible
+    water is stopped within one fluid step h, so its single-step pressure is not bounded as h
+    shrinks (printed: the largest point and nodal pressure); its pressure impulse is. The nodal
+    pressure averaged over tau = 0.02 s must (1) be 0 in free fall (t < 0.25 s), (2) agree within
+    10 % between h and h/2 (dx / sqrt(g) times 0.05 and 0.025), (3) lie between the stagnation
+    pressure rho U^2 / 2 and the bound rho U b / tau + rho g b of the column's whole momentum per
+    area (b = 0.5 m) stopped within tau plus its weight."""
+    rho, g, b, z0, tau = 1000.0, 9.81, 0.5, 0.5, 0.02
+    U = math.sqrt(2 * g * z0)
+    inp = os.path.join(os.path.dirname(__file__), "..", "data", "in.projection_drop")
+    peaks = {}
+    for dtf in ("0.05", "0.025"):
+        for ptau in ("0", str(tau)):
+            d, p = r.run(f"projection/impact_{dtf}_{ptau}", inp, {"tend": "0.45", "dtf": dtf, "ptau": ptau})
+            s = read_csv(os.path.join(d, "pressure.csv"))
+            check(s["t"][-1] > 0.44, f"dtf {dtf} ptau {ptau}: the run reached 0.45 s ({s['t'][-1]:.3f} s)")
+            check(max(s["nsub"]) == 1, f"dtf {dtf}: one fluid step per time step")
+            free = [pa for t, pa in zip(s["t"], s["pavg"]) if t < 0.25]
+            check(max(free) < 1.0 and min(free) > -1.0,
+                  f"dtf {dtf} ptau {ptau}: no pressure in free fall ({min(free):.2e} .. {max(free):.2e} Pa)")
+            peaks[(dtf, ptau)] = (max(s["pmax"]), max(s["pavg"]))
+    for dtf in ("0.05", "0.025"):
+        print(f"  h = {dtf} dx/sqrt(g): largest point pressure {peaks[(dtf, '0')][0]:.0f} Pa, nodal {peaks[(dtf, '0')][1]:.0f} "
+              f"Pa; averaged over {tau} s {peaks[(dtf, str(tau))][1]:.0f} Pa")
+    a, b2 = peaks[("0.05", str(tau))][1], peaks[("0.025", str(tau))][1]
+    check(abs(a - b2) <= 0.10 * max(a, b2), f"averaged peak converges with the step: {a:.0f} vs {b2:.0f} Pa (10 %)")
+    lo, hi = 0.5 * rho * U * U, rho * U * b / tau + rho * g * b
+    check(lo <= min(a, b2) and max(a, b2) <= hi,
+          f"averaged peak within [rho U^2/2, rho U b/tau + rho g b] = [{lo:.0f}, {hi:.0f}] Pa")
+
+
 def case_restart(r):
     """A projection run resumed from a restart file equals the uninterrupted run bit for bit: the
     restart file holds the last solve's nodal pressure (warm start), its gradient (the grains'
-    force of the next step) and theta (the d(theta)/dt source). Fluid alone (np 1 and np 2) and
+    force of the next step), theta (the d(theta)/dt source) and the averaged pressure of
+    pressure_average (f_ID[19], in the thermo rows compared). Fluid alone (np 1 and np 2) and
     with five falling grains."""
     for case, params, np_ in (("projection_restart/fluid", FLUID_ONLY, 1), ("projection_restart/fluid_np2", FLUID_ONLY, 2),
                               ("projection_restart/coupled", COUPLED, 1)):
