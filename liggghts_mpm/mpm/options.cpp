@@ -95,6 +95,12 @@ void parse_free_surface(Options &o, Args &a, const ParseEnv &) {
   o.surface_given = true;
 }
 
+void parse_pressure_output(Options &o, Args &a, const ParseEnv &) {
+  bool mult = true;
+  choice(a, "multiplier", "acceleration", mult);
+  o.pressure_acceleration = !mult;
+}
+
 void parse_grad_p(Options &o, Args &a, const ParseEnv &) {
   a.need(1, "grad_p", "'weak', 'fit' or 'nodal'");
   if (strcmp(a.at(1), "weak") == 0)
@@ -304,11 +310,11 @@ void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
 void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
   static const char *const eos_only[] = {"bulk", "eos", "antilock", "pmin"};
   static const char *const projection_only[] = {"tolerance", "max_iterations", "dtheta_source", "free_surface",
-                                                 "volume_correction", "pressure_average"};
+                                                 "volume_correction", "pressure_average", "pressure_output"};
   std::string bad;
   for (const std::string &kw : seen)
     for (const char *w : o.projection ? std::vector<const char *>(eos_only, eos_only + 4)
-                                      : std::vector<const char *>(projection_only, projection_only + 6))
+                                      : std::vector<const char *>(projection_only, projection_only + 7))
       if (kw == w && bad.find("'" + kw + "'") == std::string::npos) bad += (bad.empty() ? "'" : ", '") + kw + "'";
   // The ghost-fluid surface finds the surface from the nodal fill, which next to a mesh wall lacks
   // the mass the B-spline puts behind it (no mirror image of a triangle): measured beside a
@@ -457,6 +463,8 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_free_surface, false},
     {"volume_correction", "real", "1/time", ">= 0", "0", "a rate (1/time) >= 0 at which compressed points are pushed apart",
      REAL(volume_correction), 0.0, kInf, false, true, nullptr, nullptr, false},
+    {"pressure_output", "multiplier | acceleration", "-", "", "multiplier", "'multiplier' or 'acceleration'",
+     nullptr, 0, 0, false, false, nullptr, parse_pressure_output, false},
     {"pressure_average", "real", "time", ">= 0", "0", "a time constant >= 0 of the averaged pressure f_ID[19]",
      REAL(pressure_average), 0.0, kInf, false, true, nullptr, nullptr, false},
     {"fill", "region nx ny nz type T", "-", "1..8 points per cell per direction", "required (not after read_restart)",

@@ -376,7 +376,6 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
     if (std::isnan(e.residual)) os << "; " << e.what();  // hypre failed (INF or NaN), not a slow convergence
     throw Error(os.str());
   }
-  average_pressure(h);
   // for the points and grains: the padding nodes behind the box walls carry the pressure (and
   // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
   // they would lower the pressure of the points next to a wall by half a cell's hydrostatic step)
@@ -403,6 +402,8 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   }
   correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), h, u_.data());
   grid_.forward(u_.data(), 3);
+  if (opt_.pressure_acceleration) acceleration_pressure(vel, h, p2g, mmin, step);
+  average_pressure(h);
   if (mesh_) {
     // nodes behind mesh walls: the projected velocity of the fluid in front, then the wall
     // condition (the normal velocity relative to the wall removed), as the padding nodes
@@ -517,19 +518,87 @@ bool Projection::deep_inside(int i, int j, int k) const {
    time) converges as h shrinks, the single-step peak does not (docs/tank.md). The exponential
    average pa += (1 - exp(-h / tau)) (p - pa) responds to an impulse I with I / tau, independent of
    h, and to a steady pressure with that pressure. Nodes hold a fixed place, as a wall sensor. */
+/* pressure_output acceleration (docs/projection.md, "The pressure of the acceleration"). The
+   projection's p is the Lagrange multiplier that makes this step's velocity divergence-free: it
+   removes whatever divergence the step's u* holds, the transfer's as well (FLIP and APIC do not
+   give back on the grid the divergence-free velocity they took from it), in one step h, so that
+   part of it is of order rho |du| dx / h and grows without bound as h shrinks (C3, F2 dam break,
+   docs/tank.md). The pressure of the incompressible Navier-Stokes equations is instead fixed by
+   the velocity field and the forces alone: with Du/Dt = a_f - grad p / rho and div u = 0,
+       div(beta grad p) = div(theta (a_f - (u . grad) u)),   no normal acceleration at walls,
+   p = 0 at the free surface. Here u is the projected velocity, a_f the grid forces per mass of the
+   step (gravity, viscosity, drag, damping: (u* - u_old) / h), (u . grad) u by central differences
+   between FLUID nodes (one-sided next to a non-FLUID node). The same operator and labels as the
+   projection: at rest it is the projection's hydrostatic pressure. Not in it: d(theta)/dt of moving
+   grains, the acceleration of walls. */
+void Projection::acceleration_pressure(const double *vel, double h, const double *p2g, double mmin, long step) {
+  const std::size_t nn = grid_.size();
+  if (acc_.size() != 3 * nn) {
+    acc_.assign(3 * nn, 0.0);
+    p_acc_.assign(nn, 0.0);
+    p_acc_ext_.assign(nn, 0.0);
+  }
+  const double inv2dx = 0.5 / opt_.grid.dx, invdx = 1.0 / opt_.grid.dx;
+  const long s[3] = {1, static_cast<long>(grid_.stride_y()), static_cast<long>(grid_.stride_z())};
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    double *a = &acc_[3 * n];
+    if (lab_.kind[n] != kFluid) {
+      a[0] = a[1] = a[2] = 0.0;
+      return;
+    }
+    const double *rec = vel + VelRec::N * n;
+    // V_NEW still holds u*: the forces of the step per mass
+    for (int d = 0; d < 3; ++d) a[d] = (rec[VelRec::V_NEW + d] - rec[VelRec::V_OLD + d]) / h;
+    const double *u = &u_[3 * n];
+    for (int e = 0; e < 3; ++e) {  // - u_e d/dx_e u
+      const std::size_t lo = n - s[e], hi = n + s[e];
+      const bool fl = lab_.kind[lo] == kFluid, fh = lab_.kind[hi] == kFluid;
+      if (!fl && !fh) continue;
+      for (int d = 0; d < 3; ++d) {
+        const double du = fl && fh ? (u_[3 * hi + d] - u_[3 * lo + d]) * inv2dx
+                                   : fh ? (u_[3 * hi + d] - u[d]) * invdx : (u[d] - u_[3 * lo + d]) * invdx;
+        a[d] -= u[e] * du;
+      }
+    }
+  });
+  grid_.forward(acc_.data(), 3);
+  const double *th = theta_last_.empty() || !have_theta_last_ ? theta_.data() : theta_last_.data();
+  acceleration_rhs(grid_, lab_, geo_, acc_.data(), th, rhs_.data());
+  try {
+    const double t0 = MPI_Wtime();
+    last_acc_ = solver_->solve(lab_, beta_.data(), rhs_.data(), p_acc_.data());
+    solver_seconds_ += MPI_Wtime() - t0;
+  } catch (const PressureSolveError &e) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: the solve for the pressure of the acceleration (keyword 'pressure_output "
+          "acceleration') did not converge at step "
+       << step << ": " << e.iterations << " PCG iterations (keyword 'max_iterations' " << opt_.pressure_max_iterations
+       << "), relative residual " << e.residual << " (keyword 'tolerance' " << opt_.pressure_tolerance << ")";
+    throw Error(os.str());
+  }
+  if (mesh_) {
+    std::vector<double> pb = p_acc_;
+    extend_behind(pb, 1, p2g, mmin);
+    extend_to_padding(pb, p_acc_ext_, 1);
+  } else {
+    extend_to_padding(p_acc_, p_acc_ext_, 1);
+  }
+}
+
 void Projection::average_pressure(double h) {
   const double tau = opt_.pressure_average;
   if (tau > 0.0) {
     if (p_avg_.empty()) p_avg_.assign(grid_.size(), 0.0);
     const double a = have_avg_ ? -std::expm1(-h / tau) : 1.0;  // the first solve starts the average
-    grid_.for_owned([&](int, int, int, std::size_t n) { p_avg_[n] += a * (p_[n] - p_avg_[n]); });
+    const std::vector<double> &p = opt_.pressure_acceleration ? p_acc_ : p_;
+    grid_.for_owned([&](int, int, int, std::size_t n) { p_avg_[n] += a * (p[n] - p_avg_[n]); });
     have_avg_ = true;
   }
   largest_pressure();
 }
 
 void Projection::largest_pressure() {
-  const std::vector<double> &a = have_avg_ ? p_avg_ : p_;
+  const std::vector<double> &a = have_avg_ ? p_avg_ : opt_.pressure_acceleration && !p_acc_.empty() ? p_acc_ : p_;
   double mx = -HUGE_VAL;
   grid_.for_owned([&](int, int, int, std::size_t n) { mx = std::max(mx, a[n]); });
   p_avg_max_ = mx;
@@ -547,12 +616,16 @@ void Projection::save(ProjectionState &s) const {
   s.theta_last.resize(have_theta_last_ ? nb : 0);
   s.have_avg = have_avg_;
   s.p_avg.resize(have_avg_ ? nb : 0);
+  const bool acc = !p_acc_.empty();
+  s.have_acc = acc;
+  s.p_acc.resize(acc ? nb : 0);
   std::size_t q = 0;
   grid_.for_owned([&](int, int, int, std::size_t n) {  // k, j, i with i fastest: the box's order
     s.p[q] = p_[n];
     for (int d = 0; d < 3; ++d) s.grad[3 * q + d] = grad_[3 * n + d];
     if (have_theta_last_) s.theta_last[q] = theta_last_[n];
     if (have_avg_) s.p_avg[q] = p_avg_[n];
+    if (acc) s.p_acc[q] = p_acc_[n];
     ++q;
   });
 }
@@ -590,6 +663,16 @@ bool Projection::load(const ProjectionState &s) {
       p_avg_[n] = s.p_avg[static_cast<std::size_t>(((k - b.lo[2]) * ey + (j - b.lo[1])) * ex + (i - b.lo[0]))];
     });
   }
+  if (s.have_acc && opt_.pressure_acceleration) {
+    const std::size_t nn = grid_.size();
+    acc_.assign(3 * nn, 0.0);
+    p_acc_.assign(nn, 0.0);
+    p_acc_ext_.assign(nn, 0.0);
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+      p_acc_[n] = s.p_acc[static_cast<std::size_t>(((k - b.lo[2]) * ey + (j - b.lo[1])) * ex + (i - b.lo[0]))];
+    });
+    grid_.forward(p_acc_.data(), 1);
+  }
   largest_pressure();
   last_.iterations = s.iterations;
   last_.relative_residual = s.residual;
@@ -597,6 +680,7 @@ bool Projection::load(const ProjectionState &s) {
   lab_.reset(grid_);
   extend_to_padding(p_, p_ext_, 1);
   extend_to_padding(grad_, grad_ext_, 3);
+  if (!p_acc_.empty()) extend_to_padding(p_acc_, p_acc_ext_, 1);
   return true;
 }
 
@@ -617,6 +701,8 @@ void ProjectionState::pack(std::vector<double> &out) const {
   out.insert(out.end(), theta_last.begin(), theta_last.end());
   out.push_back(have_avg ? 1.0 : 0.0);
   out.insert(out.end(), p_avg.begin(), p_avg.end());
+  out.push_back(have_acc ? 1.0 : 0.0);
+  out.insert(out.end(), p_acc.begin(), p_acc.end());
 }
 
 std::size_t ProjectionState::unpack(const double *in) {
@@ -649,6 +735,11 @@ std::size_t ProjectionState::unpack(const double *in) {
       p_avg.assign(in + m, in + m + nb);
       m += nb;
     }
+    have_acc = in[m++] != 0.0;
+    if (have_acc) {
+      p_acc.assign(in + m, in + m + nb);
+      m += nb;
+    }
   }
   valid = true;
   return m;
@@ -672,10 +763,13 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
   int av = local.have_avg ? 1 : 0, allav = 0;
   MPI_Allreduce(&av, &allav, 1, MPI_INT, MPI_MIN, comm);
   g.have_avg = allav != 0;
+  int ac = local.have_acc ? 1 : 0, allac = 0;
+  MPI_Allreduce(&ac, &allac, 1, MPI_INT, MPI_MIN, comm);
+  g.have_acc = allac != 0;
   g.iterations = local.iterations;
   g.residual = local.residual;
   // every rank's box and values (p, grad, theta, p_avg per node), copied into place on every rank
-  const int per = 4 + (g.have_theta_last ? 1 : 0) + (g.have_avg ? 1 : 0);
+  const int per = 4 + (g.have_theta_last ? 1 : 0) + (g.have_avg ? 1 : 0) + (g.have_acc ? 1 : 0);
   std::vector<double> mine;
   const std::size_t nb = static_cast<std::size_t>(local.box.count());
   mine.reserve(per * nb);
@@ -684,6 +778,7 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
     for (int d = 0; d < 3; ++d) mine.push_back(local.grad[3 * q + d]);
     if (g.have_theta_last) mine.push_back(local.theta_last[q]);
     if (g.have_avg) mine.push_back(local.p_avg[q]);
+    if (g.have_acc) mine.push_back(local.p_acc[q]);
   }
   std::vector<int> boxes(6 * nprocs), counts(nprocs), displs(nprocs);
   const int mybox[6] = {local.box.lo[0], local.box.lo[1], local.box.lo[2], local.box.hi[0], local.box.hi[1], local.box.hi[2]};
@@ -702,6 +797,7 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
   g.grad.assign(3 * ng, 0.0);
   g.theta_last.assign(g.have_theta_last ? ng : 0, 1.0);
   g.p_avg.assign(g.have_avg ? ng : 0, 0.0);
+  g.p_acc.assign(g.have_acc ? ng : 0, 0.0);
   const long gx = g.box.hi[0] - g.box.lo[0] + 1, gy = g.box.hi[1] - g.box.lo[1] + 1;
   for (int r = 0; r < nprocs; ++r) {
     const int *b = &boxes[6 * r];
@@ -714,6 +810,7 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
           for (int d = 0; d < 3; ++d) g.grad[3 * n + d] = all[q++];
           if (g.have_theta_last) g.theta_last[n] = all[q++];
           if (g.have_avg) g.p_avg[n] = all[q++];
+          if (g.have_acc) g.p_acc[n] = all[q++];
         }
   }
   return g;

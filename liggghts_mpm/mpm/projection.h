@@ -42,8 +42,9 @@ class Projection {
   bool load(const ProjectionState &s);
 
   // nodal pressure of the last solve (owned nodes and halos), the padding nodes behind the box
-  // walls with the pressure of the wall node in front (for interpolation to points and grains)
-  const std::vector<double> &pressure() const { return p_ext_; }
+  // walls with the pressure of the wall node in front (for interpolation to points); with
+  // pressure_output acceleration the pressure of the fluid's acceleration (acceleration_pressure)
+  const std::vector<double> &pressure() const { return opt_.pressure_acceleration ? p_acc_ext_ : p_ext_; }
   // nodal pressure gradient of the last solve, the one the fluid felt (owned nodes and halos;
   // padding nodes with the wall node's): for the grains
   const std::vector<double> &gradient() const { return grad_ext_; }
@@ -98,6 +99,12 @@ class Projection {
   bool have_avg_ = false;
   double p_avg_max_ = 0.0;
   void average_pressure(double h);
+  // pressure_output acceleration: the pressure of the projected velocity's acceleration,
+  // div(beta grad p) = div(theta (a_f - (u . grad) u)) (a_f: the grid forces per mass of this step,
+  // vel's u* - u_old over h); u_ holds the projected velocity (owned and halos)
+  void acceleration_pressure(const double *vel, double h, const double *p2g, double mmin, long step);
+  std::vector<double> acc_, p_acc_, p_acc_ext_;
+  PressureResult last_acc_;
   void largest_pressure();  // p_avg_max_ from p_avg_ (averaging) or p_
   PressureResult last_;
   double solver_seconds_ = 0.0;

@@ -163,6 +163,17 @@ void pressure_rhs(const LocalGrid &grid, const NodeLabels &labels, const Project
   });
 }
 
+void acceleration_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                      const double *a, const double *theta, double *rhs) {
+  const double inv_dx = 1.0 / grid.spec().dx;
+  grid.for_owned([&](int, int, int, std::size_t n) { rhs[n] = 0.0; });
+  for_faces_if(
+      grid, labels, geo, [&](int, int, int, std::size_t n) { return labels.kind[n] == kFluid; },
+      [&](std::size_t n, const Face &f, int d, int side) {
+        if (!f.wall) rhs[n] += side * f.area * face_flux(labels, n, f, d, a, theta) * inv_dx;
+      });
+}
+
 void apply_laplacian(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
                      const double *beta, const double *p, double *out) {
   const double inv_dx2 = 1.0 / (grid.spec().dx * grid.spec().dx);

@@ -113,6 +113,12 @@ void flux_divergence(const LocalGrid &grid, const NodeLabels &labels, const Proj
 void pressure_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
                   const double *u, const double *theta, const double *theta_prev, double dt, double *rhs);
 
+// Right-hand side of the pressure of an acceleration field a (keyword pressure_output
+// acceleration): rhs_n = D_n of flux_divergence with a for u, at the owned FLUID nodes (0
+// elsewhere), but no flux through wall faces (a wall at rest or moving at a constant velocity has
+// no normal acceleration). The solve then gives the p of div(beta grad p) = div(theta a).
+void acceleration_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                      const double *a, const double *theta, double *rhs);
 // The operator the solver inverts, at the owned FLUID nodes (0 elsewhere):
 // (L p)_n = sum over the open faces f = (n, m) of area_f beta_f (p_m - p_n) / dx^2,
 // beta_f = (beta_n + beta_m) / 2, EMPTY neighbours entering with their p.

@@ -54,7 +54,8 @@ struct ProjectionState {
   int iterations = 0;            // of the last solve (f_ID[16], f_ID[17])
   double residual = 0.0;
   bool have_avg = false;         // p_avg holds values (pressure_average, after the first solve)
-  std::vector<double> p, grad, theta_last, p_avg;  // 1, 3, 1, 1 per node of box
+  bool have_acc = false;         // p_acc holds values (pressure_output acceleration: its warm start)
+  std::vector<double> p, grad, theta_last, p_avg, p_acc;  // 1, 3, 1, 1, 1 per node of box
   // appends the restart block (doubles); unpack reads one at in and returns the doubles read
   void pack(std::vector<double> &out) const;
   std::size_t unpack(const double *in);
@@ -145,6 +146,7 @@ class FluidSolver {
   void point_volume_to_grid();      // projection + volume_correction: sum S V of the points
   void projection_gradient_to_grains();  // projection + couple: grad p for the grains
   void grid_to_particles();         // G2P (8-37)-(8-40)
+  void wall_normal_pic();           // projection + flip: the wall-normal velocity near box walls from the grid
   void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
   void update_stress(double h, bool theta_only = false);  // (7-21)-(7-24)
   void advance_positions(double h); // (8-41), points put back

@@ -42,6 +42,7 @@ mpm::ProjectionState local_state(const mpm::LocalGrid &grid) {
   s.box = grid.owned();
   s.have_theta_last = true;
   s.have_avg = true;
+  s.have_acc = true;
   s.iterations = 7;
   s.residual = 3e-9;
   grid.for_owned([&](int i, int j, int k, std::size_t) {
@@ -49,6 +50,7 @@ mpm::ProjectionState local_state(const mpm::LocalGrid &grid) {
     for (int d = 0; d < 3; ++d) s.grad.push_back(field(i, j, k, 1 + d));
     s.theta_last.push_back(field(i, j, k, 4));
     s.p_avg.push_back(field(i, j, k, 5));
+    s.p_acc.push_back(field(i, j, k, 6));
   });
   return s;
 }
@@ -75,7 +77,7 @@ TEST(ProjectionState, GatherGlobalHasEveryNode) {
       for (int j = s.box.lo[1]; j <= s.box.hi[1]; ++j)
         for (int i = s.box.lo[0]; i <= s.box.hi[0]; ++i, ++q) {
           if (s.p[q] != field(i, j, k, 0) || s.theta_last[q] != field(i, j, k, 4) ||
-              s.p_avg[q] != field(i, j, k, 5)) ++bad;
+              s.p_avg[q] != field(i, j, k, 5) || s.p_acc[q] != field(i, j, k, 6)) ++bad;
           for (int d = 0; d < 3; ++d)
             if (s.grad[3 * q + d] != field(i, j, k, 1 + d)) ++bad;
         }
@@ -100,10 +102,12 @@ TEST(ProjectionState, PackUnpackRoundTrip) {
   EXPECT_EQ(r.theta_last, s.theta_last);
   EXPECT_TRUE(r.have_avg);
   EXPECT_EQ(r.p_avg, s.p_avg);
+  EXPECT_TRUE(r.have_acc);
+  EXPECT_EQ(r.p_acc, s.p_acc);
   EXPECT_EQ(r.residual, s.residual);
   // layout 1 (restart files before pressure_average): the same block without the averaged
   // pressure reads back without it
-  std::vector<double> old(buf.begin(), buf.end() - 1 - static_cast<long>(s.p_avg.size()));
+  std::vector<double> old(buf.begin(), buf.end() - 2 - static_cast<long>(s.p_avg.size() + s.p_acc.size()));
   old[1] = 1.0;
   mpm::ProjectionState r1;
   EXPECT_EQ(r1.unpack(old.data() + 1), old.size() - 1);
@@ -126,6 +130,7 @@ TEST(ProjectionState, LoadSaveAcrossDecompositions) {
   opt.grid = g;
   opt.rho0 = 1000.0;
   opt.pressure_average = 0.01;
+  opt.pressure_acceleration = true;
   mpm::LocalGrid a;
   setup(a, g, 0.5);
   const mpm::ProjectionState global = mpm::gather_global(local_state(a), g, MPI_COMM_WORLD);
@@ -141,6 +146,7 @@ TEST(ProjectionState, LoadSaveAcrossDecompositions) {
     EXPECT_EQ(saved.grad, want.grad) << split;
     EXPECT_EQ(saved.theta_last, want.theta_last) << split;
     EXPECT_EQ(saved.p_avg, want.p_avg) << split;
+    EXPECT_EQ(saved.p_acc, want.p_acc) << split;
     EXPECT_EQ(proj.iterations(), 7);
     // the grains' gradient, halos included: forwarded from the owners (padding: the wall node's)
     const std::vector<double> &ge = proj.gradient();
