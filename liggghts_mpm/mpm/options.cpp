@@ -465,7 +465,7 @@ const std::vector<Keyword> kTable = {
      REAL(volume_correction), 0.0, kInf, false, true, nullptr, nullptr, false},
     {"pressure_output", "multiplier | acceleration", "-", "", "multiplier", "'multiplier' or 'acceleration'",
      nullptr, 0, 0, false, false, nullptr, parse_pressure_output, false},
-    {"pressure_average", "real", "time", ">= 0", "0", "a time constant >= 0 of the averaged pressure f_ID[19]",
+    {"pressure_average", "real", "time", ">= 0", "0", "a time constant (time) >= 0 of the averaged pressure f_ID[19]",
      REAL(pressure_average), 0.0, kInf, false, true, nullptr, nullptr, false},
     {"fill", "region nx ny nz type T", "-", "1..8 points per cell per direction", "required (not after read_restart)",
      "'region-ID nx ny nz type T'", nullptr, 0, 0, false, false, nullptr, parse_fill, false},

@@ -172,6 +172,10 @@ def case_bad_input(r):
         (base + " volume_correction -1", "keyword 'volume_correction' expects a rate (1/time) >= 0"),
         ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 volume_correction 10",
          "'volume_correction' belong to 'pressure projection'"),
+        (base + " pressure_average -1", "keyword 'pressure_average' expects a time constant (time) >= 0"),
+        (base + " pressure_output fast", "keyword 'pressure_output' expects 'multiplier' or 'acceleration', got 'fast'"),
+        ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 pressure_output acceleration pressure_average 1",
+         "'pressure_output', 'pressure_average' belong to 'pressure projection'"),
     ]
     for i, (args, expect) in enumerate(cases):
         r.expect_error(f"projection_bad_input/{i}", TMPL.format(args=args, steps=0), ("mpm/fluid", expect),
