@@ -152,42 +152,10 @@ void FluidSolver::substep(double h) {
     update_grid(h);
     if (opt.projection) interpolate_pressure();
     grid_to_particles();
-    if (opt.projection && opt.transfer == Transfer::Flip) wall_normal_pic();
     if (opt.musl) remap_velocity_musl(h);
     update_stress(h);
     advance_positions(h);
   });
-}
-
-/* projection with FLIP: a point whose stencil reaches a box wall's node takes the wall-normal
-   component of its velocity from the grid (PIC), the tangential ones stay FLIP. FLIP adds to a
-   point the change of the nodal velocity, u_new - u_old, and u_old of the wall node is the mass
-   average of every point around it, so while the water still flows onto the wall (u_old > 0,
-   u_new = 0) each point at the wall is slowed again every step, past 0: FLIP's steady state holds
-   u_old = u_new = 0 with the points on the wall moving away from it and those behind them towards
-   it. Measured (a 2-D block at 1 m/s hitting a free-slip wall, 32 cells, docs/tank.md "The
-   pressure of an impact"): points on the wall at -0.9 m/s 0.07 s after the impact while they
-   still crept towards it; APIC and PIC: no point below +0.01 m/s, as the incompressible impact
-   (u = U - grad P / rho, P the pressure impulse, between 0 and U) has it. The grid carries this
-   velocity noise into u_old at every step, and the projection removes it at every step: a
-   pressure of order rho |du| dx / h that grows as the step h shrinks. */
-void FluidSolver::wall_normal_pic() {
-  const GridSpec &gs = opt.grid;
-  const int ns = support(opt.shape);
-  double **v = pts.v;
-  for (const int i : plist_) {
-    const Stencil &ps = shapes_[i];
-    for (int d = 0; d < 3; ++d) {
-      if (gs.periodic[d] || (ps.base[d] > 0 && ps.base[d] + ns - 1 < gs.ncell[d])) continue;
-      // the share of the point's weight along d on the wall node and the padding behind it
-      double w = 0.0;
-      for (int a = 0; a < ns; ++a) {
-        const int node = ps.base[d] + a;
-        if (node <= 0 || node >= gs.ncell[d]) w += ps.w[d][a];
-      }
-      v[i][d] += w * (vpic_[3 * i + d] - v[i][d]);
-    }
-  }
 }
 
 void FluidSolver::compute_shapes() {

@@ -146,7 +146,6 @@ class FluidSolver {
   void point_volume_to_grid();      // projection + volume_correction: sum S V of the points
   void projection_gradient_to_grains();  // projection + couple: grad p for the grains
   void grid_to_particles();         // G2P (8-37)-(8-40)
-  void wall_normal_pic();           // projection + flip: the wall-normal velocity near box walls from the grid
   void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
   void update_stress(double h, bool theta_only = false);  // (7-21)-(7-24)
   void advance_positions(double h); // (8-41), points put back
