@@ -409,6 +409,25 @@ def case_hdf5_np2_vs_np1(r):
     check(sorted(ids) == [float(i) for i in range(1, len(ids) + 1)], f"every point once ({len(ids)} ids)")
 
 
+def case_sparse_grid(r):
+    """The sparse grid (keyword sparse) against the dense one: the 3-D bench dam break
+    (inputs/bench/in.dambreak3d, cells 8, 4096 points, bulk 2e5) in its tank and in a tank 10x longer, on 1
+    and 2 ranks: the HDF5 series (points and grid) and the front identical to the bit."""
+    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
+    base = dict(cells=8, warm=0, nsteps=240, h5every=80, bulk=2e5)  # c = 14 m/s: the front runs
+    for label, np_, v in (("short", 1, dict(tank=3.0)), ("long", 1, dict(tank=30.0)),
+                          ("long_np2", 2, dict(tank=30.0, balance=1, cellw=0.0))):
+        dirs = []
+        for sp in ("no", "yes"):
+            d, _ = r.run(f"sparse_grid/{label}_{sp}", inp, dict(base, sparse=sp, **v), np=np_)
+            dirs.append(d)
+        worst, files = h5_series_same(dirs[0], dirs[1], "bench3d", 0.0)
+        check(len(files) >= 3, f"{label}: several step files ({len(files)})")
+        a, b = (read_csv(os.path.join(d, "bench3d.csv")) for d in dirs)
+        check(a == b, f"{label}: the same front, height and mass ({a['front_x'][0]:.6f}, {a['front_y'][0]:.6f})")
+        check(a["front_x"][0] > 1.3, f"{label}: the front left the column (x = {a['front_x'][0]:.3f} a)")
+
+
 def schiller_naumann_settling(d, rhop, rhof, nu, g, t_end, n=20000):
     """Isolated-sphere settling speed v(t) (downward positive) by RK4 and its terminal value."""
     mu = nu * rhof
