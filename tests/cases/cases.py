@@ -412,7 +412,8 @@ def case_hdf5_np2_vs_np1(r):
 def case_sparse_grid(r):
     """The sparse grid (keyword sparse) against the dense one: the 3-D bench dam break
     (inputs/bench/in.dambreak3d, cells 8, 4096 points, bulk 2e5) in its tank and in a tank 10x longer, on 1
-    and 2 ranks: the HDF5 series (points and grid) and the front identical to the bit."""
+    and 2 ranks: the HDF5 series (points and grid) and the front identical to the bit; the same for
+    the points of a dam break released by a lifted mesh-wall gate."""
     inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
     base = dict(cells=8, warm=0, nsteps=240, h5every=80, bulk=2e5)  # c = 14 m/s: the front runs
     for label, np_, v in (("short", 1, dict(tank=3.0)), ("long", 1, dict(tank=30.0)),
@@ -426,6 +427,23 @@ def case_sparse_grid(r):
         a, b = (read_csv(os.path.join(d, "bench3d.csv")) for d in dirs)
         check(a == b, f"{label}: the same front, height and mass ({a['front_x'][0]:.6f}, {a['front_y'][0]:.6f})")
         check(a["front_x"][0] > 1.3, f"{label}: the front left the column (x = {a['front_x'][0]:.3f} a)")
+    # a mesh wall (the lifted gate of tests/data/in.mesh_walls_gate, its traction reaching nodes
+    # beyond the points' stencils): the points' state at full precision
+    dumps = []
+    for sp in ("no", "yes"):
+        d = r.fresh(f"sparse_grid/mesh_gate_{sp}")
+        shutil.copy(os.path.join(DATA, "gate.stl"), d)
+        text = open(os.path.join(DATA, "in.mesh_walls_gate")).read()
+        check("front x\n" in text, "in.mesh_walls_gate: the fix's last line ends with 'front x'")
+        text = text.replace("front x\n", f"front x sparse {sp}\n", 1) + (
+            "dump d all custom 200 dump.points id x y z vx vy vz\n"
+            'dump_modify d format "%d %.17g %.17g %.17g %.17g %.17g %.17g" sort id\nrun 400\n')
+        with open(os.path.join(d, "in.gate"), "w") as f:
+            f.write(text)
+        r.execute(d, "in.gate")
+        dumps.append(open(os.path.join(d, "dump.points")).read())
+    check(dumps[0] == dumps[1] and dumps[0].count("ITEM: ATOMS") == 2,
+          "mesh_wall gate: positions and velocities identical to the bit (2 dumps after the lift)")
 
 
 def schiller_naumann_settling(d, rhop, rhof, nu, g, t_end, n=20000):
