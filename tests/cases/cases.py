@@ -446,6 +446,36 @@ def case_sparse_grid(r):
           "mesh_wall gate: positions and velocities identical to the bit (2 dumps after the lift)")
 
 
+def case_sparse_grid_coupled(r):
+    """The sparse grid with couple (the fluid's phases on the active blocks, the coupling's on the
+    whole patch) against the dense grid: free grains driven through the fluid (inputs/ergun, APIC,
+    theta_smooth) on 2 ranks, and a moving bed with theta_transport (inputs/porewave): their
+    outputs identical to the bit."""
+    import filecmp
+    src = open(os.path.join(r.inputs, "ergun", "in.ergun")).read()
+    ds = []
+    for sp in ("no", "yes"):
+        d = r.fresh(f"sparse_grid_coupled/ergun_np2_{sp}")
+        text = src.replace("theta_smooth ${smooth}\n", f"theta_smooth ${{smooth}} sparse {sp}\n", 1)
+        check(text != src, "in.ergun: the fix's last line ends with 'theta_smooth ${smooth}'")
+        with open(os.path.join(d, "in.ergun"), "w") as f:
+            f.write(text)
+        r.execute(d, "in.ergun", {"G": 2000.0, "mobile": 1, "v0": 0.05, "tend": 0.01, "outdt": 0.001}, np=2)
+        ds.append(d)
+    rows = read_csv(os.path.join(ds[1], "ergun.csv"))
+    check(filecmp.cmp(os.path.join(ds[0], "ergun.csv"), os.path.join(ds[1], "ergun.csv"), shallow=False)
+          and len(rows["t"]) > 5, f"ergun, 2 ranks: ergun.csv identical ({len(rows['t'])} rows)")
+    ds = []
+    for sp in ("no", "yes"):
+        d, _ = r.run(f"sparse_grid_coupled/porewave_{sp}", os.path.join(r.inputs, "porewave", "in.porewave"),
+                     dict(jitter=0.0008, zb="f", mobile=1, gdrive=200, nsteps=600, nout=50,
+                          extra=f"theta_transport yes sparse {sp}"))
+        ds.append(d)
+    rows = read_csv(os.path.join(ds[1], "porewave.csv"))
+    check(filecmp.cmp(os.path.join(ds[0], "porewave.csv"), os.path.join(ds[1], "porewave.csv"), shallow=False)
+          and max(rows["pmax"]) > 0.0, f"porewave, theta_transport: porewave.csv identical ({len(rows['t'])} rows)")
+
+
 def schiller_naumann_settling(d, rhop, rhof, nu, g, t_end, n=20000):
     """Isolated-sphere settling speed v(t) (downward positive) by RK4 and its terminal value."""
     mu = nu * rhof
