@@ -227,4 +227,73 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   }
 }
 
+std::vector<IndexBox> LocalGrid::exchanged_boxes() const {
+  std::vector<IndexBox> out;
+  for (const auto &t : halo_side_) out.push_back(t.mine);
+  for (const auto &t : owner_side_) out.push_back(t.mine);
+  return out;
+}
+
+void ActiveBlocks::setup(const LocalGrid &g) {
+  patch_ = g.patch();
+  owned_ = g.owned();
+  for (int d = 0; d < 3; ++d) nb_[d] = (g.extent(d) + kSize - 1) / kSize;
+  fixed_.assign(std::size_t(nb_[0]) * nb_[1] * nb_[2], 0);
+  on_ = fixed_;
+  for (const IndexBox &b : g.exchanged_boxes()) {
+    if (b.empty()) continue;
+    mark(b.lo, b.hi);
+  }
+  fixed_ = on_;
+  corner_.assign(on_.size(), 0);
+  list_.clear();
+  boxes_.clear();
+  owned_boxes_.clear();
+  retired_.clear();
+}
+
+void ActiveBlocks::begin() {
+  std::copy(fixed_.begin(), fixed_.end(), on_.begin());
+  std::fill(corner_.begin(), corner_.end(), 0);
+}
+
+IndexBox ActiveBlocks::box_of(std::size_t q) const {
+  const int a = int(q % nb_[0]), b = int((q / nb_[0]) % nb_[1]), c = int(q / (std::size_t(nb_[0]) * nb_[1]));
+  const int blk[3] = {a, b, c};
+  IndexBox r;
+  for (int d = 0; d < 3; ++d) {
+    r.lo[d] = patch_.lo[d] + kSize * blk[d];
+    r.hi[d] = std::min(r.lo[d] + kSize - 1, patch_.hi[d]);
+  }
+  return r;
+}
+
+void ActiveBlocks::finish() {
+  const std::size_t sy = nb_[0], sz = std::size_t(nb_[0]) * nb_[1];
+  for (int c = 0; c < nb_[2]; ++c)
+    for (int b = 0; b < nb_[1]; ++b)
+      for (int a = 0; a < nb_[0]; ++a) {
+        const std::size_t q = c * sz + b * sy + a;
+        if (!corner_[q]) continue;
+        const int a1 = std::min(a + 1, nb_[0] - 1), b1 = std::min(b + 1, nb_[1] - 1), c1 = std::min(c + 1, nb_[2] - 1);
+        for (int z = c; z <= c1; ++z)
+          for (int y = b; y <= b1; ++y)
+            for (int x = a; x <= a1; ++x) on_[z * sz + y * sy + x] = 1;
+      }
+  retired_.clear();
+  for (const std::size_t q : list_)
+    if (!on_[q]) retired_.push_back(box_of(q));
+  list_.clear();
+  boxes_.clear();
+  owned_boxes_.clear();
+  for (std::size_t q = 0; q < on_.size(); ++q) {
+    if (!on_[q]) continue;
+    list_.push_back(q);
+    const IndexBox b = box_of(q);
+    boxes_.push_back(b);
+    const IndexBox o = intersect(b, owned_);
+    if (!o.empty()) owned_boxes_.push_back(o);
+  }
+}
+
 }  // namespace mpm

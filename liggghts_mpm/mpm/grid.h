@@ -6,6 +6,7 @@
 // into the owners, and copies of owned values that forward() refreshes.
 #pragma once
 #include <mpi.h>
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -83,6 +84,9 @@ class LocalGrid {
   void reverse_sum(double *data, int stride);
   // Copies owned values into every rank's halo images.
   void forward(double *data, int stride);
+  // The boxes of patch nodes that reverse_sum() and forward() read or write (halo and owner side,
+  // all peers, periodic self images included).
+  std::vector<IndexBox> exchanged_boxes() const;
 
  private:
   struct Transfer {      // one box of nodes exchanged with one peer
@@ -101,6 +105,59 @@ class LocalGrid {
   std::vector<Transfer> halo_side_;   // my halo nodes -> owner (reverse sends, forward receives)
   std::vector<Transfer> owner_side_;  // my owned nodes <- peer halos (reverse receives, forward sends)
   std::vector<double> sendbuf_, recvbuf_;
+};
+
+// The sparse grid (keyword sparse, docs/performance.md): blocks of kSize^3 nodes of a rank's patch
+// that hold values this sub-step, the blocks the material points' stencils reach plus, for good,
+// the blocks of the nodes the halo exchange moves (so that the exchange stays as it is). The solver
+// clears, updates and sweeps only active blocks; every node of an inactive block is zero, since
+// a block that drops out of the set is cleared once (retired()).
+class ActiveBlocks {
+ public:
+  static constexpr int kSize = 4;
+  // all blocks inactive except those of the exchanged nodes (the node arrays are all zero)
+  void setup(const LocalGrid &g);
+  // starts the next set: only the exchanged nodes' blocks
+  void begin();
+  // nodes lo..hi (global indices, cut to the patch) are active
+  void mark(const int lo[3], const int hi[3]) {
+    int bl[3], bh[3];
+    for (int d = 0; d < 3; ++d) {
+      bl[d] = (std::max(lo[d], patch_.lo[d]) - patch_.lo[d]) / kSize;
+      bh[d] = (std::min(hi[d], patch_.hi[d]) - patch_.lo[d]) / kSize;
+    }
+    for (int c = bl[2]; c <= bh[2]; ++c)
+      for (int b = bl[1]; b <= bh[1]; ++b)
+        for (int a = bl[0]; a <= bh[0]; ++a) on_[(std::size_t(c) * nb_[1] + b) * nb_[0] + a] = 1;
+  }
+  // the 2 x 2 x 2 blocks from the one that holds node (i, j, k) (global, in the patch) upward are
+  // active: they cover any box of kSize + 1 nodes per direction from there. One store per call;
+  // finish() spreads it.
+  void mark_from(int i, int j, int k) {
+    corner_[(std::size_t((k - patch_.lo[2]) / kSize) * nb_[1] + (j - patch_.lo[1]) / kSize) * nb_[0] +
+            (i - patch_.lo[0]) / kSize] = 1;
+  }
+  // ends the set: boxes(), owned_boxes() and retired() (the blocks of the last set that are not
+  // in this one)
+  void finish();
+  // node boxes (in the patch) of the active blocks, of their owned nodes, of the retired blocks
+  const std::vector<IndexBox> &boxes() const { return boxes_; }
+  const std::vector<IndexBox> &owned_boxes() const { return owned_boxes_; }
+  const std::vector<IndexBox> &retired() const { return retired_; }
+  bool active(int i, int j, int k) const {
+    const std::size_t q = (std::size_t((k - patch_.lo[2]) / kSize) * nb_[1] + (j - patch_.lo[1]) / kSize) * nb_[0] +
+                          (i - patch_.lo[0]) / kSize;
+    return on_[q] != 0;
+  }
+  std::size_t total() const { return on_.size(); }
+
+ private:
+  IndexBox box_of(std::size_t q) const;
+  IndexBox patch_, owned_;
+  int nb_[3] = {0, 0, 0};
+  std::vector<unsigned char> on_, fixed_, corner_;
+  std::vector<std::size_t> list_;
+  std::vector<IndexBox> boxes_, owned_boxes_, retired_;
 };
 
 }  // namespace mpm

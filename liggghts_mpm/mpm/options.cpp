@@ -451,6 +451,8 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_every, false},
     {"mass_threshold", "real", "-", "[0,1)", "1e-5", "a fraction of the point mass in [0,1)",
      REAL(mass_threshold), 0.0, 1.0, false, true, nullptr, nullptr, false},
+    {"sparse", "yes/no", "-", "", "yes", "'yes' or 'no'",
+     nullptr, 0, 0, false, false, &Options::sparse, nullptr, false},
     {"pressure", "eos | projection", "-", "", "eos",
      "'eos' or 'projection'", nullptr, 0, 0, false, false, nullptr, parse_pressure, false},
     {"tolerance", "real", "-", "> 0", "1e-8", "a relative residual > 0 of the pressure solve",

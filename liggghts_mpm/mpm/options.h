@@ -69,6 +69,7 @@ struct Options {
   int max_subcycle = 1000;
   int fluid_every = 1;              // the fluid advances every N-th time step, by N dt (keyword every)
   double mass_threshold = 1e-5;
+  bool sparse = true;                // fluid grid phases only on the blocks the points reach (pressure eos)
   // pressure model (keyword pressure): eos, the text's weakly compressible fluid, or projection,
   // the incompressible fluid of a pressure Poisson solve (mpm/projection.h, docs/projection.md)
   bool projection = false;

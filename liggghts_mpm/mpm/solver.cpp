@@ -92,6 +92,12 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
   if (opt.projection && proj_) proj_->save(last);
   grid_.setup(opt.grid, comm_, sublo, subhi, halo);
   g_.assign(grid_.size(), opt.musl, opt.coupled, opt.theta_transport);
+  // the sparse grid covers the fluid's own phases with the equation of state, also with couple:
+  // the coupling reads the fluid's arrays (zero outside the active blocks, as on the dense grid)
+  // and writes only its own, which its phases sweep on the whole patch; the projection's phases
+  // and solve sweep the whole patch (docs/performance.md, "Sparse grid")
+  sparse_ = opt.sparse && !opt.projection;
+  if (sparse_) blocks_.setup(grid_);
   th_prev_valid_ = false;
   if (opt.projection) {
     proj_.reset(new Projection(grid_, comm_, opt));
@@ -181,6 +187,64 @@ void FluidSolver::compute_shapes() {
       throw LocalError(os.str());
     }
   }
+  if (sparse_) mark_active_blocks();
+}
+
+/* The blocks the points' stencils reach, grown by one node on each side: that covers the cell
+   record of the anti-locking average (the cell's low node, clamped at the upper face), the grid-face
+   traction (inside the stencil) and the mesh-wall traction (the stencil of the nearest wall point,
+   less than a cell away: its base within one node of the point's). Blocks that drop out are
+   cleared, so that every node outside the active blocks is zero. */
+void FluidSolver::mark_active_blocks() {
+  const IndexBox &pb = grid_.patch();
+  static_assert(ActiveBlocks::kSize >= 4, "the grown stencil (bspline2: 5 nodes) spans two blocks at most");
+  blocks_.begin();
+  for (const int i : plist_) {
+    const int *b = shapes_[i].base;
+    blocks_.mark_from(std::max(b[0] - 1, pb.lo[0]), std::max(b[1] - 1, pb.lo[1]), std::max(b[2] - 1, pb.lo[2]));
+  }
+  blocks_.finish();
+  auto zero = [&](std::vector<double> &a, int stride) {
+    if (a.empty()) return;
+    for (const IndexBox &b : blocks_.retired())
+      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+          std::fill(a.begin() + stride * grid_.index(b.lo[0], j, k), a.begin() + stride * (grid_.index(b.hi[0], j, k) + 1),
+                    0.0);
+  };
+  zero(g_.p2g, P2gRec::N);
+  zero(g_.vel, VelRec::N);
+  zero(g_.aux, AuxRec::N);
+  zero(g_.cell, CellRec::N);
+}
+
+void FluidSolver::clear_nodes(std::vector<double> &a, int stride) {
+  if (!sparse_) {
+    std::fill(a.begin(), a.end(), 0.0);
+    return;
+  }
+  for (const IndexBox &b : blocks_.boxes())
+    for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+      for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+        std::fill(a.begin() + stride * grid_.index(b.lo[0], j, k), a.begin() + stride * (grid_.index(b.hi[0], j, k) + 1),
+                  0.0);
+}
+
+long FluidSolver::nonzero_outside_active() const {
+  if (!sparse_) return 0;
+  long bad = 0;
+  auto count = [&](const std::vector<double> &a, int stride) {
+    if (a.empty()) return;
+    grid_.for_box(grid_.patch(), [&](int i, int j, int k, std::size_t n) {
+      if (blocks_.active(i, j, k)) return;
+      for (int c = 0; c < stride; ++c) bad += a[stride * n + c] != 0.0;
+    });
+  };
+  count(g_.p2g, P2gRec::N);
+  count(g_.vel, VelRec::N);
+  count(g_.aux, AuxRec::N);
+  count(g_.cell, CellRec::N);
+  return bad;
 }
 
 // What the step reads of point i (position, velocity, mass) is finite, the mass positive.
@@ -229,7 +293,7 @@ bool FluidSolver::shape_of(const double *x, Stencil &ps) {
 /* grid momentum update (8-35), velocity (8-36), boundary conditions */
 void FluidSolver::update_grid(double h) {
   const double mmin = mass_min();
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+  for_owned_nodes([&](int i, int j, int k, std::size_t n) {
     const double *g = &g_.p2g[P2gRec::N * n];
     double *gv = &g_.vel[VelRec::N * n];
     for (int c = 0; c < VelRec::N; ++c) gv[c] = 0.0;
@@ -326,7 +390,7 @@ void FluidSolver::update_stress(double h, bool theta_only) {
     return grid_.index(c[0], c[1], c[2]);
   };
   if (opt.antilock) {
-    std::fill(g_.cell.begin(), g_.cell.end(), 0.0);
+    clear_nodes(g_.cell, CellRec::N);
     for (int i = 0; i < nlocal; ++i) {
       if (!is_point(i)) continue;
       const double *s = pts.state[i];

@@ -152,6 +152,13 @@ class FluidSolver {
   void substep(double h);           // all of them
   GridFields &fields() { return g_; }
   const LocalGrid &grid() const { return grid_; }
+  // sparse grid (keyword sparse; pure eos fluid): the active blocks of this sub-step, and whether
+  // the grid phases run on them only
+  bool sparse() const { return sparse_; }
+  const ActiveBlocks &active_blocks() const { return blocks_; }
+  // the values of the node arrays of fields() at nodes of inactive blocks that are not zero (the
+  // sparse grid's invariant; 0 for the dense grid)
+  long nonzero_outside_active() const;
 
  private:
   // kernels (transfer.cpp, coupling.cpp), instantiated per stencil size and transfer policy
@@ -173,6 +180,15 @@ class FluidSolver {
   bool near_face(const int base[3], int ns) const;
   void smooth_node_volume(std::vector<double> &a, int stride = 1);
   template <class Fn> void for_nodes(const Stencil &ps, Fn &&fn) const;
+  // sparse grid: the active blocks of the points' stencils, retired blocks cleared
+  void mark_active_blocks();
+  // zeroes a node array (stride doubles per node): all of it, or the active blocks (sparse)
+  void clear_nodes(std::vector<double> &a, int stride);
+  // fn(i, j, k, n) for every owned node, or every owned node of an active block (sparse)
+  template <class Fn> void for_owned_nodes(Fn &&fn) const {
+    if (!sparse_) return grid_.for_owned(fn);
+    for (const IndexBox &b : blocks_.owned_boxes()) grid_.for_box(b, fn);
+  }
 
   bool shape_of(const double *x, Stencil &ps);
   void smooth_solid_volume();
@@ -187,6 +203,8 @@ class FluidSolver {
   int me_ = 0, nprocs_ = 1;
   LocalGrid grid_;
   GridFields g_;
+  ActiveBlocks blocks_;
+  bool sparse_ = false;
   bool grid_ready_ = false;
   bool th_prev_valid_ = false;
   std::vector<Stencil> shapes_, grain_shapes_;

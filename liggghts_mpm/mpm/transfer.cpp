@@ -12,7 +12,7 @@ namespace mpm {
 /* particles to grid: mass (8-19), momentum (8-10), internal force (8-24),
    external forces (gravity (8-18) and whatever the host's fixes add), wall traction (8-23) */
 void FluidSolver::particles_to_grid() {
-  std::fill(g_.p2g.begin(), g_.p2g.end(), 0.0);
+  clear_nodes(g_.p2g, P2gRec::N);
   // the boundary term of each point right after its own share, so that every node sums its
   // contributions in point order
   // (projection: the walls' reaction is the solve's pressure, not a traction of the points)
@@ -135,11 +135,11 @@ void FluidSolver::g2p_kernel() {
    field for APIC), mapped back to the grid, gives the velocity gradient for the stress update,
    still at the positions of the start of the step. */
 void FluidSolver::remap_velocity_musl(double h) {
-  std::fill(g_.aux.begin(), g_.aux.end(), 0.0);
+  clear_nodes(g_.aux, AuxRec::N);
   with_policy(opt, [&](auto pol) { musl_scatter<decltype(pol)::NS, decltype(pol)>(); });
   grid_.reverse_sum(g_.aux.data(), AuxRec::N);
   const double mmin = mass_min();
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+  for_owned_nodes([&](int i, int j, int k, std::size_t n) {
     const double m = g_.p2g[P2gRec::N * n + P2gRec::M];
     double *g = &g_.aux[AuxRec::N * n + AuxRec::U];
     if (m <= mmin || m <= 0.0) {

@@ -409,6 +409,73 @@ def case_hdf5_np2_vs_np1(r):
     check(sorted(ids) == [float(i) for i in range(1, len(ids) + 1)], f"every point once ({len(ids)} ids)")
 
 
+def case_sparse_grid(r):
+    """The sparse grid (keyword sparse) against the dense one: the 3-D bench dam break
+    (inputs/bench/in.dambreak3d, cells 8, 4096 points, bulk 2e5) in its tank and in a tank 10x longer, on 1
+    and 2 ranks: the HDF5 series (points and grid) and the front identical to the bit; the same for
+    the points of a dam break released by a lifted mesh-wall gate."""
+    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
+    base = dict(cells=8, warm=0, nsteps=240, h5every=80, bulk=2e5)  # c = 14 m/s: the front runs
+    for label, np_, v in (("short", 1, dict(tank=3.0)), ("long", 1, dict(tank=30.0)),
+                          ("long_np2", 2, dict(tank=30.0, balance=1, cellw=0.0))):
+        dirs = []
+        for sp in ("no", "yes"):
+            d, _ = r.run(f"sparse_grid/{label}_{sp}", inp, dict(base, sparse=sp, **v), np=np_)
+            dirs.append(d)
+        worst, files = h5_series_same(dirs[0], dirs[1], "bench3d", 0.0)
+        check(len(files) >= 3, f"{label}: several step files ({len(files)})")
+        a, b = (read_csv(os.path.join(d, "bench3d.csv")) for d in dirs)
+        check(a == b, f"{label}: the same front, height and mass ({a['front_x'][0]:.6f}, {a['front_y'][0]:.6f})")
+        check(a["front_x"][0] > 1.3, f"{label}: the front left the column (x = {a['front_x'][0]:.3f} a)")
+    # a mesh wall (the lifted gate of tests/data/in.mesh_walls_gate, its traction reaching nodes
+    # beyond the points' stencils): the points' state at full precision
+    dumps = []
+    for sp in ("no", "yes"):
+        d = r.fresh(f"sparse_grid/mesh_gate_{sp}")
+        shutil.copy(os.path.join(DATA, "gate.stl"), d)
+        text = open(os.path.join(DATA, "in.mesh_walls_gate")).read()
+        check("front x\n" in text, "in.mesh_walls_gate: the fix's last line ends with 'front x'")
+        text = text.replace("front x\n", f"front x sparse {sp}\n", 1) + (
+            "dump d all custom 200 dump.points id x y z vx vy vz\n"
+            'dump_modify d format "%d %.17g %.17g %.17g %.17g %.17g %.17g" sort id\nrun 400\n')
+        with open(os.path.join(d, "in.gate"), "w") as f:
+            f.write(text)
+        r.execute(d, "in.gate")
+        dumps.append(open(os.path.join(d, "dump.points")).read())
+    check(dumps[0] == dumps[1] and dumps[0].count("ITEM: ATOMS") == 2,
+          "mesh_wall gate: positions and velocities identical to the bit (2 dumps after the lift)")
+
+
+def case_sparse_grid_coupled(r):
+    """The sparse grid with couple (the fluid's phases on the active blocks, the coupling's on the
+    whole patch) against the dense grid: free grains driven through the fluid (inputs/ergun, APIC,
+    theta_smooth) on 2 ranks, and a moving bed with theta_transport (inputs/porewave): their
+    outputs identical to the bit."""
+    import filecmp
+    src = open(os.path.join(r.inputs, "ergun", "in.ergun")).read()
+    ds = []
+    for sp in ("no", "yes"):
+        d = r.fresh(f"sparse_grid_coupled/ergun_np2_{sp}")
+        text = src.replace("theta_smooth ${smooth}\n", f"theta_smooth ${{smooth}} sparse {sp}\n", 1)
+        check(text != src, "in.ergun: the fix's last line ends with 'theta_smooth ${smooth}'")
+        with open(os.path.join(d, "in.ergun"), "w") as f:
+            f.write(text)
+        r.execute(d, "in.ergun", {"G": 2000.0, "mobile": 1, "v0": 0.05, "tend": 0.01, "outdt": 0.001}, np=2)
+        ds.append(d)
+    rows = read_csv(os.path.join(ds[1], "ergun.csv"))
+    check(filecmp.cmp(os.path.join(ds[0], "ergun.csv"), os.path.join(ds[1], "ergun.csv"), shallow=False)
+          and len(rows["t"]) > 5, f"ergun, 2 ranks: ergun.csv identical ({len(rows['t'])} rows)")
+    ds = []
+    for sp in ("no", "yes"):
+        d, _ = r.run(f"sparse_grid_coupled/porewave_{sp}", os.path.join(r.inputs, "porewave", "in.porewave"),
+                     dict(jitter=0.0008, zb="f", mobile=1, gdrive=200, nsteps=600, nout=50,
+                          extra=f"theta_transport yes sparse {sp}"))
+        ds.append(d)
+    rows = read_csv(os.path.join(ds[1], "porewave.csv"))
+    check(filecmp.cmp(os.path.join(ds[0], "porewave.csv"), os.path.join(ds[1], "porewave.csv"), shallow=False)
+          and max(rows["pmax"]) > 0.0, f"porewave, theta_transport: porewave.csv identical ({len(rows['t'])} rows)")
+
+
 def schiller_naumann_settling(d, rhop, rhof, nu, g, t_end, n=20000):
     """Isolated-sphere settling speed v(t) (downward positive) by RK4 and its terminal value."""
     mu = nu * rhof
