@@ -577,8 +577,19 @@ void Projection::acceleration_pressure(const double *vel, double h, const double
     throw Error(os.str());
   }
   if (mesh_) {
-    std::vector<double> pb = p_acc_;
-    extend_behind(pb, 1, p2g, mmin);
+    // behind mesh walls: extrapolated linearly with its own (extended) gradient, as the
+    // multiplier, so that a hydrostatic pressure stays exact behind an inclined wall (at rest
+    // beside a 0 and a 30 degree wall the points' pressure equals the multiplier's to 1e-13 rho g)
+    std::vector<double> keep(3 * nn);
+    keep.swap(grad_);
+    grad_.assign(3 * nn, 0.0);
+    pressure_gradient(grid_, lab_, p_acc_.data(), grad_.data());
+    grid_.forward(grad_.data(), 3);
+    fill_wall_gradient();
+    std::vector<double> gb = grad_, pb = p_acc_;
+    grad_.swap(keep);
+    extend_behind(gb, 3, p2g, mmin);
+    extend_behind(pb, 1, p2g, mmin, &gb);
     extend_to_padding(pb, p_acc_ext_, 1);
   } else {
     extend_to_padding(p_acc_, p_acc_ext_, 1);
