@@ -28,6 +28,12 @@ Projection::Projection(LocalGrid &grid, MPI_Comm comm, const Options &opt)
   p_.assign(n, 0.0);
   p_ext_.assign(n, 0.0);
   grad_ext_.assign(3 * n, 0.0);
+  if (opt.pressure_average > 0.0) p_avg_.assign(n, 0.0);
+  if (opt.pressure_acceleration) {
+    acc_.assign(3 * n, 0.0);
+    p_acc_.assign(n, 0.0);
+    p_acc_ext_.assign(n, 0.0);
+  }
 }
 
 namespace {
@@ -166,7 +172,7 @@ bool Projection::behind_mesh(int i, int j, int k, std::size_t n) const {
    wall (measured: the surface corner on a wall inclined 30 degrees from the vertical slid down it
    at 0.15 m/s). Such a component (nodes touching a mesh wall only) takes the mean of that component
    at the face neighbours that have it. */
-void Projection::fill_wall_gradient() {
+void Projection::fill_wall_gradient(std::vector<double> &grad) {
   const std::size_t sz = grid_.size();
   std::vector<double> info(3 * sz, 0.0);
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -180,7 +186,7 @@ void Projection::fill_wall_gradient() {
   });
   grid_.forward(info.data(), 3);
   const IndexBox &pb = grid_.patch();
-  std::vector<double> g = grad_;
+  std::vector<double> g = grad;
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kSolid) return;
     if (info[3 * n] != 0.0 && info[3 * n + 1] != 0.0 && info[3 * n + 2] != 0.0) return;
@@ -205,14 +211,14 @@ void Projection::fill_wall_gradient() {
       int cnt = 0;
       for (int f = 0; f < 6; ++f) {
         if (!in[f] || lab_.kind[nb[f]] == kSolid || info[3 * nb[f] + d] == 0.0) continue;
-        sum += grad_[3 * nb[f] + d];
+        sum += grad[3 * nb[f] + d];
         ++cnt;
       }
       if (cnt) g[3 * n + d] = sum / cnt;
     }
   });
-  grad_.swap(g);
-  grid_.forward(grad_.data(), 3);
+  grad.swap(g);
+  grid_.forward(grad.data(), 3);
 }
 
 void Projection::extend_behind(std::vector<double> &a, int stride, const double *p2g, double mmin,
@@ -345,6 +351,38 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin) {
   }
 }
 
+PressureResult Projection::solve_rhs(double *p, long step, const char *subject) {
+  try {
+    const double t0 = MPI_Wtime();
+    const PressureResult r = solver_->solve(lab_, beta_.data(), rhs_.data(), p);
+    solver_seconds_ += MPI_Wtime() - t0;
+    return r;
+  } catch (const PressureSolveError &e) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: " << subject << " did not converge at step " << step << ": " << e.iterations
+       << " PCG iterations (keyword 'max_iterations' " << opt_.pressure_max_iterations << "), relative residual "
+       << e.residual << " (keyword 'tolerance' " << opt_.pressure_tolerance << ")";
+    if (std::isnan(e.residual)) os << "; " << e.what();  // hypre failed (INF or NaN), not a slow convergence
+    throw Error(os.str());
+  }
+}
+
+void Projection::extend_for_points(const std::vector<double> &p, const std::vector<double> &grad, const double *p2g,
+                                   double mmin, std::vector<double> &p_out, std::vector<double> *grad_out) {
+  if (!mesh_) {
+    extend_to_padding(p, p_out, 1);
+    if (grad_out) extend_to_padding(grad, *grad_out, 3);
+    return;
+  }
+  // the pressure extrapolated linearly with the (extended) gradient: a hydrostatic pressure
+  // stays exact behind an inclined wall
+  std::vector<double> pb = p, gb = grad;
+  extend_behind(gb, 3, p2g, mmin);
+  extend_behind(pb, 1, p2g, mmin, &gb);
+  extend_to_padding(pb, p_out, 1);
+  if (grad_out) extend_to_padding(gb, *grad_out, 3);
+}
+
 void Projection::project(double *vel, const double *p2g, double mmin, const double *theta, bool dtheta, double h,
                          Boundaries &bc, long step, const double *pvol) {
   make_labels(p2g, mmin, theta, bc.walls());
@@ -362,20 +400,9 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
     for (std::size_t n = 0; n < beta_.size(); ++n) beta_[n] = theta[n] / opt_.rho0;
   pressure_rhs(grid_, lab_, geo_, u_.data(), th, theta_prev, h, rhs_.data());
   if (pvol && opt_.volume_correction > 0.0) add_volume_correction(pvol, theta, h);
-  try {
-    const double t0 = MPI_Wtime();
-    last_ = solver_->solve(lab_, beta_.data(), rhs_.data(), p_.data());
-    solver_seconds_ += MPI_Wtime() - t0;
-    ++solves_;
-    iterations_summed_ += last_.iterations;
-  } catch (const PressureSolveError &e) {
-    std::ostringstream os;
-    os << "Fix mpm/fluid: the pressure projection did not converge at step " << step << ": " << e.iterations
-       << " PCG iterations (keyword 'max_iterations' " << opt_.pressure_max_iterations << "), relative residual "
-       << e.residual << " (keyword 'tolerance' " << opt_.pressure_tolerance << ")";
-    if (std::isnan(e.residual)) os << "; " << e.what();  // hypre failed (INF or NaN), not a slow convergence
-    throw Error(os.str());
-  }
+  last_ = solve_rhs(p_.data(), step, "the pressure projection");
+  ++solves_;
+  iterations_summed_ += last_.iterations;
   // for the points and grains: the padding nodes behind the box walls carry the pressure (and
   // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
   // they would lower the pressure of the points next to a wall by half a cell's hydrostatic step)
@@ -383,26 +410,15 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   pressure_gradient(grid_, lab_, p_.data(), grad_.data());
   grid_.forward(grad_.data(), 3);
   if (opt_.surface_ghost) extrapolate_above_surface(p2g, mmin);
-  if (mesh_) {
-    fill_wall_gradient();
-    // the pressure extrapolated linearly with the (extended) gradient: a hydrostatic pressure
-    // stays exact behind an inclined wall
-    std::vector<double> pb = p_, gb = grad_;
-    extend_behind(gb, 3, p2g, mmin);
-    extend_behind(pb, 1, p2g, mmin, &gb);
-    extend_to_padding(pb, p_ext_, 1);
-    extend_to_padding(gb, grad_ext_, 3);
-  } else {
-    extend_to_padding(p_, p_ext_, 1);
-    extend_to_padding(grad_, grad_ext_, 3);
-  }
+  if (mesh_) fill_wall_gradient(grad_);
+  extend_for_points(p_, grad_, p2g, mmin, p_ext_, &grad_ext_);
   if (theta) {
     theta_last_.assign(theta, theta + grid_.size());
     have_theta_last_ = true;
   }
   correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), h, u_.data());
   grid_.forward(u_.data(), 3);
-  if (opt_.pressure_acceleration) acceleration_pressure(vel, h, p2g, mmin, step);
+  if (opt_.pressure_acceleration) acceleration_pressure(vel, th, h, p2g, mmin, step);
   average_pressure(h);
   if (mesh_) {
     // nodes behind mesh walls: the projected velocity of the fluid in front, then the wall
@@ -512,13 +528,7 @@ bool Projection::deep_inside(int i, int j, int k) const {
 
 /* ---------------------------------------------------------------------- state of the last solve */
 
-/* The pressure a sensor of finite response time reads (keyword pressure_average tau). Under the
-   projection an impact or a transfer event that must change the velocity within one fluid step h
-   gives a pressure of order rho |du| dx / h for that step: the pressure impulse (its integral over
-   time) converges as h shrinks, the single-step peak does not (docs/tank.md). The exponential
-   average pa += (1 - exp(-h / tau)) (p - pa) responds to an impulse I with I / tau, independent of
-   h, and to a steady pressure with that pressure. Nodes hold a fixed place, as a wall sensor. */
-/* pressure_output acceleration (docs/projection.md, "The pressure of the acceleration"). The
+/* pressure_output acceleration (docs/projection.md, "The pressure the points carry"). The
    projection's p is the Lagrange multiplier that makes this step's velocity divergence-free: it
    removes whatever divergence the step's u* holds, the transfer's as well (FLIP and APIC do not
    give back on the grid the divergence-free velocity they took from it), in one step h, so that
@@ -531,13 +541,8 @@ bool Projection::deep_inside(int i, int j, int k) const {
    between FLUID nodes (one-sided next to a non-FLUID node). The same operator and labels as the
    projection: at rest it is the projection's hydrostatic pressure. Not in it: d(theta)/dt of moving
    grains, the acceleration of walls. */
-void Projection::acceleration_pressure(const double *vel, double h, const double *p2g, double mmin, long step) {
-  const std::size_t nn = grid_.size();
-  if (acc_.size() != 3 * nn) {
-    acc_.assign(3 * nn, 0.0);
-    p_acc_.assign(nn, 0.0);
-    p_acc_ext_.assign(nn, 0.0);
-  }
+void Projection::acceleration_pressure(const double *vel, const double *theta, double h, const double *p2g,
+                                      double mmin, long step) {
   const double inv2dx = 0.5 / opt_.grid.dx, invdx = 1.0 / opt_.grid.dx;
   const long s[3] = {1, static_cast<long>(grid_.stride_y()), static_cast<long>(grid_.stride_z())};
   grid_.for_owned([&](int, int, int, std::size_t n) {
@@ -562,44 +567,30 @@ void Projection::acceleration_pressure(const double *vel, double h, const double
     }
   });
   grid_.forward(acc_.data(), 3);
-  const double *th = theta_last_.empty() || !have_theta_last_ ? theta_.data() : theta_last_.data();
-  acceleration_rhs(grid_, lab_, geo_, acc_.data(), th, rhs_.data());
-  try {
-    const double t0 = MPI_Wtime();
-    last_acc_ = solver_->solve(lab_, beta_.data(), rhs_.data(), p_acc_.data());
-    solver_seconds_ += MPI_Wtime() - t0;
-  } catch (const PressureSolveError &e) {
-    std::ostringstream os;
-    os << "Fix mpm/fluid: the solve for the pressure of the acceleration (keyword 'pressure_output "
-          "acceleration') did not converge at step "
-       << step << ": " << e.iterations << " PCG iterations (keyword 'max_iterations' " << opt_.pressure_max_iterations
-       << "), relative residual " << e.residual << " (keyword 'tolerance' " << opt_.pressure_tolerance << ")";
-    throw Error(os.str());
-  }
+  acceleration_rhs(grid_, lab_, geo_, acc_.data(), theta, rhs_.data());
+  solve_rhs(p_acc_.data(), step, "the solve for the pressure of the acceleration (keyword 'pressure_output acceleration')");
+  // behind mesh walls extrapolated linearly with its own gradient, as the multiplier (at rest
+  // beside a 30 degree wall one pressure per row of points to 2e-11 rho g dx; with the mean of the
+  // neighbours behind the wall instead, 0.27 rho g dx)
+  std::vector<double> g;
   if (mesh_) {
-    // behind mesh walls: extrapolated linearly with its own (extended) gradient, as the
-    // multiplier, so that a hydrostatic pressure stays exact behind an inclined wall (at rest
-    // beside a 0 and a 30 degree wall the points' pressure equals the multiplier's to 1e-13 rho g)
-    std::vector<double> keep(3 * nn);
-    keep.swap(grad_);
-    grad_.assign(3 * nn, 0.0);
-    pressure_gradient(grid_, lab_, p_acc_.data(), grad_.data());
-    grid_.forward(grad_.data(), 3);
-    fill_wall_gradient();
-    std::vector<double> gb = grad_, pb = p_acc_;
-    grad_.swap(keep);
-    extend_behind(gb, 3, p2g, mmin);
-    extend_behind(pb, 1, p2g, mmin, &gb);
-    extend_to_padding(pb, p_acc_ext_, 1);
-  } else {
-    extend_to_padding(p_acc_, p_acc_ext_, 1);
+    g.assign(3 * grid_.size(), 0.0);
+    pressure_gradient(grid_, lab_, p_acc_.data(), g.data());
+    grid_.forward(g.data(), 3);
+    fill_wall_gradient(g);
   }
+  extend_for_points(p_acc_, g, p2g, mmin, p_acc_ext_, nullptr);
 }
 
+/* The pressure a sensor of finite response time reads (keyword pressure_average tau). Under the
+   projection an impact or a transfer event that must change the velocity within one fluid step h
+   gives a pressure of order rho |du| dx / h for that step: the pressure impulse (its integral over
+   time) converges as h shrinks, the single-step peak does not (docs/tank.md). The exponential
+   average pa += (1 - exp(-h / tau)) (p - pa) responds to an impulse I with I / tau, independent of
+   h, and to a steady pressure with that pressure. Nodes hold a fixed place, as a wall sensor. */
 void Projection::average_pressure(double h) {
   const double tau = opt_.pressure_average;
   if (tau > 0.0) {
-    if (p_avg_.empty()) p_avg_.assign(grid_.size(), 0.0);
     const double a = have_avg_ ? -std::expm1(-h / tau) : 1.0;  // the first solve starts the average
     const std::vector<double> &p = opt_.pressure_acceleration ? p_acc_ : p_;
     grid_.for_owned([&](int, int, int, std::size_t n) { p_avg_[n] += a * (p[n] - p_avg_[n]); });
@@ -609,7 +600,7 @@ void Projection::average_pressure(double h) {
 }
 
 void Projection::largest_pressure() {
-  const std::vector<double> &a = have_avg_ ? p_avg_ : opt_.pressure_acceleration && !p_acc_.empty() ? p_acc_ : p_;
+  const std::vector<double> &a = have_avg_ ? p_avg_ : opt_.pressure_acceleration ? p_acc_ : p_;
   double mx = -HUGE_VAL;
   grid_.for_owned([&](int, int, int, std::size_t n) { mx = std::max(mx, a[n]); });
   p_avg_max_ = mx;
@@ -627,7 +618,7 @@ void Projection::save(ProjectionState &s) const {
   s.theta_last.resize(have_theta_last_ ? nb : 0);
   s.have_avg = have_avg_;
   s.p_avg.resize(have_avg_ ? nb : 0);
-  const bool acc = !p_acc_.empty();
+  const bool acc = opt_.pressure_acceleration;
   s.have_acc = acc;
   s.p_acc.resize(acc ? nb : 0);
   std::size_t q = 0;
@@ -651,8 +642,12 @@ bool Projection::load(const ProjectionState &s) {
   MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, comm_);
   if (!all) return false;
   const long ex = b.hi[0] - b.lo[0] + 1, ey = b.hi[1] - b.lo[1] + 1;
+  // the place of node (i, j, k) in the state's box
+  auto at = [&](int i, int j, int k) {
+    return static_cast<std::size_t>(((k - b.lo[2]) * ey + (j - b.lo[1])) * ex + (i - b.lo[0]));
+  };
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const std::size_t q = static_cast<std::size_t>(((k - b.lo[2]) * ey + (j - b.lo[1])) * ex + (i - b.lo[0]));
+    const std::size_t q = at(i, j, k);
     p_[n] = s.p[q];
     for (int d = 0; d < 3; ++d) grad_[3 * n + d] = s.grad[3 * q + d];
   });
@@ -662,26 +657,15 @@ bool Projection::load(const ProjectionState &s) {
   if (have_theta_last_) {
     theta_last_.assign(grid_.size(), 1.0);
     grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-      theta_last_[n] = s.theta_last[static_cast<std::size_t>(((k - b.lo[2]) * ey + (j - b.lo[1])) * ex + (i - b.lo[0]))];
+      theta_last_[n] = s.theta_last[at(i, j, k)];
     });
     grid_.forward(theta_last_.data(), 1);
   }
   // the averaged pressure goes on only if this run averages too (else it starts at the next solve)
   have_avg_ = s.have_avg && opt_.pressure_average > 0.0;
-  if (have_avg_) {
-    p_avg_.assign(grid_.size(), 0.0);
-    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-      p_avg_[n] = s.p_avg[static_cast<std::size_t>(((k - b.lo[2]) * ey + (j - b.lo[1])) * ex + (i - b.lo[0]))];
-    });
-  }
+  if (have_avg_) grid_.for_owned([&](int i, int j, int k, std::size_t n) { p_avg_[n] = s.p_avg[at(i, j, k)]; });
   if (s.have_acc && opt_.pressure_acceleration) {
-    const std::size_t nn = grid_.size();
-    acc_.assign(3 * nn, 0.0);
-    p_acc_.assign(nn, 0.0);
-    p_acc_ext_.assign(nn, 0.0);
-    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-      p_acc_[n] = s.p_acc[static_cast<std::size_t>(((k - b.lo[2]) * ey + (j - b.lo[1])) * ex + (i - b.lo[0]))];
-    });
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) { p_acc_[n] = s.p_acc[at(i, j, k)]; });
     grid_.forward(p_acc_.data(), 1);
   }
   largest_pressure();
@@ -691,7 +675,7 @@ bool Projection::load(const ProjectionState &s) {
   lab_.reset(grid_);
   extend_to_padding(p_, p_ext_, 1);
   extend_to_padding(grad_, grad_ext_, 3);
-  if (!p_acc_.empty()) extend_to_padding(p_acc_, p_acc_ext_, 1);
+  if (opt_.pressure_acceleration) extend_to_padding(p_acc_, p_acc_ext_, 1);
   return true;
 }
 
@@ -768,18 +752,16 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
     g.box.lo[d] = spec.node_lo(d);
     g.box.hi[d] = spec.node_hi(d);
   }
-  int th = local.have_theta_last ? 1 : 0, allth = 0;
-  MPI_Allreduce(&th, &allth, 1, MPI_INT, MPI_MIN, comm);
-  g.have_theta_last = allth != 0;
-  int av = local.have_avg ? 1 : 0, allav = 0;
-  MPI_Allreduce(&av, &allav, 1, MPI_INT, MPI_MIN, comm);
-  g.have_avg = allav != 0;
-  int ac = local.have_acc ? 1 : 0, allac = 0;
-  MPI_Allreduce(&ac, &allac, 1, MPI_INT, MPI_MIN, comm);
-  g.have_acc = allac != 0;
+  // the optional fields every rank holds
+  const int mine_has[3] = {local.have_theta_last, local.have_avg, local.have_acc};
+  int all_have[3];
+  MPI_Allreduce(mine_has, all_have, 3, MPI_INT, MPI_MIN, comm);
+  g.have_theta_last = all_have[0] != 0;
+  g.have_avg = all_have[1] != 0;
+  g.have_acc = all_have[2] != 0;
   g.iterations = local.iterations;
   g.residual = local.residual;
-  // every rank's box and values (p, grad, theta, p_avg per node), copied into place on every rank
+  // every rank's box and values (p, grad, theta, p_avg, p_acc per node), copied into place on every rank
   const int per = 4 + (g.have_theta_last ? 1 : 0) + (g.have_avg ? 1 : 0) + (g.have_acc ? 1 : 0);
   std::vector<double> mine;
   const std::size_t nb = static_cast<std::size_t>(local.box.count());

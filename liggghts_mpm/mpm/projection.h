@@ -73,7 +73,14 @@ class Projection {
   // grad (stride 1 only): extrapolate linearly with this nodal gradient instead
   void extend_behind(std::vector<double> &a, int stride, const double *p2g, double mmin,
                      const std::vector<double> *grad = nullptr);
-  void fill_wall_gradient();
+  void fill_wall_gradient(std::vector<double> &grad);
+  // one solve of the operator with rhs_ into p (warm start), timed into solver_seconds_; a solve
+  // that does not converge is an error naming subject and the step
+  PressureResult solve_rhs(double *p, long step, const char *subject);
+  // p and its nodal gradient for the points and grains: behind mesh walls extrapolated linearly
+  // with the extended gradient (grad read only with mesh walls), then into the padding nodes
+  void extend_for_points(const std::vector<double> &p, const std::vector<double> &grad, const double *p2g,
+                         double mmin, std::vector<double> &p_out, std::vector<double> *grad_out);
   std::size_t wall_node(int i, int j, int k) const;
   void mirror_normal(double *v, int i, int j, int k, const double *p2g, double mmin) const;
   double folded_mass(int i, int j, int k) const;
@@ -95,17 +102,18 @@ class Projection {
   std::vector<double> vol_;         // volume correction: sum S V with the padding folded back
   void add_volume_correction(const double *pvol, const double *theta, double h);
   bool deep_inside(int i, int j, int k) const;
-  std::vector<double> p_avg_;       // pressure_average: the nodal pressure averaged in time
+  std::vector<double> p_avg_;       // pressure_average: the nodal pressure averaged in time (sized only then)
   bool have_avg_ = false;
   double p_avg_max_ = 0.0;
   void average_pressure(double h);
   // pressure_output acceleration: the pressure of the projected velocity's acceleration,
   // div(beta grad p) = div(theta (a_f - (u . grad) u)) (a_f: the grid forces per mass of this step,
   // vel's u* - u_old over h); u_ holds the projected velocity (owned and halos)
-  void acceleration_pressure(const double *vel, double h, const double *p2g, double mmin, long step);
-  std::vector<double> acc_, p_acc_, p_acc_ext_;
-  PressureResult last_acc_;
-  void largest_pressure();  // p_avg_max_ from p_avg_ (averaging) or p_
+  // theta: the nodal fluid fraction of this solve
+  void acceleration_pressure(const double *vel, const double *theta, double h, const double *p2g, double mmin,
+                             long step);
+  std::vector<double> acc_, p_acc_, p_acc_ext_;  // sized only with pressure_output acceleration
+  void largest_pressure();  // p_avg_max_ from p_avg_ (averaging), else p_acc_ or p_ (the points' kind)
   PressureResult last_;
   double solver_seconds_ = 0.0;
   long solves_ = 0, iterations_summed_ = 0;
