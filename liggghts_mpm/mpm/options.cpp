@@ -1,6 +1,7 @@
 #include "mpm/options.h"
 
 #include <algorithm>
+#include <iterator>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
@@ -313,8 +314,8 @@ void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
                                                  "volume_correction", "pressure_average", "pressure_output"};
   std::string bad;
   for (const std::string &kw : seen)
-    for (const char *w : o.projection ? std::vector<const char *>(eos_only, eos_only + 4)
-                                      : std::vector<const char *>(projection_only, projection_only + 7))
+    for (const char *w : o.projection ? std::vector<const char *>(std::begin(eos_only), std::end(eos_only))
+                                      : std::vector<const char *>(std::begin(projection_only), std::end(projection_only)))
       if (kw == w && bad.find("'" + kw + "'") == std::string::npos) bad += (bad.empty() ? "'" : ", '") + kw + "'";
   // The ghost-fluid surface finds the surface from the nodal fill, which next to a mesh wall lacks
   // the mass the B-spline puts behind it (no mirror image of a triangle): measured beside a

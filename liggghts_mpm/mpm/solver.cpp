@@ -204,18 +204,21 @@ void FluidSolver::mark_active_blocks() {
     blocks_.mark_from(std::max(b[0] - 1, pb.lo[0]), std::max(b[1] - 1, pb.lo[1]), std::max(b[2] - 1, pb.lo[2]));
   }
   blocks_.finish();
-  auto zero = [&](std::vector<double> &a, int stride) {
-    if (a.empty()) return;
-    for (const IndexBox &b : blocks_.retired())
-      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-        for (int j = b.lo[1]; j <= b.hi[1]; ++j)
-          std::fill(a.begin() + stride * grid_.index(b.lo[0], j, k), a.begin() + stride * (grid_.index(b.hi[0], j, k) + 1),
-                    0.0);
-  };
-  zero(g_.p2g, P2gRec::N);
-  zero(g_.vel, VelRec::N);
-  zero(g_.aux, AuxRec::N);
-  zero(g_.cell, CellRec::N);
+  zero_boxes(g_.p2g, P2gRec::N, blocks_.retired());
+  zero_boxes(g_.vel, VelRec::N, blocks_.retired());
+  zero_boxes(g_.aux, AuxRec::N, blocks_.retired());
+  zero_boxes(g_.cell, CellRec::N, blocks_.retired());
+}
+
+// The nodes of the boxes in a (stride doubles per node; nothing if a is not in use) set to 0, row
+// by row along x.
+void FluidSolver::zero_boxes(std::vector<double> &a, int stride, const std::vector<IndexBox> &boxes) const {
+  if (a.empty()) return;
+  for (const IndexBox &b : boxes)
+    for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+      for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+        std::fill(a.begin() + stride * grid_.index(b.lo[0], j, k), a.begin() + stride * (grid_.index(b.hi[0], j, k) + 1),
+                  0.0);
 }
 
 void FluidSolver::clear_nodes(std::vector<double> &a, int stride) {
@@ -223,11 +226,7 @@ void FluidSolver::clear_nodes(std::vector<double> &a, int stride) {
     std::fill(a.begin(), a.end(), 0.0);
     return;
   }
-  for (const IndexBox &b : blocks_.boxes())
-    for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-      for (int j = b.lo[1]; j <= b.hi[1]; ++j)
-        std::fill(a.begin() + stride * grid_.index(b.lo[0], j, k), a.begin() + stride * (grid_.index(b.hi[0], j, k) + 1),
-                  0.0);
+  zero_boxes(a, stride, blocks_.boxes());
 }
 
 long FluidSolver::nonzero_outside_active() const {
