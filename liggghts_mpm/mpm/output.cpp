@@ -16,7 +16,8 @@ void FluidSolver::global_vector(double out[kGlobalSize]) {
   const double *rmass = pts.rmass;
   const double *spacing = state.spacing;
   double sum[4] = {0, 0, 0, state.n_clamped};  // mass, kinetic energy, points, clamped
-  // |v|max, front, height, p max, wall time of the fluid and of the coupling (slowest rank)
+  // |v|max, front, height, p max, wall time of the fluid, of the coupling and of the pressure solver
+  // (slowest rank), largest averaged nodal pressure (f_ID[19])
   double mx[8] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, time_fluid, time_couple, time_pressure_solver(),
                   proj_ ? proj_->largest_average_pressure() : -HUGE_VAL};
   for (int i = 0; i < pts.nlocal; ++i) {
