@@ -102,6 +102,12 @@ void parse_pressure_output(Options &o, Args &a, const ParseEnv &) {
   o.pressure_acceleration = !mult;
 }
 
+void parse_grain_pressure(Options &o, Args &a, const ParseEnv &) {
+  bool mult = true;
+  choice(a, "multiplier", "acceleration", mult);
+  o.grain_pressure_acceleration = !mult;
+}
+
 void parse_grad_p(Options &o, Args &a, const ParseEnv &) {
   a.need(1, "grad_p", "'weak', 'fit' or 'nodal'");
   if (strcmp(a.at(1), "weak") == 0)
@@ -311,7 +317,8 @@ void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
 void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
   static const char *const eos_only[] = {"bulk", "eos", "antilock", "pmin"};
   static const char *const projection_only[] = {"tolerance", "max_iterations", "dtheta_source", "free_surface",
-                                                 "volume_correction", "pressure_average", "pressure_output"};
+                                                 "volume_correction", "pressure_average", "pressure_output",
+                                                 "grain_pressure"};
   std::string bad;
   for (const std::string &kw : seen)
     for (const char *w : o.projection ? std::vector<const char *>(std::begin(eos_only), std::end(eos_only))
@@ -468,6 +475,8 @@ const std::vector<Keyword> kTable = {
      REAL(volume_correction), 0.0, kInf, false, true, nullptr, nullptr, false},
     {"pressure_output", "multiplier | acceleration", "-", "", "multiplier", "'multiplier' or 'acceleration'",
      nullptr, 0, 0, false, false, nullptr, parse_pressure_output, false},
+    {"grain_pressure", "multiplier | acceleration", "-", "", "acceleration", "'multiplier' or 'acceleration'",
+     nullptr, 0, 0, false, false, nullptr, parse_grain_pressure, false},
     {"pressure_average", "real", "time", ">= 0", "0", "a time constant (time) >= 0 of the averaged pressure f_ID[19]",
      REAL(pressure_average), 0.0, kInf, false, true, nullptr, nullptr, false},
     {"fill", "region nx ny nz type T", "-", "1..8 points per cell per direction", "required (not after read_restart)",
@@ -566,6 +575,14 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
   check_pressure_model(o, seen);
   if (o.coupled && !(o.viscosity > 0.0))
     throw Error("Fix mpm/fluid: keyword 'couple' needs keyword 'viscosity' > 0 (the drag laws scale with it)");
+  // grain_pressure: the pressure the grains feel; without grains there is none to choose (and the
+  // default acceleration would cost a second solve for nothing)
+  if (!o.projection) o.grain_pressure_acceleration = false;  // the keyword itself: an error above
+  if (!o.coupled) {
+    if (std::find(seen.begin(), seen.end(), "grain_pressure") != seen.end())
+      throw Error("Fix mpm/fluid: keyword 'grain_pressure' needs keyword 'couple' (the grains that feel the pressure)");
+    o.grain_pressure_acceleration = false;
+  }
   o.dimension = env.dimension;
   o.grid.dx = o.cell_size;
   o.eos.rho0 = o.rho0;

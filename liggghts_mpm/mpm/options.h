@@ -79,6 +79,7 @@ struct Options {
   bool surface_given = false;        // free_surface given (else node with mesh walls)
   bool projection_dtheta = true;     // couple: the d(theta)/dt source of the pressure equation
   bool pressure_acceleration = false;  // pressure_output acceleration: points' p from the fluid's acceleration
+  bool grain_pressure_acceleration = true;   // grain_pressure acceleration (couple only): grains feel its gradient
   double pressure_average = 0.0;     // time: time constant of the averaged nodal pressure f_ID[19] (0: none)
   double volume_correction = 0.0;    // 1/time: rate at which compressed points are pushed apart (0: off)
   // reports

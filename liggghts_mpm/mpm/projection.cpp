@@ -29,11 +29,13 @@ Projection::Projection(LocalGrid &grid, MPI_Comm comm, const Options &opt)
   p_ext_.assign(n, 0.0);
   grad_ext_.assign(3 * n, 0.0);
   if (opt.pressure_average > 0.0) p_avg_.assign(n, 0.0);
-  if (opt.pressure_acceleration) {
+  if (opt.pressure_acceleration || opt.grain_pressure_acceleration) {
     acc_.assign(3 * n, 0.0);
     p_acc_.assign(n, 0.0);
     p_acc_ext_.assign(n, 0.0);
+    grad_acc_.assign(3 * n, 0.0);
   }
+  if (opt.grain_pressure_acceleration) grad_acc_ext_.assign(3 * n, 0.0);
 }
 
 namespace {
@@ -291,8 +293,10 @@ void Projection::extend_to_padding(const std::vector<double> &a, std::vector<dou
    linear continuation p_k + (x_n - x_k) . grad_n from those neighbours k (for the first layer the
    ghost value p_k (1 - 1 / s_f)): a hydrostatic column then stays at rest and its points read the
    hydrostatic pressure at their height, also in the top layer. The solve's EMPTY values (0) are
-   not changed: p_ holds the extrapolated values only after the solve. */
-void Projection::extrapolate_above_surface(const double *p2g, double mmin) {
+   not changed: p holds the extrapolated values only after the solve. with_p false: the gradient
+   alone (the grains' gradient of the acceleration pressure, whose p the points read unextended). */
+void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::vector<double> &p,
+                                           std::vector<double> &grad, bool with_p) {
   const double dx = opt_.grid.dx;
   // per node: 1 if its gradient (gk) / pressure (pk) is known: FLUID nodes, and EMPTY nodes next
   // to a FLUID one for the gradient (pressure_gradient's one-sided surface face)
@@ -324,21 +328,21 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin) {
           std::size_t q;
           if (!open_face(grid_, lab_, i, j, k, d, side, &q)) continue;
           if (gk[q] != 0.0) {
-            for (int e = 0; e < 3; ++e) g[e] += grad_[3 * q + e];
+            for (int e = 0; e < 3; ++e) g[e] += grad[3 * q + e];
             ++ng;
           }
           // x_n - x_q = -side dx e_d
-          if (gk[n] != 0.0 && pk[q] != 0.0) {
-            psum += p_[q] - side * dx * grad_[3 * n + d];
+          if (with_p && gk[n] != 0.0 && pk[q] != 0.0) {
+            psum += p[q] - side * dx * grad[3 * n + d];
             ++np;
           }
         }
       if (gk[n] == 0.0 && ng > 0) {
-        for (int e = 0; e < 3; ++e) grad_[3 * n + e] = g[e] / ng;
+        for (int e = 0; e < 3; ++e) grad[3 * n + e] = g[e] / ng;
         gk_new[n] = 1.0;
       }
       if (pk[n] == 0.0 && np > 0) {
-        p_[n] = psum / np;
+        p[n] = psum / np;
         pk_new[n] = 1.0;
       }
     });
@@ -346,8 +350,8 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin) {
     pk.swap(pk_new);
     grid_.forward(gk.data(), 1);
     grid_.forward(pk.data(), 1);
-    grid_.forward(grad_.data(), 3);
-    grid_.forward(p_.data(), 1);
+    grid_.forward(grad.data(), 3);
+    if (with_p) grid_.forward(p.data(), 1);
   }
 }
 
@@ -409,7 +413,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   // (first the nodes behind mesh walls, which the padding nodes behind them then copy)
   pressure_gradient(grid_, lab_, p_.data(), grad_.data());
   grid_.forward(grad_.data(), 3);
-  if (opt_.surface_ghost) extrapolate_above_surface(p2g, mmin);
+  if (opt_.surface_ghost) extrapolate_above_surface(p2g, mmin, p_, grad_, true);
   if (mesh_) fill_wall_gradient(grad_);
   extend_for_points(p_, grad_, p2g, mmin, p_ext_, &grad_ext_);
   if (theta) {
@@ -418,7 +422,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   }
   correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), h, u_.data());
   grid_.forward(u_.data(), 3);
-  if (opt_.pressure_acceleration) acceleration_pressure(vel, th, h, p2g, mmin, step);
+  if (opt_.pressure_acceleration || opt_.grain_pressure_acceleration) acceleration_pressure(vel, th, h, p2g, mmin, step);
   average_pressure(h);
   if (mesh_) {
     // nodes behind mesh walls: the projected velocity of the fluid in front, then the wall
@@ -568,18 +572,20 @@ void Projection::acceleration_pressure(const double *vel, const double *theta, d
   });
   grid_.forward(acc_.data(), 3);
   acceleration_rhs(grid_, lab_, geo_, acc_.data(), theta, rhs_.data());
-  solve_rhs(p_acc_.data(), step, "the solve for the pressure of the acceleration (keyword 'pressure_output acceleration')");
+  solve_rhs(p_acc_.data(), step, "the solve for the pressure of the acceleration (keyword 'pressure_output' or 'grain_pressure' acceleration)");
   // behind mesh walls extrapolated linearly with its own gradient, as the multiplier (at rest
   // beside a 30 degree wall one pressure per row of points to 2e-11 rho g dx; with the mean of the
   // neighbours behind the wall instead, 0.27 rho g dx)
-  std::vector<double> g;
-  if (mesh_) {
-    g.assign(3 * grid_.size(), 0.0);
-    pressure_gradient(grid_, lab_, p_acc_.data(), g.data());
-    grid_.forward(g.data(), 3);
-    fill_wall_gradient(g);
+  // grain_pressure acceleration: the grains feel its gradient, formed as the multiplier's (the
+  // surface layers of the ghost-fluid surface included)
+  const bool grains = opt_.grain_pressure_acceleration;
+  if (mesh_ || grains) {
+    pressure_gradient(grid_, lab_, p_acc_.data(), grad_acc_.data());
+    grid_.forward(grad_acc_.data(), 3);
+    if (grains && opt_.surface_ghost) extrapolate_above_surface(p2g, mmin, p_acc_, grad_acc_, false);
+    if (mesh_) fill_wall_gradient(grad_acc_);
   }
-  extend_for_points(p_acc_, g, p2g, mmin, p_acc_ext_, nullptr);
+  extend_for_points(p_acc_, grad_acc_, p2g, mmin, p_acc_ext_, grains ? &grad_acc_ext_ : nullptr);
 }
 
 /* The pressure a sensor of finite response time reads (keyword pressure_average tau). Under the
@@ -618,13 +624,16 @@ void Projection::save(ProjectionState &s) const {
   s.theta_last.resize(have_theta_last_ ? nb : 0);
   s.have_avg = have_avg_;
   s.p_avg.resize(have_avg_ ? nb : 0);
-  const bool acc = opt_.pressure_acceleration;
+  const bool acc = opt_.pressure_acceleration || opt_.grain_pressure_acceleration;
   s.have_acc = acc;
   s.p_acc.resize(acc ? nb : 0);
+  // the gradient the grains feel at the next step (grain_pressure: of the multiplier or of the
+  // acceleration pressure)
+  const std::vector<double> &grad = opt_.grain_pressure_acceleration ? grad_acc_ : grad_;
   std::size_t q = 0;
   grid_.for_owned([&](int, int, int, std::size_t n) {  // k, j, i with i fastest: the box's order
     s.p[q] = p_[n];
-    for (int d = 0; d < 3; ++d) s.grad[3 * q + d] = grad_[3 * n + d];
+    for (int d = 0; d < 3; ++d) s.grad[3 * q + d] = grad[3 * n + d];
     if (have_theta_last_) s.theta_last[q] = theta_last_[n];
     if (have_avg_) s.p_avg[q] = p_avg_[n];
     if (acc) s.p_acc[q] = p_acc_[n];
@@ -646,13 +655,15 @@ bool Projection::load(const ProjectionState &s) {
   auto at = [&](int i, int j, int k) {
     return static_cast<std::size_t>(((k - b.lo[2]) * ey + (j - b.lo[1])) * ex + (i - b.lo[0]));
   };
+  const bool grains_acc = opt_.grain_pressure_acceleration;
+  std::vector<double> &grad = grains_acc ? grad_acc_ : grad_;  // the grains' (save)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     const std::size_t q = at(i, j, k);
     p_[n] = s.p[q];
-    for (int d = 0; d < 3; ++d) grad_[3 * n + d] = s.grad[3 * q + d];
+    for (int d = 0; d < 3; ++d) grad[3 * n + d] = s.grad[3 * q + d];
   });
   grid_.forward(p_.data(), 1);
-  grid_.forward(grad_.data(), 3);
+  grid_.forward(grad.data(), 3);
   have_theta_last_ = s.have_theta_last;
   if (have_theta_last_) {
     theta_last_.assign(grid_.size(), 1.0);
@@ -664,7 +675,8 @@ bool Projection::load(const ProjectionState &s) {
   // the averaged pressure goes on only if this run averages too (else it starts at the next solve)
   have_avg_ = s.have_avg && opt_.pressure_average > 0.0;
   if (have_avg_) grid_.for_owned([&](int i, int j, int k, std::size_t n) { p_avg_[n] = s.p_avg[at(i, j, k)]; });
-  if (s.have_acc && opt_.pressure_acceleration) {
+  const bool acc = opt_.pressure_acceleration || grains_acc;
+  if (s.have_acc && acc) {
     grid_.for_owned([&](int i, int j, int k, std::size_t n) { p_acc_[n] = s.p_acc[at(i, j, k)]; });
     grid_.forward(p_acc_.data(), 1);
   }
@@ -675,7 +687,8 @@ bool Projection::load(const ProjectionState &s) {
   lab_.reset(grid_);
   extend_to_padding(p_, p_ext_, 1);
   extend_to_padding(grad_, grad_ext_, 3);
-  if (opt_.pressure_acceleration) extend_to_padding(p_acc_, p_acc_ext_, 1);
+  if (acc) extend_to_padding(p_acc_, p_acc_ext_, 1);
+  if (grains_acc) extend_to_padding(grad_acc_, grad_acc_ext_, 3);
   return true;
 }
 

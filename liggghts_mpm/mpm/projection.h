@@ -45,9 +45,12 @@ class Projection {
   // walls with the pressure of the wall node in front (for interpolation to points); with
   // pressure_output acceleration the pressure of the fluid's acceleration (acceleration_pressure)
   const std::vector<double> &pressure() const { return opt_.pressure_acceleration ? p_acc_ext_ : p_ext_; }
-  // nodal pressure gradient of the last solve, the one the fluid felt (owned nodes and halos;
-  // padding nodes with the wall node's): for the grains
-  const std::vector<double> &gradient() const { return grad_ext_; }
+  // nodal pressure gradient for the grains (owned nodes and halos; padding nodes with the wall
+  // node's): of the last solve, the one the fluid felt; with grain_pressure acceleration that of
+  // the pressure of the fluid's acceleration
+  const std::vector<double> &gradient() const {
+    return opt_.grain_pressure_acceleration ? grad_acc_ext_ : grad_ext_;
+  }
   // largest nodal pressure of the last solve on this rank's owned nodes, averaged in time
   // (keyword pressure_average tau: exponential average with time constant tau; 0: as solved)
   double largest_average_pressure() const { return p_avg_max_; }
@@ -85,7 +88,8 @@ class Projection {
   void mirror_normal(double *v, int i, int j, int k, const double *p2g, double mmin) const;
   double folded_mass(int i, int j, int k) const;
   double mirror_sum(const std::vector<double> &a, int i, int j, int k) const;
-  void extrapolate_above_surface(const double *p2g, double mmin);
+  void extrapolate_above_surface(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
+                                 bool with_p);
   void extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const;
 
   LocalGrid &grid_;
@@ -112,7 +116,8 @@ class Projection {
   // theta: the nodal fluid fraction of this solve
   void acceleration_pressure(const double *vel, const double *theta, double h, const double *p2g, double mmin,
                              long step);
-  std::vector<double> acc_, p_acc_, p_acc_ext_;  // sized only with pressure_output acceleration
+  // sized only with pressure_output or grain_pressure acceleration (grad_acc_ext_: grain_pressure)
+  std::vector<double> acc_, p_acc_, p_acc_ext_, grad_acc_, grad_acc_ext_;
   void largest_pressure();  // p_avg_max_ from p_avg_ (averaging), else p_acc_ or p_ (the points' kind)
   PressureResult last_;
   double solver_seconds_ = 0.0;
