@@ -155,6 +155,8 @@ VARIANTS = [
     ("proj smooth", {"pressure": "projection", "extra": "theta_smooth 0.002"}),
     ("proj nodtheta smooth", {"pressure": "projection", "extra": "dtheta_source no theta_smooth 0.002"}),
     ("eos smooth", {"pressure": "eos", "extra": "theta_smooth 0.002"}),
+    # the grains' pressure force from the projection's multiplier (the default before 24 Nov 2026)
+    ("proj smooth multiplier", {"pressure": "projection", "extra": "theta_smooth 0.002 grain_pressure multiplier"}),
 ]
 
 
