@@ -14,6 +14,7 @@
 #include "comm.h"
 #include "domain.h"
 #include "error.h"
+#include "fix_mpm_fluid.h"
 #include "group.h"
 #include "irregular.h"
 #include "modify.h"
@@ -89,16 +90,6 @@ void FixBalanceMpm::bad_arg(const char *keyword, const char *expected, const cha
 
 int FixBalanceMpm::setmask() { return FixConst::PRE_EXCHANGE; }
 
-void FixBalanceMpm::init() {
-  // fix mpm/fluid builds its grid patch from the subdomain at the setup of a
-  // run; moving the cuts inside a run would leave it with the old patch.
-  if (every_ > 0)
-    for (int m = 0; m < modify->nfix; ++m)
-      if (strcmp(modify->fix[m]->style, "mpm/fluid") == 0)
-        error->all(FLERR, "Fix balance/mpm: keyword 'every' > 0 cannot be used with fix mpm/fluid, which builds "
-                          "its grid patch at the setup of a run; use 'every 0' (balance at the setup of every "
-                          "run) and split the run into several runs");
-}
 
 double FixBalanceMpm::weight(int i) const {
   const int mask = atom->mask[i];
@@ -283,6 +274,10 @@ void FixBalanceMpm::balance() {
   irregular.migrate_atoms();
   comm->setup();
   if (neighbor->style) neighbor->setup_bins();
+  // fix mpm/fluid builds its grid patch from the subdomain: inside a run it builds it again at
+  // its next step (at the setup of a run it builds it after this anyway)
+  for (int m = 0; m < modify->nfix; ++m)
+    if (strcmp(modify->fix[m]->style, "mpm/fluid") == 0) static_cast<FixMpmFluid *>(modify->fix[m])->subdomain_changed();
 
   imb_after_ = imbalance();
   ++nbalance_;

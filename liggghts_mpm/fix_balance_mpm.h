@@ -22,7 +22,6 @@ class FixBalanceMpm : public Fix {
  public:
   FixBalanceMpm(class LAMMPS *, int, char **);
   int setmask() override;
-  void init() override;
   void setup_pre_exchange() override;
   void pre_exchange() override;
   double compute_vector(int) override;

@@ -272,7 +272,12 @@ void FixMpmFluid::post_run() {
 
 void FixMpmFluid::pre_final_integrate() {
   mpm::FluidSolver &s = sync();
-  if (!s.grid_ready()) s.setup_grid(domain->sublo, domain->subhi, neighbor->skin);
+  if (!s.grid_ready()) {
+    // a new grid patch inside a run (fix balance/mpm every N): as at the setup of a run, the
+    // projection's last solve goes on into it and theta_transport takes its nodal reference again
+    s.setup_grid(domain->sublo, domain->subhi, neighbor->skin);
+    guarded([&] { s.setup_coupling(); });
+  }
   mpm::Gate &gate = s.opt.gate;
   if (gate.active && gate.release_time >= 0.0 && sim_time() >= gate.release_time - 0.5 * update->dt) {
     gate.active = false;
@@ -291,6 +296,10 @@ void FixMpmFluid::pre_final_integrate() {
       if (atom->mask[k] & couple_groupbit)
         for (int d = 0; d < 3; ++d) fix_dragforce->array_atom[k][d] = s.grain_force()[3 * k + d];
   vector_step = -1;
+}
+
+void FixMpmFluid::subdomain_changed() {
+  if (solver) solver->invalidate_grid();
 }
 
 double FixMpmFluid::compute_vector(int n) {

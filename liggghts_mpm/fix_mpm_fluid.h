@@ -36,6 +36,8 @@ class FixMpmFluid : public Fix {
   void setup(int) override;
   void post_run() override;
   void pre_final_integrate() override;
+  // fix balance/mpm moved the subdomain cuts inside a run: the grid patch follows at the next step
+  void subdomain_changed();
   void end_of_step() override;
 
   double compute_vector(int) override;

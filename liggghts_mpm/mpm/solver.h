@@ -98,6 +98,8 @@ class FluidSolver {
   // rounded up, plus one).
   void setup_grid(const double sublo[3], const double subhi[3], double skin);
   bool grid_ready() const { return grid_ready_; }
+  // the host moved the subdomain cuts inside a run (fix balance/mpm every N): setup_grid again
+  void invalidate_grid() { grid_ready_ = false; }
   const IndexBox &patch() const { return grid_.patch(); }
   // pressure projection: the state of the last solve on the whole grid (collective), for the
   // restart file; before the grid is set up, the one read from a restart file (or none)

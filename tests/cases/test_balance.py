@@ -5,6 +5,7 @@ Standard library only.
     test_balance.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR [--mpirun "mpirun ..."]
 
 CASE: np2 (3-D dam break of inputs/bench on 2 ranks with the balance fix against 1 rank),
+every_fluid (the same re-balanced every 50 steps inside one run, eos and projection),
 every_dem (re-balancing inside a run, no fluid), volume_dem (keyword volume), bad_input, all. Exit status 0 when every check passes.
 """
 import argparse
@@ -49,6 +50,30 @@ def case_np2(r):
         check(before > 1.9 and after < 1.05, f"imbalance {before:.3f} -> {after:.3f} (max rank / mean)")
 
 
+def case_every_fluid(r):
+    """2 ranks re-balanced every 50 steps inside one run of 300 (`every 50`: fix mpm/fluid builds its
+    grid patch again after each re-cut, the projection's last solve carried into it) = 1 rank:
+    eos to 1e-10 m, projection to 1e-6 m (the solver tolerance); the cut follows the front."""
+    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
+    for pressure, tol in (("eos", 1e-10), ("projection", 1e-6)):
+        v = dict(cells=8, warm=10, nsteps=300, segments=1, cellw=0, pressure=pressure)
+        d1, _ = r.run(f"balance_every_fluid/{pressure}_np1", inp, v)
+        d2, p2 = r.run(f"balance_every_fluid/{pressure}_np2", inp, dict(v, balance=1, rebal=50), np=2)
+        f1 = read_csv(os.path.join(d1, "bench3d.csv"))
+        f2 = read_csv(os.path.join(d2, "bench3d.csv"))
+        for k in ("front_x", "front_y", "mass"):
+            diff = abs(f1[k][0] - f2[k][0])
+            check(diff < tol, f"{pressure}, {k}: np2 (re-balanced in the run) = np1 to {tol:g} (|diff| = {diff:.1e})")
+        lines = cut_lines(p2.stdout)
+        cuts = [ln[1][1] for ln in lines]
+        print(f"  {pressure}: {len(lines)} balances, cut {cuts[0]:.4f} -> {cuts[-1]:.4f} m, front {f1['front_x'][0]:.4f} m"
+              if lines else f"  {pressure}: no balance line")
+        # at the setups of the two runs (10 and 300 steps) and at steps 50, 100, ..., 300 of the second
+        check(len(lines) == 8, f"{pressure}: balanced at both setups and every 50 steps ({len(lines)} of 8)")
+        if pressure == "projection" and cuts:
+            check(cuts[-1] > cuts[0] + 0.3, f"the cut follows the water ({cuts[0]:.3f} -> {cuts[-1]:.3f} m)")
+
+
 def case_bad_input(r):
     """Bad arguments stop with an error naming the command and the keyword."""
     tmpl = """atom_style sphere
@@ -75,7 +100,6 @@ run 0
         ("dim x weight all", "Fix balance/mpm: keyword 'weight' expects a weight >= 0"),
         ("dim x volume -1", "Fix balance/mpm: keyword 'volume' expects a weight per unit volume >= 0"),
         ("dim x volume", "Fix balance/mpm: keyword 'volume' expects a weight per unit volume >= 0"),
-        ("dim x every 100", "Fix balance/mpm: keyword 'every' > 0 cannot be used with fix mpm/fluid"),
         ("dim x every 4294967296", "Fix balance/mpm: keyword 'every' expects a number of steps >= 0"),
         ("dim x weight all 1e308", "Fix balance/mpm: keyword 'weight' expects a weight per atom (dimensionless"),
         ("dim x volume 1e308", "Fix balance/mpm: keyword 'volume' expects a weight per unit volume (1/length^3) in"),
@@ -150,7 +174,8 @@ def case_volume_dem(r):
     check(bool(lines0) and abs(lines0[0][1][1] - 0.45) < 1e-6, "without volume: cut at 0.45 m")
 
 
-CASES = {"np2": case_np2, "bad_input": case_bad_input, "every_dem": case_every_dem, "volume_dem": case_volume_dem}
+CASES = {"np2": case_np2, "every_fluid": case_every_fluid, "bad_input": case_bad_input, "every_dem": case_every_dem,
+         "volume_dem": case_volume_dem}
 
 
 def main():
