@@ -360,6 +360,8 @@ PressureResult Projection::solve_rhs(double *p, long step, const char *subject) 
     const double t0 = MPI_Wtime();
     const PressureResult r = solver_->solve(lab_, beta_.data(), rhs_.data(), p);
     solver_seconds_ += MPI_Wtime() - t0;
+    ++solves_;  // every solve (the acceleration pressure's too), as the time
+    iterations_summed_ += r.iterations;
     return r;
   } catch (const PressureSolveError &e) {
     std::ostringstream os;
@@ -405,8 +407,6 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   pressure_rhs(grid_, lab_, geo_, u_.data(), th, theta_prev, h, rhs_.data());
   if (pvol && opt_.volume_correction > 0.0) add_volume_correction(pvol, theta, h);
   last_ = solve_rhs(p_.data(), step, "the pressure projection");
-  ++solves_;
-  iterations_summed_ += last_.iterations;
   // for the points and grains: the padding nodes behind the box walls carry the pressure (and
   // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
   // they would lower the pressure of the points next to a wall by half a cell's hydrostatic step)

@@ -57,7 +57,8 @@ class Projection {
   int iterations() const { return last_.iterations; }
   double residual() const { return last_.relative_residual; }
   // since construction, this rank: wall time in the pressure solver (hypre assembly, setup and
-  // PCG), number of solves, PCG iterations summed over them
+  // PCG), number of solves (with the acceleration pressure two per fluid step), PCG iterations
+  // summed over them
   double solver_seconds() const { return solver_seconds_; }
   long solves() const { return solves_; }
   long iterations_summed() const { return iterations_summed_; }
