@@ -29,7 +29,7 @@ Projection::Projection(LocalGrid &grid, MPI_Comm comm, const Options &opt)
   p_ext_.assign(n, 0.0);
   grad_ext_.assign(3 * n, 0.0);
   if (opt.pressure_average > 0.0) p_avg_.assign(n, 0.0);
-  if (opt.pressure_acceleration || opt.grain_pressure_acceleration) {
+  if (acceleration_on()) {
     acc_.assign(3 * n, 0.0);
     p_acc_.assign(n, 0.0);
     p_acc_ext_.assign(n, 0.0);
@@ -422,7 +422,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   }
   correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), h, u_.data());
   grid_.forward(u_.data(), 3);
-  if (opt_.pressure_acceleration || opt_.grain_pressure_acceleration) acceleration_pressure(vel, th, h, p2g, mmin, step);
+  if (acceleration_on()) acceleration_pressure(vel, th, h, p2g, mmin, step);
   average_pressure(h);
   if (mesh_) {
     // nodes behind mesh walls: the projected velocity of the fluid in front, then the wall
@@ -624,7 +624,7 @@ void Projection::save(ProjectionState &s) const {
   s.theta_last.resize(have_theta_last_ ? nb : 0);
   s.have_avg = have_avg_;
   s.p_avg.resize(have_avg_ ? nb : 0);
-  const bool acc = opt_.pressure_acceleration || opt_.grain_pressure_acceleration;
+  const bool acc = acceleration_on();
   s.have_acc = acc;
   s.p_acc.resize(acc ? nb : 0);
   // the gradient the grains feel at the next step (grain_pressure: of the multiplier or of the
@@ -675,7 +675,7 @@ bool Projection::load(const ProjectionState &s) {
   // the averaged pressure goes on only if this run averages too (else it starts at the next solve)
   have_avg_ = s.have_avg && opt_.pressure_average > 0.0;
   if (have_avg_) grid_.for_owned([&](int i, int j, int k, std::size_t n) { p_avg_[n] = s.p_avg[at(i, j, k)]; });
-  const bool acc = opt_.pressure_acceleration || grains_acc;
+  const bool acc = acceleration_on();
   if (s.have_acc && acc) {
     grid_.for_owned([&](int i, int j, int k, std::size_t n) { p_acc_[n] = s.p_acc[at(i, j, k)]; });
     grid_.forward(p_acc_.data(), 1);

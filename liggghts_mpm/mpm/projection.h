@@ -117,7 +117,9 @@ class Projection {
   // theta: the nodal fluid fraction of this solve
   void acceleration_pressure(const double *vel, const double *theta, double h, const double *p2g, double mmin,
                              long step);
-  // sized only with pressure_output or grain_pressure acceleration (grad_acc_ext_: grain_pressure)
+  // the acceleration pressure is solved (pressure_output or grain_pressure acceleration)
+  bool acceleration_on() const { return opt_.pressure_acceleration || opt_.grain_pressure_acceleration; }
+  // sized only when acceleration_on() (grad_acc_ext_: grain_pressure acceleration)
   std::vector<double> acc_, p_acc_, p_acc_ext_, grad_acc_, grad_acc_ext_;
   void largest_pressure();  // p_avg_max_ from p_avg_ (averaging), else p_acc_ or p_ (the points' kind)
   PressureResult last_;
