@@ -224,9 +224,20 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
   const GridSpec &gs = opt.grid;
   const int passes = smoothing_passes(opt.theta_smooth, gs.dx);
   if (passes <= 0) return;
-  const int r = stride + 1;  // phi (stride values), node volume
+  const std::size_t N = grid_.size();
+  // the node volumes of the patch (owned, forwarded to the halo; 0 on padding nodes) do not change
+  // with the grid's patch: computed once after setup_grid
+  std::vector<double> &vol = g_.vnode;
+  if (vol.empty()) {
+    vol.assign(N, 0.0);
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) { vol[n] = solid_node_volume(i, j, k); });
+    grid_.forward(vol.data(), 1);
+  }
+  // phi and phi_new take turns (each pass writes the other and they swap): both are 0 outside the
+  // box of the pass, which only grows, so the nodes a pass does not write hold the same in both
   std::vector<double> &phi = g_.phi, &phi_new = g_.phi_new;
-  phi.assign(r * grid_.size(), 0.0);
+  phi.assign(stride * N, 0.0);
+  phi_new.assign(stride * N, 0.0);
   // the box (global node indices, over all ranks) of the nodes with a nonzero fraction: a pass
   // along d changes no node farther than one node along d from it, so the passes sweep only that
   // box, grown by one node along d before each pass along d; everywhere else phi stays 0, as the
@@ -234,13 +245,12 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
   // the whole grid, twice per coupled step, took 40 % of the run.)
   int box[6] = {INT_MAX, INT_MAX, INT_MAX, INT_MAX, INT_MAX, INT_MAX};  // lo[3], -hi[3]
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double V = solid_node_volume(i, j, k);
+    const double V = vol[n];
     bool nz = false;
     for (int c = 0; c < stride; ++c) {
-      phi[r * n + c] = V > 0.0 ? a[stride * n + c] / V : 0.0;
-      if (phi[r * n + c] != 0.0) nz = true;
+      phi[stride * n + c] = V > 0.0 ? a[stride * n + c] / V : 0.0;
+      if (phi[stride * n + c] != 0.0) nz = true;
     }
-    phi[r * n + stride] = V;
     if (nz) {
       const int idx[3] = {i, j, k};
       for (int d = 0; d < 3; ++d) {
@@ -260,11 +270,16 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
     }
   }
   const bool any = lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2];
-  grid_.forward(phi.data(), r);
-  phi_new.resize(stride * grid_.size());
+  grid_.forward(phi.data(), stride);
   const IndexBox &ob = grid_.owned();
   const IndexBox &pb = grid_.patch();
   const std::size_t step[3] = {1, grid_.stride_y(), grid_.stride_z()};
+  const double *const V = vol.data();
+  IndexBox b;  // owned nodes inside the box
+  for (int e = 0; e < 3; ++e) {
+    b.lo[e] = std::max(ob.lo[e], lo[e]);
+    b.hi[e] = std::min(ob.hi[e], hi[e]);
+  }
   for (int pass = 0; pass < passes && any; ++pass)
     for (int d = 0; d < 3; ++d) {
       if (!gs.periodic[d] && gs.ncell[d] < 2) continue;
@@ -272,28 +287,37 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
         --lo[d];
         ++hi[d];
       }
-      IndexBox b;  // owned nodes inside the box
       for (int e = 0; e < 3; ++e) {
         b.lo[e] = std::max(ob.lo[e], lo[e]);
         b.hi[e] = std::min(ob.hi[e], hi[e]);
       }
-      grid_.for_box(b, [&](int i, int j, int k, std::size_t n) {
-        const int id = d == 0 ? i : d == 1 ? j : k;
-        const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
-        const std::size_t m[2] = {has[0] ? n - step[d] : 0, has[1] ? n + step[d] : 0};
-        const double Vn[2] = {has[0] ? phi[r * m[0] + stride] : 0.0, has[1] ? phi[r * m[1] + stride] : 0.0};
-        for (int c = 0; c < stride; ++c) {
-          const double phin[2] = {has[0] ? phi[r * m[0] + c] : 0.0, has[1] ? phi[r * m[1] + c] : 0.0};
-          phi_new[stride * n + c] = smoothing_step(phi[r * n + stride], phi[r * n + c], Vn, phin, has);
+      const double *const p = phi.data();
+      double *const q = phi_new.data();
+      const std::size_t sd = step[d];
+      // row by row along x: along y and z a row's neighbours exist or not as a whole
+      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
+          const std::size_t n0 = grid_.index(b.lo[0], j, k);
+          const int jk = d == 1 ? j : k;
+          for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
+            const std::size_t n = n0 + static_cast<std::size_t>(i - b.lo[0]);
+            const int id = d == 0 ? i : jk;
+            const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
+            const std::size_t m[2] = {has[0] ? n - sd : 0, has[1] ? n + sd : 0};
+            const double Vn[2] = {has[0] ? V[m[0]] : 0.0, has[1] ? V[m[1]] : 0.0};
+            for (int c = 0; c < stride; ++c) {
+              const double phin[2] = {has[0] ? p[stride * m[0] + c] : 0.0, has[1] ? p[stride * m[1] + c] : 0.0};
+              q[stride * n + c] = smoothing_step(V[n], p[stride * n + c], Vn, phin, has);
+            }
+          }
         }
-      });
-      grid_.for_box(b, [&](int, int, int, std::size_t n) {
-        for (int c = 0; c < stride; ++c) phi[r * n + c] = phi_new[stride * n + c];
-      });
-      grid_.forward(phi.data(), r);
+      phi.swap(phi_new);
+      grid_.forward(phi.data(), stride);
     }
-  grid_.for_owned([&](int, int, int, std::size_t n) {
-    for (int c = 0; c < stride; ++c) a[stride * n + c] = phi[r * n + c] * phi[r * n + stride];
+  if (!any) return;  // a is 0 at every owned node (each has a volume)
+  // outside the last box phi is 0 and so was a: only the box is written back
+  grid_.for_box(b, [&](int, int, int, std::size_t n) {
+    for (int c = 0; c < stride; ++c) a[stride * n + c] = phi[stride * n + c] * V[n];
   });
 }
 
