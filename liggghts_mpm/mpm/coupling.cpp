@@ -348,10 +348,11 @@ void FluidSolver::pressure_moments() {
   double *const g = g_.pfit.data();
   const double *const need = g_.need.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const bool nodal = opt.grad_p == GradP::Nodal;
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     const double V = pts.state[i][C_VOL], p = pts.state[i][C_P];
-    if (opt.grad_p == GradP::Nodal && !near_face(ps.base, NS)) {
+    if (nodal && !near_face(ps.base, NS)) {
       // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
         double *cn = g + PfitRec::N * n;
@@ -374,11 +375,22 @@ void FluidSolver::pressure_moments() {
       }
       for (int q = 0; q < 3; ++q) dn[a][q] = xs - (gs.origin[a] + (ps.base[a] + q) * gs.dx);
     }
+    // grad_p nodal fits only the nodes near a face (near_face(i, j, k)); the others take the mean
+    // (the fit's first entries r[0] = sum S V p and M[0][0] = sum S V are the same sums)
+    bool nf[3][3];  // node plane q along a is near a face
+    for (int a = 0; a < 3; ++a)
+      for (int q = 0; q < 3; ++q)
+        nf[a][q] = nodal && !gs.periodic[a] && (ps.base[a] + q <= 1 || ps.base[a] + q >= gs.ncell[a] - 1);
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
       if (need[n] == 0.0) return;
+      double *cn = g + PfitRec::N * n;
+      if (nodal && !(nf[0][a] || nf[1][b] || nf[2][c])) {
+        cn[PfitRec::R] += w * V * p;
+        cn[PfitRec::MAT] += w * V;
+        return;
+      }
       const Row4 e = {1.0, dn[0][a], dn[1][b], dn[2][c]};
       const Row4 we = (w * V) * e;
-      double *cn = g + PfitRec::N * n;
       row4(cn + PfitRec::R) += p * we;
       row4(cn + PfitRec::MAT) += we;
       row4(cn + PfitRec::MAT + 4) += e[1] * we;
