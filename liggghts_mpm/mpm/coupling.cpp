@@ -309,33 +309,42 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
       const double *const p = phi.data();
       double *const q = phi_new.data();
       const std::size_t sd = step[d];
-      // row by row along x: along y and z a row's neighbours exist or not as a whole
+      // row by row along x: along y and z a row's neighbours exist or not as a whole, along x
+      // they do except at the patch's ends
+      auto one = [&](std::size_t n, int id) {  // any node: the neighbours that exist
+        const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
+        const std::size_t m[2] = {has[0] ? n - sd : 0, has[1] ? n + sd : 0};
+        const double Vn[2] = {has[0] ? V[m[0]] : 0.0, has[1] ? V[m[1]] : 0.0};
+        for (int c = 0; c < stride; ++c) {
+          const double phin[2] = {has[0] ? p[stride * m[0] + c] : 0.0, has[1] ? p[stride * m[1] + c] : 0.0};
+          q[stride * n + c] = smoothing_step(V[n], p[stride * n + c], Vn, phin, has);
+        }
+      };
+      auto row = [&](std::size_t n0, int len) {  // nodes n0 .. n0 + len - 1 with both neighbours
+        if (len <= 0) return;
+        if (stride == 1)
+          smooth_row<1>(p, q, V, n0, len, sd);
+        else if (stride == 3)
+          smooth_row<3>(p, q, V, n0, len, sd);
+        else
+          for (int t = 0; t < len; ++t) one(n0 + static_cast<std::size_t>(t), pb.lo[d] + 1);
+      };
       for (int k = b.lo[2]; k <= b.hi[2]; ++k)
         for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
           const std::size_t n0 = grid_.index(b.lo[0], j, k);
-          const int jk = d == 1 ? j : k;
-          const int len = b.hi[0] - b.lo[0] + 1;
-          const bool inner = d == 0 ? b.lo[0] - 1 >= pb.lo[0] && b.hi[0] + 1 <= pb.hi[0]
-                                    : jk - 1 >= pb.lo[d] && jk + 1 <= pb.hi[d];
-          if (inner && stride == 1) {
-            smooth_row<1>(p, q, V, n0, len, sd);
-            continue;
-          }
-          if (inner && stride == 3) {
-            smooth_row<3>(p, q, V, n0, len, sd);
-            continue;
-          }
-          for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
-            const std::size_t n = n0 + static_cast<std::size_t>(i - b.lo[0]);
-            const int id = d == 0 ? i : jk;
-            const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
-            const std::size_t m[2] = {has[0] ? n - sd : 0, has[1] ? n + sd : 0};
-            const double Vn[2] = {has[0] ? V[m[0]] : 0.0, has[1] ? V[m[1]] : 0.0};
-            for (int c = 0; c < stride; ++c) {
-              const double phin[2] = {has[0] ? p[stride * m[0] + c] : 0.0, has[1] ? p[stride * m[1] + c] : 0.0};
-              q[stride * n + c] = smoothing_step(V[n], p[stride * n + c], Vn, phin, has);
+          if (d != 0) {
+            const int jk = d == 1 ? j : k;
+            if (jk - 1 >= pb.lo[d] && jk + 1 <= pb.hi[d]) {
+              row(n0, b.hi[0] - b.lo[0] + 1);
+            } else {
+              for (int i = b.lo[0]; i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), jk);
             }
+            continue;
           }
+          const int ilo = std::max(b.lo[0], pb.lo[0] + 1), ihi = std::min(b.hi[0], pb.hi[0] - 1);
+          for (int i = b.lo[0]; i <= b.hi[0] && i < ilo; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
+          row(n0 + static_cast<std::size_t>(ilo - b.lo[0]), ihi - ilo + 1);
+          for (int i = std::max(ihi + 1, b.lo[0]); i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
         }
       phi.swap(phi_new);
       grid_.forward(phi.data(), stride);
