@@ -32,16 +32,22 @@ bool fit_linear_pressure(const double *c, double dx, double out[4]) {
 }
 
 // One pass of smooth_node_volume along a row of len nodes from n0 whose neighbours along the
-// pass's direction (n -+ sd) all exist: the filter's arithmetic, free of the per-node tests
+// pass's direction (n -+ sd) all exist: smoothing_step's arithmetic (the same operations in the
+// same order), free of the per-node tests; the division is done before the test V > 0 and the
+// function is compiled without trapping math (it changes no value: it lets the compiler treat the
+// comparisons and the division as free of side effects), so that the loop is vectorized
 template <int ST>
-static void smooth_row(const double *p, double *q, const double *V, std::size_t n0, int len, std::size_t sd) {
-  const bool has[2] = {true, true};
+__attribute__((optimize("no-trapping-math"))) static void smooth_row(const double *p, double *q, const double *V, std::size_t n0, int len, std::size_t sd) {
   for (int t = 0; t < len; ++t) {
     const std::size_t n = n0 + static_cast<std::size_t>(t);
-    const double Vn[2] = {V[n - sd], V[n + sd]};
+    const double v = V[n], v0 = V[n - sd], v1 = V[n + sd];
     for (int c = 0; c < ST; ++c) {
-      const double phin[2] = {p[ST * (n - sd) + c], p[ST * (n + sd) + c]};
-      q[ST * n + c] = smoothing_step(V[n], p[ST * n + c], Vn, phin, has);
+      const double ph = p[ST * n + c];
+      double S = ph * v;
+      S += 0.25 * (v < v0 ? v : v0) * (p[ST * (n - sd) + c] - ph);
+      S += 0.25 * (v < v1 ? v : v1) * (p[ST * (n + sd) + c] - ph);
+      const double r = S / v;
+      q[ST * n + c] = v > 0.0 ? r : 0.0;
     }
   }
 }
