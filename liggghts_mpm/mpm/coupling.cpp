@@ -625,11 +625,26 @@ void FluidSolver::couple_kernel(double h) {
   }
 }
 
-/* The points' volume and external force at the nodes (WkRec, reverse-summed), and the volume
-   again folded at the faces (rq[3 n], for route_reaction). */
+/* The points' volume and external force at the nodes (WkRec, reverse-summed, grad_p weak), and
+   the volume again folded at the faces (rq[3 n], for route_reaction). */
 template <int NS>
 void FluidSolver::point_sums() {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  if (!(opt.grad_p == GradP::Weak || opt.projection)) {
+    // reaction points alone (grad_p nodal, fit) reads only the points' volume folded (rq[3 n]):
+    // summed straight there (the same sums wk[V] had before it was copied), no wk
+    double *const rq = g_.rq.data();
+    std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
+    for (const int i : plist_) {
+      const double V = pts.state[i][C_VOL];
+      for_stencil<NS>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+        rq[3 * n] += w * V;
+      });
+    }
+    fold_to_mirror(g_.rq, 3);
+    grid_.reverse_sum(g_.rq.data(), 3);
+    return;
+  }
   double *const wk = g_.wk.data();
   std::fill(g_.wk.begin(), g_.wk.end(), 0.0);
   for (const int i : plist_) {
