@@ -36,8 +36,13 @@ bool fit_linear_pressure(const double *c, double dx, double out[4]) {
 // same order), free of the per-node tests; the division is done before the test V > 0 and the
 // function is compiled without trapping math (it changes no value: it lets the compiler treat the
 // comparisons and the division as free of side effects), so that the loop is vectorized
+#if defined(__GNUC__) && !defined(__clang__)
+#define MPM_NO_TRAPPING_MATH __attribute__((optimize("no-trapping-math")))
+#else
+#define MPM_NO_TRAPPING_MATH
+#endif
 template <int ST>
-__attribute__((optimize("no-trapping-math"))) static void smooth_row(const double *p, double *q, const double *V, std::size_t n0, int len, std::size_t sd) {
+MPM_NO_TRAPPING_MATH static void smooth_row(const double *p, double *q, const double *V, std::size_t n0, int len, std::size_t sd) {
   for (int t = 0; t < len; ++t) {
     const std::size_t n = n0 + static_cast<std::size_t>(t);
     const double v = V[n], v0 = V[n - sd], v1 = V[n + sd];
@@ -249,7 +254,8 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
   // the node volumes of the patch (owned, forwarded to the halo; 0 on padding nodes) do not change
   // with the grid's patch: computed once after setup_grid
   std::vector<double> &vol = g_.vnode;
-  if (vol.empty()) {
+  if (!g_.vnode_ready) {
+    g_.vnode_ready = true;
     vol.assign(N, 0.0);
     grid_.for_owned([&](int i, int j, int k, std::size_t n) { vol[n] = solid_node_volume(i, j, k); });
     grid_.forward(vol.data(), 1);
