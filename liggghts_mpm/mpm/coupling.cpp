@@ -277,6 +277,8 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
     for (int c = 0; c < stride; ++c) {
       phi[stride * n + c] = V > 0.0 ? a[stride * n + c] / V : 0.0;
       if (phi[stride * n + c] != 0.0) nz = true;
+      // an owned padding node (no volume) keeps phi = 0 in every pass and ends with a = 0 x 0
+      if (!(V > 0.0)) a[stride * n + c] = 0.0;
     }
     if (nz) {
       const int idx[3] = {i, j, k};
@@ -361,8 +363,8 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
       phi.swap(phi_new);
       grid_.forward(phi.data(), stride);
     }
-  if (!any) return;  // a is 0 at every owned node (each has a volume)
-  // outside the last box phi is 0 and so was a: only the box is written back
+  if (!any) return;  // a is +-0 at every owned node with a volume, 0 on the others: as phi V
+  // outside the last box phi is 0 and a was +-0 (or set 0 above): only the box is written back
   grid_.for_box(b, [&](int, int, int, std::size_t n) {
     for (int c = 0; c < stride; ++c) a[stride * n + c] = phi[stride * n + c] * V[n];
   });
