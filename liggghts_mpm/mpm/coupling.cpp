@@ -31,6 +31,32 @@ bool fit_linear_pressure(const double *c, double dx, double out[4]) {
   return true;
 }
 
+// One pass of smooth_node_volume along a row of len nodes from n0 whose neighbours along the
+// pass's direction (n -+ sd) all exist: smoothing_step's arithmetic (the same operations in the
+// same order), free of the per-node tests; the division is done before the test V > 0 and the
+// function is compiled without trapping math (it changes no value: it lets the compiler treat the
+// comparisons and the division as free of side effects), so that the loop is vectorized
+#if defined(__GNUC__) && !defined(__clang__)
+#define MPM_NO_TRAPPING_MATH __attribute__((optimize("no-trapping-math")))
+#else
+#define MPM_NO_TRAPPING_MATH
+#endif
+template <int ST>
+MPM_NO_TRAPPING_MATH static void smooth_row(const double *p, double *q, const double *V, std::size_t n0, int len, std::size_t sd) {
+  for (int t = 0; t < len; ++t) {
+    const std::size_t n = n0 + static_cast<std::size_t>(t);
+    const double v = V[n], v0 = V[n - sd], v1 = V[n + sd];
+    for (int c = 0; c < ST; ++c) {
+      const double ph = p[ST * n + c];
+      double S = ph * v;
+      S += 0.25 * (v < v0 ? v : v0) * (p[ST * (n - sd) + c] - ph);
+      S += 0.25 * (v < v1 ? v : v1) * (p[ST * (n + sd) + c] - ph);
+      const double r = S / v;
+      q[ST * n + c] = v > 0.0 ? r : 0.0;
+    }
+  }
+}
+
 int smoothing_passes(double L, double dx) { return static_cast<int>(std::ceil(2.0 * L * L / (dx * dx) - 1e-9)); }
 
 // fn(n, w) for the nodes a stencil reaches (the solver's shape functions)
@@ -224,9 +250,21 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
   const GridSpec &gs = opt.grid;
   const int passes = smoothing_passes(opt.theta_smooth, gs.dx);
   if (passes <= 0) return;
-  const int r = stride + 1;  // phi (stride values), node volume
+  const std::size_t N = grid_.size();
+  // the node volumes of the patch (owned, forwarded to the halo; 0 on padding nodes) do not change
+  // with the grid's patch: computed once after setup_grid
+  std::vector<double> &vol = g_.vnode;
+  if (!g_.vnode_ready) {
+    g_.vnode_ready = true;
+    vol.assign(N, 0.0);
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) { vol[n] = solid_node_volume(i, j, k); });
+    grid_.forward(vol.data(), 1);
+  }
+  // phi and phi_new take turns (each pass writes the other and they swap): both are 0 outside the
+  // box of the pass, which only grows, so the nodes a pass does not write hold the same in both
   std::vector<double> &phi = g_.phi, &phi_new = g_.phi_new;
-  phi.assign(r * grid_.size(), 0.0);
+  phi.assign(stride * N, 0.0);
+  phi_new.assign(stride * N, 0.0);
   // the box (global node indices, over all ranks) of the nodes with a nonzero fraction: a pass
   // along d changes no node farther than one node along d from it, so the passes sweep only that
   // box, grown by one node along d before each pass along d; everywhere else phi stays 0, as the
@@ -234,13 +272,14 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
   // the whole grid, twice per coupled step, took 40 % of the run.)
   int box[6] = {INT_MAX, INT_MAX, INT_MAX, INT_MAX, INT_MAX, INT_MAX};  // lo[3], -hi[3]
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double V = solid_node_volume(i, j, k);
+    const double V = vol[n];
     bool nz = false;
     for (int c = 0; c < stride; ++c) {
-      phi[r * n + c] = V > 0.0 ? a[stride * n + c] / V : 0.0;
-      if (phi[r * n + c] != 0.0) nz = true;
+      phi[stride * n + c] = V > 0.0 ? a[stride * n + c] / V : 0.0;
+      if (phi[stride * n + c] != 0.0) nz = true;
+      // an owned padding node (no volume) keeps phi = 0 in every pass and ends with a = 0 x 0
+      if (!(V > 0.0)) a[stride * n + c] = 0.0;
     }
-    phi[r * n + stride] = V;
     if (nz) {
       const int idx[3] = {i, j, k};
       for (int d = 0; d < 3; ++d) {
@@ -260,11 +299,16 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
     }
   }
   const bool any = lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2];
-  grid_.forward(phi.data(), r);
-  phi_new.resize(stride * grid_.size());
+  grid_.forward(phi.data(), stride);
   const IndexBox &ob = grid_.owned();
   const IndexBox &pb = grid_.patch();
   const std::size_t step[3] = {1, grid_.stride_y(), grid_.stride_z()};
+  const double *const V = vol.data();
+  IndexBox b;  // owned nodes inside the box
+  for (int e = 0; e < 3; ++e) {
+    b.lo[e] = std::max(ob.lo[e], lo[e]);
+    b.hi[e] = std::min(ob.hi[e], hi[e]);
+  }
   for (int pass = 0; pass < passes && any; ++pass)
     for (int d = 0; d < 3; ++d) {
       if (!gs.periodic[d] && gs.ncell[d] < 2) continue;
@@ -272,28 +316,57 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
         --lo[d];
         ++hi[d];
       }
-      IndexBox b;  // owned nodes inside the box
       for (int e = 0; e < 3; ++e) {
         b.lo[e] = std::max(ob.lo[e], lo[e]);
         b.hi[e] = std::min(ob.hi[e], hi[e]);
       }
-      grid_.for_box(b, [&](int i, int j, int k, std::size_t n) {
-        const int id = d == 0 ? i : d == 1 ? j : k;
+      const double *const p = phi.data();
+      double *const q = phi_new.data();
+      const std::size_t sd = step[d];
+      // row by row along x: along y and z a row's neighbours exist or not as a whole, along x
+      // they do except at the patch's ends
+      auto one = [&](std::size_t n, int id) {  // any node: the neighbours that exist
         const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
-        const std::size_t m[2] = {has[0] ? n - step[d] : 0, has[1] ? n + step[d] : 0};
-        const double Vn[2] = {has[0] ? phi[r * m[0] + stride] : 0.0, has[1] ? phi[r * m[1] + stride] : 0.0};
+        const std::size_t m[2] = {has[0] ? n - sd : 0, has[1] ? n + sd : 0};
+        const double Vn[2] = {has[0] ? V[m[0]] : 0.0, has[1] ? V[m[1]] : 0.0};
         for (int c = 0; c < stride; ++c) {
-          const double phin[2] = {has[0] ? phi[r * m[0] + c] : 0.0, has[1] ? phi[r * m[1] + c] : 0.0};
-          phi_new[stride * n + c] = smoothing_step(phi[r * n + stride], phi[r * n + c], Vn, phin, has);
+          const double phin[2] = {has[0] ? p[stride * m[0] + c] : 0.0, has[1] ? p[stride * m[1] + c] : 0.0};
+          q[stride * n + c] = smoothing_step(V[n], p[stride * n + c], Vn, phin, has);
         }
-      });
-      grid_.for_box(b, [&](int, int, int, std::size_t n) {
-        for (int c = 0; c < stride; ++c) phi[r * n + c] = phi_new[stride * n + c];
-      });
-      grid_.forward(phi.data(), r);
+      };
+      auto row = [&](std::size_t n0, int len) {  // nodes n0 .. n0 + len - 1 with both neighbours
+        if (len <= 0) return;
+        if (stride == 1)
+          smooth_row<1>(p, q, V, n0, len, sd);
+        else if (stride == 3)
+          smooth_row<3>(p, q, V, n0, len, sd);
+        else
+          for (int t = 0; t < len; ++t) one(n0 + static_cast<std::size_t>(t), pb.lo[d] + 1);
+      };
+      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
+          const std::size_t n0 = grid_.index(b.lo[0], j, k);
+          if (d != 0) {
+            const int jk = d == 1 ? j : k;
+            if (jk - 1 >= pb.lo[d] && jk + 1 <= pb.hi[d]) {
+              row(n0, b.hi[0] - b.lo[0] + 1);
+            } else {
+              for (int i = b.lo[0]; i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), jk);
+            }
+            continue;
+          }
+          const int ilo = std::max(b.lo[0], pb.lo[0] + 1), ihi = std::min(b.hi[0], pb.hi[0] - 1);
+          for (int i = b.lo[0]; i <= b.hi[0] && i < ilo; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
+          row(n0 + static_cast<std::size_t>(ilo - b.lo[0]), ihi - ilo + 1);
+          for (int i = std::max(ihi + 1, b.lo[0]); i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
+        }
+      phi.swap(phi_new);
+      grid_.forward(phi.data(), stride);
     }
-  grid_.for_owned([&](int, int, int, std::size_t n) {
-    for (int c = 0; c < stride; ++c) a[stride * n + c] = phi[r * n + c] * phi[r * n + stride];
+  if (!any) return;  // a is +-0 at every owned node with a volume, 0 on the others: as phi V
+  // outside the last box phi is 0 and a was +-0 (or set 0 above): only the box is written back
+  grid_.for_box(b, [&](int, int, int, std::size_t n) {
+    for (int c = 0; c < stride; ++c) a[stride * n + c] = phi[stride * n + c] * V[n];
   });
 }
 
@@ -324,10 +397,11 @@ void FluidSolver::pressure_moments() {
   double *const g = g_.pfit.data();
   const double *const need = g_.need.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const bool nodal = opt.grad_p == GradP::Nodal;
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     const double V = pts.state[i][C_VOL], p = pts.state[i][C_P];
-    if (opt.grad_p == GradP::Nodal && !near_face(ps.base, NS)) {
+    if (nodal && !near_face(ps.base, NS)) {
       // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
         double *cn = g + PfitRec::N * n;
@@ -350,11 +424,22 @@ void FluidSolver::pressure_moments() {
       }
       for (int q = 0; q < 3; ++q) dn[a][q] = xs - (gs.origin[a] + (ps.base[a] + q) * gs.dx);
     }
+    // grad_p nodal fits only the nodes near a face (near_face(i, j, k)); the others take the mean
+    // (the fit's first entries r[0] = sum S V p and M[0][0] = sum S V are the same sums)
+    bool nf[3][3];  // node plane q along a is near a face
+    for (int a = 0; a < 3; ++a)
+      for (int q = 0; q < 3; ++q)
+        nf[a][q] = nodal && !gs.periodic[a] && (ps.base[a] + q <= 1 || ps.base[a] + q >= gs.ncell[a] - 1);
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
       if (need[n] == 0.0) return;
+      double *cn = g + PfitRec::N * n;
+      if (nodal && !(nf[0][a] || nf[1][b] || nf[2][c])) {
+        cn[PfitRec::R] += w * V * p;
+        cn[PfitRec::MAT] += w * V;
+        return;
+      }
       const Row4 e = {1.0, dn[0][a], dn[1][b], dn[2][c]};
       const Row4 we = (w * V) * e;
-      double *cn = g + PfitRec::N * n;
       row4(cn + PfitRec::R) += p * we;
       row4(cn + PfitRec::MAT) += we;
       row4(cn + PfitRec::MAT + 4) += e[1] * we;
@@ -548,11 +633,26 @@ void FluidSolver::couple_kernel(double h) {
   }
 }
 
-/* The points' volume and external force at the nodes (WkRec, reverse-summed), and the volume
-   again folded at the faces (rq[3 n], for route_reaction). */
+/* The points' volume and external force at the nodes (WkRec, reverse-summed, grad_p weak), and
+   the volume again folded at the faces (rq[3 n], for route_reaction). */
 template <int NS>
 void FluidSolver::point_sums() {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  if (!(opt.grad_p == GradP::Weak || opt.projection)) {
+    // reaction points alone (grad_p nodal, fit) reads only the points' volume folded (rq[3 n]):
+    // summed straight there (the same sums wk[V] had before it was copied), no wk
+    double *const rq = g_.rq.data();
+    std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
+    for (const int i : plist_) {
+      const double V = pts.state[i][C_VOL];
+      for_stencil<NS>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+        rq[3 * n] += w * V;
+      });
+    }
+    fold_to_mirror(g_.rq, 3);
+    grid_.reverse_sum(g_.rq.data(), 3);
+    return;
+  }
   double *const wk = g_.wk.data();
   std::fill(g_.wk.begin(), g_.wk.end(), 0.0);
   for (const int i : plist_) {

@@ -53,6 +53,8 @@ struct GridFields {
   std::vector<double> rx;       // force of the grains on the fluid (3), owned nodes
   std::vector<double> th_prev;  // theta_transport: nodal fraction of the last sub-step
   std::vector<double> phi, phi_new;  // smoothing work arrays
+  std::vector<double> vnode;    // smoothing: node volume (solid_node_volume, forwarded), filled on first use
+  bool vnode_ready = false;     // (a flag, not vnode.empty(): a rank may have no node, and filling is collective)
   std::vector<double> wk;       // grad_p weak: WkRec (reverse-summed)
   std::vector<double> gw;       // grad_p weak: the fluid's pressure gradient (3), every patch node
   std::vector<double> rp, rq;   // reaction points: the grains' pressure reaction, its density (3)
@@ -75,6 +77,8 @@ struct GridFields {
       gw.assign(nodes * 3, 0.0);
       rp.assign(nodes * 3, 0.0);
       rq.assign(nodes * 3, 0.0);
+      vnode.clear();
+      vnode_ready = false;
     }
   }
 };
