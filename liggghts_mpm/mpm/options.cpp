@@ -96,16 +96,18 @@ void parse_free_surface(Options &o, Args &a, const ParseEnv &) {
   o.surface_given = true;
 }
 
-void parse_pressure_output(Options &o, Args &a, const ParseEnv &) {
-  bool mult = true;
-  choice(a, "multiplier", "acceleration", mult);
-  o.pressure_acceleration = !mult;
+// 'multiplier' or 'acceleration' (true) of the projection's pressure kinds
+void multiplier_or_acceleration(Args &a, bool &acceleration) {
+  bool multiplier = true;
+  choice(a, "multiplier", "acceleration", multiplier);
+  acceleration = !multiplier;
 }
 
+void parse_pressure_output(Options &o, Args &a, const ParseEnv &) {
+  multiplier_or_acceleration(a, o.pressure_acceleration);
+}
 void parse_grain_pressure(Options &o, Args &a, const ParseEnv &) {
-  bool mult = true;
-  choice(a, "multiplier", "acceleration", mult);
-  o.grain_pressure_acceleration = !mult;
+  multiplier_or_acceleration(a, o.grain_pressure_acceleration);
 }
 
 void parse_grad_p(Options &o, Args &a, const ParseEnv &) {
