@@ -355,6 +355,14 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
   }
 }
 
+void Projection::form_gradient(std::vector<double> &p, std::vector<double> &grad, const double *p2g, double mmin,
+                               bool above_surface, bool with_p) {
+  pressure_gradient(grid_, lab_, p.data(), grad.data());
+  grid_.forward(grad.data(), 3);
+  if (above_surface && opt_.surface_ghost) extrapolate_above_surface(p2g, mmin, p, grad, with_p);
+  if (mesh_) fill_wall_gradient(grad);
+}
+
 PressureResult Projection::solve_rhs(double *p, long step, const char *subject) {
   try {
     const double t0 = MPI_Wtime();
@@ -411,10 +419,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
   // they would lower the pressure of the points next to a wall by half a cell's hydrostatic step)
   // (first the nodes behind mesh walls, which the padding nodes behind them then copy)
-  pressure_gradient(grid_, lab_, p_.data(), grad_.data());
-  grid_.forward(grad_.data(), 3);
-  if (opt_.surface_ghost) extrapolate_above_surface(p2g, mmin, p_, grad_, true);
-  if (mesh_) fill_wall_gradient(grad_);
+  form_gradient(p_, grad_, p2g, mmin, true, true);
   extend_for_points(p_, grad_, p2g, mmin, p_ext_, &grad_ext_);
   if (theta) {
     theta_last_.assign(theta, theta + grid_.size());
@@ -579,12 +584,7 @@ void Projection::acceleration_pressure(const double *vel, const double *theta, d
   // grain_pressure acceleration: the grains feel its gradient, formed as the multiplier's (the
   // surface layers of the ghost-fluid surface included)
   const bool grains = opt_.grain_pressure_acceleration;
-  if (mesh_ || grains) {
-    pressure_gradient(grid_, lab_, p_acc_.data(), grad_acc_.data());
-    grid_.forward(grad_acc_.data(), 3);
-    if (grains && opt_.surface_ghost) extrapolate_above_surface(p2g, mmin, p_acc_, grad_acc_, false);
-    if (mesh_) fill_wall_gradient(grad_acc_);
-  }
+  if (mesh_ || grains) form_gradient(p_acc_, grad_acc_, p2g, mmin, grains, false);
   extend_for_points(p_acc_, grad_acc_, p2g, mmin, p_acc_ext_, grains ? &grad_acc_ext_ : nullptr);
 }
 

@@ -78,6 +78,12 @@ class Projection {
   void extend_behind(std::vector<double> &a, int stride, const double *p2g, double mmin,
                      const std::vector<double> *grad = nullptr);
   void fill_wall_gradient(std::vector<double> &grad);
+  // the nodal gradient of p (one-sided at the surface, halos forwarded), with the ghost surface
+  // and above_surface extrapolated into the EMPTY layers above it (p as well if with_p), behind
+  // mesh walls filled (fill_wall_gradient): the multiplier's for the fluid and the grains, the
+  // acceleration pressure's for the grains and the mesh-wall extension of its points' values
+  void form_gradient(std::vector<double> &p, std::vector<double> &grad, const double *p2g, double mmin,
+                     bool above_surface, bool with_p);
   // one solve of the operator with rhs_ into p (warm start), timed into solver_seconds_; a solve
   // that does not converge is an error naming subject and the step
   PressureResult solve_rhs(double *p, long step, const char *subject);
