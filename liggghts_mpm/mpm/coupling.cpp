@@ -372,18 +372,19 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
 
 // A node within one node of a grid face of a non-periodic dimension (padding nodes included).
 bool FluidSolver::near_face(int i, int j, int k) const {
+  return near_face_along(0, i) || near_face_along(1, j) || near_face_along(2, k);
+}
+
+// node index idx along d lies within one node of a (non-periodic) grid face
+bool FluidSolver::near_face_along(int d, int idx) const {
   const GridSpec &gs = opt.grid;
-  const int idx[3] = {i, j, k};
-  for (int d = 0; d < 3; ++d)
-    if (!gs.periodic[d] && (idx[d] <= 1 || idx[d] >= gs.ncell[d] - 1)) return true;
-  return false;
+  return !gs.periodic[d] && (idx <= 1 || idx >= gs.ncell[d] - 1);
 }
 
 // Some node of a stencil of ns nodes per direction from base is near_face.
 bool FluidSolver::near_face(const int base[3], int ns) const {
-  const GridSpec &gs = opt.grid;
-  for (int d = 0; d < 3; ++d)
-    if (!gs.periodic[d] && (base[d] <= 1 || base[d] + ns - 1 >= gs.ncell[d] - 1)) return true;
+  for (int d = 0; d < 3; ++d)  // the stencil's first or last node plane along d
+    if (near_face_along(d, base[d]) || near_face_along(d, base[d] + ns - 1)) return true;
   return false;
 }
 
@@ -429,7 +430,7 @@ void FluidSolver::pressure_moments() {
     bool nf[3][3];  // node plane q along a is near a face
     for (int a = 0; a < 3; ++a)
       for (int q = 0; q < 3; ++q)
-        nf[a][q] = nodal && !gs.periodic[a] && (ps.base[a] + q <= 1 || ps.base[a] + q >= gs.ncell[a] - 1);
+        nf[a][q] = nodal && near_face_along(a, ps.base[a] + q);
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
       if (need[n] == 0.0) return;
       double *cn = g + PfitRec::N * n;

@@ -179,6 +179,7 @@ class FluidSolver {
   template <int NS> void through_points(const double *q, std::vector<double> &out);
   void fold_to_mirror(std::vector<double> &a, int stride);
   bool near_face(int i, int j, int k) const;
+  bool near_face_along(int d, int idx) const;
   bool near_face(const int base[3], int ns) const;
   void smooth_node_volume(std::vector<double> &a, int stride = 1);
   template <class Fn> void for_nodes(const Stencil &ps, Fn &&fn) const;
