@@ -20,6 +20,18 @@ struct IndexBox {
   long count() const {
     return empty() ? 0 : long(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
   }
+  // the nodes of both boxes
+  IndexBox cut(const IndexBox &b) const {
+    IndexBox r;
+    for (int d = 0; d < 3; ++d) {
+      r.lo[d] = std::max(lo[d], b.lo[d]);
+      r.hi[d] = std::min(hi[d], b.hi[d]);
+    }
+    return r;
+  }
+  bool contains(int i, int j, int k) const {
+    return i >= lo[0] && i <= hi[0] && j >= lo[1] && j <= hi[1] && k >= lo[2] && k <= hi[2];
+  }
 };
 
 struct GridSpec {
@@ -74,11 +86,36 @@ class LocalGrid {
       for (int j = b.lo[1]; j <= b.hi[1]; ++j)
         for (int i = b.lo[0]; i <= b.hi[0]; ++i) fn(i, j, k, index(i, j, k));
   }
-  // Calls fn(i, j, k, n) for every owned node.
+  // Calls fn(i, j, k, n) for every owned node (of the work box only, while one is set).
   template <class Fn>
   void for_owned(Fn &&fn) const {
+    for_box(restricted_ ? owned_.cut(work_) : owned_, fn);
+  }
+  // Calls fn(i, j, k, n) for every owned node, work box or not.
+  template <class Fn>
+  void for_owned_all(Fn &&fn) const {
     for_box(owned_, fn);
   }
+  // The work box (the projection's sparse sweeps, docs/performance.md "Sparse grid"): while set,
+  // for_owned visits only the owned nodes inside it; null: every owned node again. WorkScope
+  // sets it for a scope.
+  void set_work(const IndexBox *b) {
+    restricted_ = b != nullptr;
+    if (b) work_ = *b;
+  }
+  bool restricted() const { return restricted_; }
+  class WorkScope {
+   public:
+    WorkScope(LocalGrid &g, const IndexBox *b) : g_(g), was_(g.restricted_), old_(g.work_) { g.set_work(b); }
+    ~WorkScope() { g_.set_work(was_ ? &old_ : nullptr); }
+    WorkScope(const WorkScope &) = delete;
+    WorkScope &operator=(const WorkScope &) = delete;
+
+   private:
+    LocalGrid &g_;
+    bool was_;
+    IndexBox old_;
+  };
 
   // Adds the halo partial sums of data (stride doubles per node) into their owners.
   void reverse_sum(double *data, int stride);
@@ -105,6 +142,8 @@ class LocalGrid {
   std::vector<Transfer> halo_side_;   // my halo nodes -> owner (reverse sends, forward receives)
   std::vector<Transfer> owner_side_;  // my owned nodes <- peer halos (reverse receives, forward sends)
   std::vector<double> sendbuf_, recvbuf_;
+  IndexBox work_;
+  bool restricted_ = false;
 };
 
 // The sparse grid (keyword sparse, docs/performance.md): blocks of kSize^3 nodes of a rank's patch

@@ -298,7 +298,8 @@ PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *
   // changing the solution of the compatible system up to its constant.
   long counts[2] = {0, 0}, gcounts[2];  // EMPTY nodes, FLUID nodes
   long first = -1;
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+  // every owned node (the projection's work box leaves out EMPTY nodes, which count here)
+  grid_.for_owned_all([&](int i, int j, int k, std::size_t n) {
     if (labels.kind[n] == kEmpty) ++counts[0];
     if (labels.kind[n] != kFluid) return;
     ++counts[1];

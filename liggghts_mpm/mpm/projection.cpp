@@ -57,13 +57,22 @@ constexpr double kLevelTie = 1e-9;
    wall at rest: the face between the last node on the fluid side and the next one (a gate through
    a node plane leaves that node on the fluid side, like a box wall through its nodes). */
 void Projection::make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls) {
-  lab_.reset(grid_);
+  const bool sparse = grid_.restricted();
+  lab_.reset(grid_, sparse ? &work_ : nullptr);
   mesh_ = walls != nullptr;
   if (mesh_) mesh_wall_labels(*walls);
   const double dx = opt_.grid.dx, full = opt_.rho0 * dx * dx * dx;
   if (opt_.surface_ghost) {
-    lab_.level.assign(grid_.size(), 0.0);
-    fold_mass_.assign(grid_.size(), 0.0);
+    if (sparse) {
+      // the work box's nodes as the full sweep sets them; outside it the level is never read (it
+      // enters only the faces of FLUID nodes) and fold_mass_ is 0 (retire)
+      lab_.level.resize(grid_.size(), 0.0);
+      fold_mass_.resize(grid_.size(), 0.0);
+      grid_.for_box(work_, [&](int, int, int, std::size_t n) { lab_.level[n] = fold_mass_[n] = 0.0; });
+    } else {
+      lab_.level.assign(grid_.size(), 0.0);
+      fold_mass_.assign(grid_.size(), 0.0);
+    }
     grid_.for_owned([&](int, int, int, std::size_t n) { fold_mass_[n] = p2g[P2gRec::N * n + P2gRec::M]; });
     grid_.forward(fold_mass_.data(), 1);
   }
@@ -90,13 +99,11 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     const bool on_plane = std::fabs(xi - r) < 1e-9;
     // lower node of the closed face
     const int lo = on_plane ? static_cast<int>(g.fluid_below ? r : r - 1) : static_cast<int>(std::floor(xi));
-    const IndexBox &pb = grid_.patch();
-    for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
-      for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
-        for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-          const int idx[3] = {i, j, k};
-          if (idx[g.dim] == lo) lab_.close_face(grid_, i, j, k, g.dim);
-        }
+    // the plane of those nodes in the patch
+    IndexBox plane = grid_.patch();
+    plane.lo[g.dim] = std::max(plane.lo[g.dim], lo);
+    plane.hi[g.dim] = std::min(plane.hi[g.dim], lo);
+    grid_.for_box(plane, [&](int i, int j, int k, std::size_t) { lab_.close_face(grid_, i, j, k, g.dim); });
   }
   lab_.exchange(grid_, comm_);
 }
@@ -273,8 +280,15 @@ std::size_t Projection::wall_node(int i, int j, int k) const {
 }
 
 void Projection::extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const {
-  out = a;
-  const IndexBox &pb = grid_.patch();
+  // sparse sweeps: the work box only (outside it both hold 0, retire)
+  const bool sparse = grid_.restricted();
+  const IndexBox &pb = sparse ? work_ : grid_.patch();
+  if (sparse)
+    grid_.for_box(pb, [&](int, int, int, std::size_t n) {
+      for (int e = 0; e < stride; ++e) out[stride * n + e] = a[stride * n + e];
+    });
+  else
+    out = a;
   for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
     for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
       for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
@@ -283,6 +297,20 @@ void Projection::extend_to_padding(const std::vector<double> &a, std::vector<dou
         const std::size_t c = wall_node(i, j, k);
         for (int e = 0; e < stride; ++e) out[stride * n + e] = a[stride * c + e];
       }
+}
+
+void Projection::retire(const IndexBox &work) {
+  if (!have_prev_) return;
+  std::vector<std::pair<std::vector<double> *, int>> arrays = {
+      {&u_, 3}, {&grad_, 3}, {&grad_ext_, 3}, {&rhs_, 1}, {&p_, 1}, {&p_ext_, 1},
+      {&acc_, 3}, {&p_acc_, 1}, {&p_acc_ext_, 1}, {&grad_acc_, 3}, {&grad_acc_ext_, 3},
+      {&fold_mass_, 1}, {&gk_, 1}, {&pk_, 1}};
+  grid_.for_box(work_prev_.cut(grid_.patch()), [&](int i, int j, int k, std::size_t n) {
+    if (work.contains(i, j, k)) return;
+    for (auto &a : arrays)
+      if (a.first->size() == a.second * grid_.size())
+        for (int e = 0; e < a.second; ++e) (*a.first)[a.second * n + e] = 0.0;
+  });
 }
 
 /* Ghost-fluid surface: the EMPTY nodes that hold fluid mass (the B-spline spreads the points'
@@ -300,7 +328,15 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
   const double dx = opt_.grid.dx;
   // per node: 1 if its gradient (gk) / pressure (pk) is known: FLUID nodes, and EMPTY nodes next
   // to a FLUID one for the gradient (pressure_gradient's one-sided surface face)
-  std::vector<double> gk(grid_.size(), 0.0), pk(grid_.size(), 0.0);
+  std::vector<double> &gk = gk_, &pk = pk_;
+  if (grid_.restricted()) {  // 0 outside the work box (retire)
+    gk.resize(grid_.size(), 0.0);
+    pk.resize(grid_.size(), 0.0);
+    grid_.for_box(work_, [&](int, int, int, std::size_t n) { gk[n] = pk[n] = 0.0; });
+  } else {
+    gk.assign(grid_.size(), 0.0);
+    pk.assign(grid_.size(), 0.0);
+  }
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kFluid) {
       gk[n] = pk[n] = 1.0;
@@ -315,8 +351,11 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
   });
   grid_.forward(gk.data(), 1);
   grid_.forward(pk.data(), 1);
+  // the nodes that become known in a pass are marked after it (the pass reads the flags before it)
+  std::vector<std::size_t> gnew, pnew;
   for (int pass = 0; pass < 3; ++pass) {
-    std::vector<double> gk_new = gk, pk_new = pk;
+    gnew.clear();
+    pnew.clear();
     grid_.for_owned([&](int i, int j, int k, std::size_t n) {
       if (lab_.kind[n] != kEmpty) return;
       const double m = p2g[P2gRec::N * n + P2gRec::M];
@@ -339,15 +378,15 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
         }
       if (gk[n] == 0.0 && ng > 0) {
         for (int e = 0; e < 3; ++e) grad[3 * n + e] = g[e] / ng;
-        gk_new[n] = 1.0;
+        gnew.push_back(n);
       }
       if (pk[n] == 0.0 && np > 0) {
         p[n] = psum / np;
-        pk_new[n] = 1.0;
+        pnew.push_back(n);
       }
     });
-    gk.swap(gk_new);
-    pk.swap(pk_new);
+    for (const std::size_t n : gnew) gk[n] = 1.0;
+    for (const std::size_t n : pnew) pk[n] = 1.0;
     grid_.forward(gk.data(), 1);
     grid_.forward(pk.data(), 1);
     grid_.forward(grad.data(), 3);
@@ -398,7 +437,13 @@ void Projection::extend_for_points(const std::vector<double> &p, const std::vect
 }
 
 void Projection::project(double *vel, const double *p2g, double mmin, const double *theta, bool dtheta, double h,
-                         Boundaries &bc, long step, const double *pvol) {
+                         Boundaries &bc, long step, const double *pvol, const IndexBox *work) {
+  // sparse sweeps: every for_owned of this step visits the work box only
+  work_ = work ? work->cut(grid_.patch()) : grid_.patch();
+  if (work) retire(work_);
+  work_prev_ = work_;
+  have_prev_ = true;
+  LocalGrid::WorkScope scope(grid_, work ? &work_ : nullptr);
   make_labels(p2g, mmin, theta, bc.walls());
   const double *theta_prev = theta && dtheta && have_theta_last_ ? theta_last_.data() : nullptr;
   // u* as it is; every wall condition comes after the projection: the wall's reaction is the
@@ -599,7 +644,8 @@ void Projection::average_pressure(double h) {
   if (tau > 0.0) {
     const double a = have_avg_ ? -std::expm1(-h / tau) : 1.0;  // the first solve starts the average
     const std::vector<double> &p = opt_.pressure_acceleration ? p_acc_ : p_;
-    grid_.for_owned([&](int, int, int, std::size_t n) { p_avg_[n] += a * (p[n] - p_avg_[n]); });
+    // every owned node, work box or not: the average decays where the fluid has gone
+    grid_.for_owned_all([&](int, int, int, std::size_t n) { p_avg_[n] += a * (p[n] - p_avg_[n]); });
     have_avg_ = true;
   }
   largest_pressure();
@@ -608,7 +654,7 @@ void Projection::average_pressure(double h) {
 void Projection::largest_pressure() {
   const std::vector<double> &a = have_avg_ ? p_avg_ : opt_.pressure_acceleration ? p_acc_ : p_;
   double mx = -HUGE_VAL;
-  grid_.for_owned([&](int, int, int, std::size_t n) { mx = std::max(mx, a[n]); });
+  grid_.for_owned_all([&](int, int, int, std::size_t n) { mx = std::max(mx, a[n]); });
   p_avg_max_ = mx;
 }
 
@@ -689,6 +735,8 @@ bool Projection::load(const ProjectionState &s) {
   extend_to_padding(grad_, grad_ext_, 3);
   if (acc) extend_to_padding(p_acc_, p_acc_ext_, 1);
   if (grains_acc) extend_to_padding(grad_acc_, grad_acc_ext_, 3);
+  work_prev_ = grid_.patch();  // values anywhere: a sparse step retires all outside its work box
+  have_prev_ = true;
   return true;
 }
 

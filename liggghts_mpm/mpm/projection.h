@@ -32,8 +32,15 @@ class Projection {
   // pvol: sum S V of the points per node (owned nodes, after the reverse sum), for the
   // volume correction (keyword volume_correction; null: none). Throws mpm::Error naming the
   // step if the solve does not converge.
+  // work (sparse sweeps, docs/performance.md "Sparse grid"): a box of the patch that holds every
+  // node with fluid mass grown by kWorkMargin nodes; the sweeps then visit its nodes only and every
+  // array keeps outside it the value the full sweep gives there (no fluid within reach: 0, EMPTY).
+  // Not with theta (couple) or mesh walls. null: the whole patch.
   void project(double *vel, const double *p2g, double mmin, const double *theta, bool dtheta, double h,
-               Boundaries &bc, long step, const double *pvol = nullptr);
+               Boundaries &bc, long step, const double *pvol = nullptr, const IndexBox *work = nullptr);
+  // the nodes the work box must reach beyond the nodes with mass: the farthest any sweep reads or
+  // writes from them (the surface's gradient and extrapolation 1, deep_inside 2) and one more
+  static constexpr int kWorkMargin = 4;
 
   // The state of the last solve on this rank's owned nodes (ProjectionState, solver.h).
   void save(ProjectionState &s) const;
@@ -98,6 +105,12 @@ class Projection {
   void extrapolate_above_surface(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
                                  bool with_p);
   void extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const;
+  // sparse sweeps: the nodes of the last work box that are not in this one get the arrays' values
+  // of a node without fluid within reach
+  void retire(const IndexBox &work);
+  IndexBox work_, work_prev_;       // this step's work box (the patch when not sparse), the last one
+  bool have_prev_ = false;
+  std::vector<double> gk_, pk_;     // extrapolate_above_surface: gradient / pressure known
 
   LocalGrid &grid_;
   const Options &opt_;

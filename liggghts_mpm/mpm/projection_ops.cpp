@@ -90,20 +90,23 @@ bool open_face(const LocalGrid &grid, const NodeLabels &labels, int i, int j, in
   return !((labels.closed[lower] >> d) & 1u) && labels.kind[n] != kSolid && labels.kind[nb] != kSolid;
 }
 
-void NodeLabels::reset(const LocalGrid &grid) {
+void NodeLabels::reset(const LocalGrid &grid, const IndexBox *work) {
   const GridSpec &g = grid.spec();
-  kind.assign(grid.size(), kFluid);
+  const IndexBox &pb = grid.patch();
+  kind.assign(grid.size(), work ? kEmpty : kFluid);
+  if (work) grid.for_box(work->cut(pb), [&](int, int, int, std::size_t n) { kind[n] = kFluid; });
   closed.assign(grid.size(), 0);
   wall_u.clear();
   level.clear();
-  const IndexBox &pb = grid.patch();
-  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
-    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
-      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-        const int idx[3] = {i, j, k};
-        for (int d = 0; d < 3; ++d)
-          if (!g.periodic[d] && (idx[d] < 0 || idx[d] > g.ncell[d])) kind[grid.index(i, j, k)] = kSolid;
-      }
+  // the padding: the slabs of the patch below node 0 and above node ncell of each non-periodic d
+  for (int d = 0; d < 3; ++d) {
+    if (g.periodic[d]) continue;
+    IndexBox lo = pb, hi = pb;
+    lo.hi[d] = std::min(pb.hi[d], -1);
+    hi.lo[d] = std::max(pb.lo[d], g.ncell[d] + 1);
+    grid.for_box(lo, [&](int, int, int, std::size_t n) { kind[n] = kSolid; });
+    grid.for_box(hi, [&](int, int, int, std::size_t n) { kind[n] = kSolid; });
+  }
 }
 
 void NodeLabels::close_face(const LocalGrid &grid, int i, int j, int k, int d, double wall_velocity) {
@@ -116,14 +119,18 @@ void NodeLabels::close_face(const LocalGrid &grid, int i, int j, int k, int d, d
 void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm) {
   // One forward of small integers packed in doubles (exact), and of the wall
   // velocities when some rank has moving walls.
-  std::vector<double> buf(grid.size());
-  for (std::size_t n = 0; n < buf.size(); ++n) buf[n] = kind[n] + 4.0 * closed[n];
-  grid.forward(buf.data(), 1);
-  for (std::size_t n = 0; n < buf.size(); ++n) {
-    const int v = static_cast<int>(buf[n]);
-    kind[n] = std::uint8_t(v & 3);
-    closed[n] = std::uint8_t(v >> 2);
-  }
+  // Only the nodes the forward reads or writes are packed and unpacked (a surface, not the patch).
+  buf_.resize(grid.size());
+  const std::vector<IndexBox> boxes = grid.exchanged_boxes();
+  for (const IndexBox &b : boxes)
+    grid.for_box(b, [&](int, int, int, std::size_t n) { buf_[n] = kind[n] + 4.0 * closed[n]; });
+  grid.forward(buf_.data(), 1);
+  for (const IndexBox &b : boxes)
+    grid.for_box(b, [&](int, int, int, std::size_t n) {
+      const int v = static_cast<int>(buf_[n]);
+      kind[n] = std::uint8_t(v & 3);
+      closed[n] = std::uint8_t(v >> 2);
+    });
   int moving = wall_u.empty() ? 0 : 1, any = 0;
   MPI_Allreduce(&moving, &any, 1, MPI_INT, MPI_MAX, comm);
   if (any) {

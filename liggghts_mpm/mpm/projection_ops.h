@@ -44,10 +44,15 @@ struct NodeLabels {
 
   // Every node FLUID with open faces, except the padding nodes behind the box
   // walls (indices < 0 or > ncell in non-periodic dimensions), which are SOLID.
-  void reset(const LocalGrid &grid);
+  // work (the projection's sparse sweeps): only the nodes of that box FLUID, the others EMPTY
+  // (they hold no fluid, which is what the labelling of their mass would find).
+  void reset(const LocalGrid &grid, const IndexBox *work = nullptr);
   void close_face(const LocalGrid &grid, int i, int j, int k, int d, double wall_velocity = 0.0);
   // Copies the owned nodes' labels into the halos (collective over the grid's comm).
   void exchange(LocalGrid &grid, MPI_Comm comm);
+
+ private:
+  std::vector<double> buf_;  // exchange: kind and closed packed (only the exchanged nodes used)
 };
 
 // Control volumes of the nodes. The box walls pass through the nodes with index

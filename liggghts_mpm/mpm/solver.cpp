@@ -3,6 +3,7 @@
 #include "mpm/solver.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <sstream>
 
@@ -96,7 +97,7 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
   // the coupling reads the fluid's arrays (zero outside the active blocks, as on the dense grid)
   // and writes only its own, which its phases sweep on the whole patch; the projection's phases
   // and solve sweep the whole patch (docs/performance.md, "Sparse grid")
-  sparse_ = opt.sparse && !opt.projection;
+  sparse_ = opt.sparse;
   if (sparse_) blocks_.setup(grid_);
   th_prev_valid_ = false;
   if (opt.projection) {
@@ -174,11 +175,20 @@ void FluidSolver::compute_shapes() {
   plist_.clear();
   double **x = pts.x;
   const GridSpec &gs = opt.grid;
+  for (int d = 0; d < 3; ++d) {
+    base_lo_[d] = INT_MAX;
+    base_hi_[d] = INT_MIN;
+  }
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
     plist_.push_back(i);
     check_point(i);
-    if (!shape_of(x[i], shapes_[i])) {
+    if (shape_of(x[i], shapes_[i]))
+      for (int d = 0; d < 3; ++d) {
+        base_lo_[d] = std::min(base_lo_[d], shapes_[i].base[d]);
+        base_hi_[d] = std::max(base_hi_[d], shapes_[i].base[d]);
+      }
+    else {
       std::ostringstream os;
       os << "Fix mpm/fluid: material point " << pts.tag[i] << " at (" << x[i][0] << ", " << x[i][1] << ", "
          << x[i][2] << ") left the grid [" << gs.origin[0] << ", " << gs.upper(0) << "] x [" << gs.origin[1]
@@ -314,10 +324,40 @@ void FluidSolver::update_grid(double h) {
   if (opt.projection) {
     const bool vc = opt.volume_correction > 0.0;
     if (vc) point_volume_to_grid();
+    IndexBox work;
+    const bool sparse_proj = sparse_ && !opt.coupled && !bc.walls();
+    if (sparse_proj) work = projection_work_box();
     proj_->project(g_.vel.data(), g_.p2g.data(), mmin, opt.coupled ? g_.th.data() : nullptr, opt.projection_dtheta, h,
-                   bc, clock.step, vc ? pvol_.data() : nullptr);
+                   bc, clock.step, vc ? pvol_.data() : nullptr, sparse_proj ? &work : nullptr);
   }
   grid_.forward(g_.vel.data(), VelRec::N);
+}
+
+/* The projection's work box (sparse grid, pure fluid without mesh walls): the bounding box of the
+   stencils of all points of all ranks (every node that can hold fluid mass, also the owned nodes
+   that get their mass from another rank's points), grown by Projection::kWorkMargin nodes, cut to
+   the patch; the whole patch along periodic dimensions. Empty when there are no points. */
+IndexBox FluidSolver::projection_work_box() {
+  int loc[6], glob[6];
+  for (int d = 0; d < 3; ++d) {
+    loc[d] = base_lo_[d];
+    loc[3 + d] = -base_hi_[d] - (support(opt.shape) - 1);  // the stencil's top node, negated
+    if (base_hi_[d] == INT_MIN) loc[3 + d] = INT_MAX;      // no points here
+  }
+  MPI_Allreduce(loc, glob, 6, MPI_INT, MPI_MIN, comm_);
+  const IndexBox &pb = grid_.patch();
+  IndexBox w;
+  if (glob[0] == INT_MAX) return w;  // no points anywhere: empty
+  for (int d = 0; d < 3; ++d) {
+    if (opt.grid.periodic[d]) {
+      w.lo[d] = pb.lo[d];
+      w.hi[d] = pb.hi[d];
+      continue;
+    }
+    w.lo[d] = glob[d] - Projection::kWorkMargin;
+    w.hi[d] = -glob[3 + d] + Projection::kWorkMargin;
+  }
+  return w.cut(pb);
 }
 
 /* projection with couple: the grains feel the nodal pressure gradient of the last solve, the

@@ -209,6 +209,10 @@ class FluidSolver {
   GridFields g_;
   ActiveBlocks blocks_;
   bool sparse_ = false;
+  // compute_shapes: the smallest and largest stencil base of this rank's points (INT_MAX / INT_MIN
+  // without any), for the projection's work box
+  int base_lo_[3] = {0, 0, 0}, base_hi_[3] = {-1, -1, -1};
+  IndexBox projection_work_box();
   bool grid_ready_ = false;
   bool th_prev_valid_ = false;
   std::vector<Stencil> shapes_, grain_shapes_;

@@ -3,7 +3,7 @@
 // After every sub-step the points and all node arrays must be identical to the bit, every node
 // value outside the active blocks zero (the invariant the sparse phases rely on), and the active
 // blocks a small part of the grid. Serially and on 2 ranks (the exchanged nodes), for the shape
-// functions, transfers and updates, a gate and a periodic dimension.
+// functions, transfers and updates, a gate, a periodic dimension and the pressure projection.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -30,7 +30,8 @@ struct Column {
   std::unique_ptr<mpm::FluidSolver> solver;
 
   Column(const std::string &args, bool periodic_y) {
-    std::istringstream is("f all mpm/fluid cell 0.05 density 1000 bulk 1e5 viscosity 1e-3 sparse " + args);
+    const bool eos = args.find("projection") == std::string::npos;
+    std::istringstream is("f all mpm/fluid cell 0.05 density 1000 viscosity 1e-3 sparse " + args + (eos ? " bulk 1e5" : ""));
     for (std::string s; is >> s;) words.push_back(s);
     std::vector<char *> argv;
     for (auto &s : words) argv.push_back(&s[0]);
@@ -130,5 +131,12 @@ TEST(SparseGrid, BsplineApicUslEqualsDense) { check("transfer apic update usl", 
 TEST(SparseGrid, LinearPicEqualsDense) { check("shape linear transfer pic antilock no", false); }
 TEST(SparseGrid, GateAndFreeslipEqualDense) { check("gate x 0.6 lower never boundary all freeslip", true); }
 TEST(SparseGrid, PeriodicYEqualsDense) { check("transfer apic", false, true); }
+// pressure projection: the fluid's phases on the active blocks, the projection's sweeps on the work
+// box around the fluid (retired as the column collapses), the hypre solve on the FLUID nodes' box
+TEST(SparseGrid, ProjectionEqualsDense) { check("pressure projection", true); }
+TEST(SparseGrid, ProjectionNodeSurfaceAveragedEqualsDense) {
+  check("pressure projection free_surface node transfer apic pressure_average 0.01 pressure_output acceleration "
+        "volume_correction 10", false);
+}
 
 }  // namespace
