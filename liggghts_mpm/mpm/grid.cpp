@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace mpm {
@@ -152,79 +153,96 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   // forward: owner boxes are packed and sent, halo boxes receive and store.
   const std::vector<Transfer> &send = reverse ? halo_side_ : owner_side_;
   const std::vector<Transfer> &recv = reverse ? owner_side_ : halo_side_;
+  const std::size_t sv = std::size_t(stride), row_step = std::size_t(n_[0]) * sv;
 
-  auto for_box = [&](const IndexBox &b, auto &&fn) {
-    for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-      for (int j = b.lo[1]; j <= b.hi[1]; ++j)
-        for (int i = b.lo[0]; i <= b.hi[0]; ++i) fn(index(i, j, k));
+  // A box moves row by row along x: the stride values of the nodes of one row are contiguous in
+  // data (x fastest). Buffers hold the boxes' rows one after the other (z, y, x, value: the order
+  // node by node), so that the rows of one box follow each other in the message.
+  auto pack = [&](const IndexBox &b, double *buf) {
+    const std::size_t len = std::size_t(b.hi[0] - b.lo[0] + 1) * sv;
+    for (int k = b.lo[2]; k <= b.hi[2]; ++k) {
+      const double *row = data + index(b.lo[0], b.lo[1], k) * sv;
+      for (int j = b.lo[1]; j <= b.hi[1]; ++j, row += row_step, buf += len)
+        std::memcpy(buf, row, len * sizeof(double));
+    }
+    return buf;
+  };
+  // reverse: each value added to its node once (per transfer, in list order: the same sums);
+  // forward: stored
+  auto unpack = [&](const IndexBox &b, const double *buf) {
+    const std::size_t len = std::size_t(b.hi[0] - b.lo[0] + 1) * sv;
+    for (int k = b.lo[2]; k <= b.hi[2]; ++k) {
+      double *row = data + index(b.lo[0], b.lo[1], k) * sv;
+      for (int j = b.lo[1]; j <= b.hi[1]; ++j, row += row_step, buf += len) {
+        if (reverse)
+          for (std::size_t m = 0; m < len; ++m) row[m] += buf[m];
+        else
+          std::memcpy(row, buf, len * sizeof(double));
+      }
+    }
+    return buf;
   };
 
-  // Self images (periodic wrap on this rank): copy directly, in the same order.
+  // Self images (periodic wrap on this rank): through a buffer, in the same order.
   {
-    std::vector<double> tmp;
+    std::size_t n = 0;
     for (const auto &t : send)
-      if (t.peer == me_) for_box(t.mine, [&](std::size_t n) {
-          for (int c = 0; c < stride; ++c) tmp.push_back(data[n * stride + c]);
-        });
-    std::size_t pos = 0;
-    for (const auto &t : recv)
-      if (t.peer == me_) for_box(t.mine, [&](std::size_t n) {
-          for (int c = 0; c < stride; ++c, ++pos) {
-            if (reverse)
-              data[n * stride + c] += tmp[pos];
-            else
-              data[n * stride + c] = tmp[pos];
-          }
-        });
+      if (t.peer == me_) n += std::size_t(t.mine.count()) * sv;
+    if (n > 0) {
+      if (selfbuf_.size() < n) selfbuf_.resize(n);
+      double *w = selfbuf_.data();
+      for (const auto &t : send)
+        if (t.peer == me_) w = pack(t.mine, w);
+      const double *r = selfbuf_.data();
+      for (const auto &t : recv)
+        if (t.peer == me_) r = unpack(t.mine, r);
+    }
   }
   if (nprocs_ == 1) return;
 
   // One message per peer: all boxes for that peer, in list order.
-  std::vector<int> sendcount(nprocs_, 0), recvcount(nprocs_, 0);
+  // xcount_: values sent to / received from each peer; xoff_: their offsets in the buffers
+  // (then the write positions).
+  const int np = nprocs_;
+  xcount_.assign(2 * std::size_t(np), 0);
+  int *sendcount = xcount_.data(), *recvcount = sendcount + np;
   for (const auto &t : send)
     if (t.peer != me_) sendcount[t.peer] += int(t.mine.count()) * stride;
   for (const auto &t : recv)
     if (t.peer != me_) recvcount[t.peer] += int(t.mine.count()) * stride;
-  std::vector<int> soff(nprocs_ + 1, 0), roff(nprocs_ + 1, 0);
-  for (int q = 0; q < nprocs_; ++q) {
+  xoff_.resize(2 * (std::size_t(np) + 1));
+  int *soff = xoff_.data(), *roff = soff + np + 1;
+  soff[0] = roff[0] = 0;
+  for (int q = 0; q < np; ++q) {
     soff[q + 1] = soff[q] + sendcount[q];
     roff[q + 1] = roff[q] + recvcount[q];
   }
-  sendbuf_.resize(soff[nprocs_]);
-  recvbuf_.resize(roff[nprocs_]);
-  {
-    std::vector<int> pos(soff.begin(), soff.end() - 1);
-    for (const auto &t : send)
-      if (t.peer != me_) for_box(t.mine, [&](std::size_t n) {
-          for (int c = 0; c < stride; ++c) sendbuf_[pos[t.peer]++] = data[n * stride + c];
-        });
-  }
-  std::vector<MPI_Request> req;
-  req.reserve(2 * nprocs_);
-  for (int q = 0; q < nprocs_; ++q)
+  if (sendbuf_.size() < std::size_t(soff[np])) sendbuf_.resize(soff[np]);
+  if (recvbuf_.size() < std::size_t(roff[np])) recvbuf_.resize(roff[np]);
+  xpos_.assign(soff, soff + np);
+  for (const auto &t : send)
+    if (t.peer != me_) {
+      pack(t.mine, sendbuf_.data() + xpos_[t.peer]);
+      xpos_[t.peer] += int(t.mine.count()) * stride;
+    }
+  req_.clear();
+  for (int q = 0; q < np; ++q)
     if (recvcount[q] > 0) {
-      req.emplace_back();
-      MPI_Irecv(recvbuf_.data() + roff[q], recvcount[q], MPI_DOUBLE, q, 7301, comm_, &req.back());
+      req_.emplace_back();
+      MPI_Irecv(recvbuf_.data() + roff[q], recvcount[q], MPI_DOUBLE, q, 7301, comm_, &req_.back());
     }
-  for (int q = 0; q < nprocs_; ++q)
+  for (int q = 0; q < np; ++q)
     if (sendcount[q] > 0) {
-      req.emplace_back();
-      MPI_Isend(sendbuf_.data() + soff[q], sendcount[q], MPI_DOUBLE, q, 7301, comm_, &req.back());
+      req_.emplace_back();
+      MPI_Isend(sendbuf_.data() + soff[q], sendcount[q], MPI_DOUBLE, q, 7301, comm_, &req_.back());
     }
-  MPI_Waitall(int(req.size()), req.data(), MPI_STATUSES_IGNORE);
-  {
-    std::vector<int> pos(roff.begin(), roff.end() - 1);
-    for (const auto &t : recv)
-      if (t.peer != me_) for_box(t.mine, [&](std::size_t n) {
-          for (int c = 0; c < stride; ++c) {
-            const double v = recvbuf_[pos[t.peer]++];
-            if (reverse)
-              data[n * stride + c] += v;
-            else
-              data[n * stride + c] = v;
-          }
-        });
-  }
+  MPI_Waitall(int(req_.size()), req_.data(), MPI_STATUSES_IGNORE);
+  xpos_.assign(roff, roff + np);
+  for (const auto &t : recv)
+    if (t.peer != me_) {
+      unpack(t.mine, recvbuf_.data() + xpos_[t.peer]);
+      xpos_[t.peer] += int(t.mine.count()) * stride;
+    }
 }
 
 std::vector<IndexBox> LocalGrid::exchanged_boxes() const {

@@ -209,9 +209,12 @@ void FluidSolver::mark_active_blocks() {
   const IndexBox &pb = grid_.patch();
   static_assert(ActiveBlocks::kSize >= 4, "the grown stencil (bspline2: 5 nodes) spans two blocks at most");
   blocks_.begin();
+  // in locals (registers): mark_from's byte store may alias them, they would be loaded per point
+  const int lo0 = pb.lo[0], lo1 = pb.lo[1], lo2 = pb.lo[2];
+  const Stencil *shapes = shapes_.data();
   for (const int i : plist_) {
-    const int *b = shapes_[i].base;
-    blocks_.mark_from(std::max(b[0] - 1, pb.lo[0]), std::max(b[1] - 1, pb.lo[1]), std::max(b[2] - 1, pb.lo[2]));
+    const int *b = shapes[i].base;
+    blocks_.mark_from(std::max(b[0] - 1, lo0), std::max(b[1] - 1, lo1), std::max(b[2] - 1, lo2));
   }
   blocks_.finish();
   zero_boxes(g_.p2g, P2gRec::N, blocks_.retired());

@@ -13,24 +13,35 @@ namespace mpm {
 double FluidSolver::stable_dt() {
   const Eos &eos = opt.eos;
   // max |v|, max density, -min density; with couple: max of rho (1 - theta) / theta over the
-  // points, -min theta, -min density of the grains an integrator moves
-  double loc[6] = {0.0, eos.rho0, -eos.rho0, 0.0, -1.0, -HUGE_VAL};
-  for (int i = 0; i < pts.nlocal; ++i) {
-    if (is_point(i)) {
-      const double *v = pts.v[i], *s = pts.state[i];
-      loc[0] = std::max(loc[0], std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
-      loc[1] = std::max(loc[1], s[C_RHO]);
-      loc[2] = std::max(loc[2], -s[C_RHO]);
-      const double th = s[C_THETA];
-      if (opt.coupled && th > 0.0 && th < 1.0) {
-        loc[3] = std::max(loc[3], s[C_RHO] * (1.0 - th) / th);
-        loc[4] = std::max(loc[4], -th);
+  // points, -min theta, -min density of the grains an integrator moves.
+  // The loop keeps max |v|^2 and takes one square root after it (sqrt is correctly rounded and
+  // monotone: the root of the largest square is the largest root, bit for bit), and holds the
+  // maxima and the points' arrays in locals (registers, not reloaded per point).
+  double v2max = 0.0, rho_max = eos.rho0, mrho_max = -eos.rho0, ratio_max = 0.0, mth_max = -1.0,
+         mgrain_max = -HUGE_VAL;
+  const int n = pts.nlocal, *mask = pts.mask, point_bit = pts.point_bit;
+  double *const *vel = pts.v, *const *state = pts.state;
+  const bool coupled = opt.coupled;
+  for (int i = 0; i < n; ++i) {
+    if (mask[i] & point_bit) {
+      const double *v = vel[i], *s = state[i];
+      v2max = std::max(v2max, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      const double rho = s[C_RHO];
+      rho_max = std::max(rho_max, rho);
+      mrho_max = std::max(mrho_max, -rho);
+      if (coupled) {
+        const double th = s[C_THETA];
+        if (th > 0.0 && th < 1.0) {
+          ratio_max = std::max(ratio_max, rho * (1.0 - th) / th);
+          mth_max = std::max(mth_max, -th);
+        }
       }
-    } else if (is_grain(i) && (pts.mask[i] & pts.integrated_bits) && pts.radius[i] > 0.0) {
+    } else if (is_grain(i) && (mask[i] & pts.integrated_bits) && pts.radius[i] > 0.0) {
       const double r = pts.radius[i];
-      loc[5] = std::max(loc[5], -pts.rmass[i] / (4.0 / 3.0 * M_PI * r * r * r));
+      mgrain_max = std::max(mgrain_max, -pts.rmass[i] / (4.0 / 3.0 * M_PI * r * r * r));
     }
   }
+  double loc[6] = {std::sqrt(v2max), rho_max, mrho_max, ratio_max, mth_max, mgrain_max};
   double glob[6];
   MPI_Allreduce(loc, glob, 6, MPI_DOUBLE, MPI_MAX, comm_);
   // Sound speed: largest over the density range (Tait stiffens under compression, the linear

@@ -1,10 +1,15 @@
 // Distributed grid: every node of the global grid has exactly one owner, and
 // halo exchanges neither lose nor duplicate anything, for uneven subdomains,
-// walls with padding nodes and periodic images. Run with 1 and 2 MPI ranks.
+// walls with padding nodes and periodic images; and the reverse sum adds the
+// images in a fixed order (bit for bit, the results do not depend on how the
+// exchange packs its messages). Run with 1 and 2 MPI ranks.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
 #include <vector>
 
 #include "mpm/grid.h"
@@ -21,11 +26,11 @@ struct Case {
 
 int wrap(int i, int n) { return ((i % n) + n) % n; }
 
-void run_case(const Case &c) {
+// The grid of case c over MPI_COMM_WORLD (2 ranks: split along x at c.split).
+void setup_case(const Case &c, mpm::GridSpec &g, mpm::LocalGrid &grid) {
   int me, np;
   MPI_Comm_rank(MPI_COMM_WORLD, &me);
   MPI_Comm_size(MPI_COMM_WORLD, &np);
-  mpm::GridSpec g;
   g.dx = 0.5;
   for (int d = 0; d < 3; ++d) {
     g.origin[d] = -1.0;
@@ -42,8 +47,13 @@ void run_case(const Case &c) {
     const double cut = g.origin[0] + c.split * (g.upper(0) - g.origin[0]);
     if (me == 0) subhi[0] = cut; else sublo[0] = cut;
   }
-  mpm::LocalGrid grid;
   grid.setup(g, MPI_COMM_WORLD, sublo, subhi, c.halo);
+}
+
+void run_case(const Case &c) {
+  mpm::GridSpec g;
+  mpm::LocalGrid grid;
+  setup_case(c, g, grid);
   const mpm::IndexBox &pb = grid.patch(), &ob = grid.owned();
 
   // Owned boxes tile the global node range exactly once.
@@ -104,5 +114,145 @@ TEST(GridHalo, UnevenSplitOffNode) { run_case({{12, 5, 4}, {false, false, false}
 TEST(GridHalo, PeriodicThinSlab) { run_case({{10, 1, 6}, {false, true, false}, 1, 4, 0.45}); }
 TEST(GridHalo, PeriodicAcrossRanks) { run_case({{9, 4, 3}, {true, false, true}, 1, 3, 0.61}); }
 TEST(GridHalo, LinearNoPadding) { run_case({{8, 3, 3}, {false, false, false}, 0, 2, 0.5}); }
+
+// Every rank's owned and patch box and its patch values (stride per node), gathered.
+struct AllPatches {
+  std::vector<mpm::IndexBox> owned, patch;
+  std::vector<std::vector<double>> data;
+  // the value c of global node (i, j, k) in rank q's patch, or nullptr if not in it
+  const double *at(const mpm::GridSpec &g, int q, int i, int j, int k, int stride) const {
+    const mpm::IndexBox &b = patch[q];
+    const int idx[3] = {i, j, k};
+    for (int d = 0; d < 3; ++d)
+      if (idx[d] < b.lo[d] || idx[d] > b.hi[d]) return nullptr;
+    const long nx = b.hi[0] - b.lo[0] + 1, ny = b.hi[1] - b.lo[1] + 1;
+    const long n = ((long(k - b.lo[2]) * ny) + (j - b.lo[1])) * nx + (i - b.lo[0]);
+    return data[q].data() + n * stride;
+  }
+};
+
+AllPatches gather(const mpm::LocalGrid &grid, const std::vector<double> &a, int stride) {
+  int np;
+  MPI_Comm_size(MPI_COMM_WORLD, &np);
+  const mpm::IndexBox &pb = grid.patch(), &ob = grid.owned();
+  int mine[12];
+  for (int d = 0; d < 3; ++d) {
+    mine[d] = ob.lo[d];
+    mine[3 + d] = ob.hi[d];
+    mine[6 + d] = pb.lo[d];
+    mine[9 + d] = pb.hi[d];
+  }
+  std::vector<int> all(12 * np);
+  MPI_Allgather(mine, 12, MPI_INT, all.data(), 12, MPI_INT, MPI_COMM_WORLD);
+  AllPatches r;
+  r.owned.resize(np);
+  r.patch.resize(np);
+  r.data.resize(np);
+  std::vector<int> count(np), off(np + 1, 0);
+  for (int q = 0; q < np; ++q) {
+    for (int d = 0; d < 3; ++d) {
+      r.owned[q].lo[d] = all[12 * q + d];
+      r.owned[q].hi[d] = all[12 * q + 3 + d];
+      r.patch[q].lo[d] = all[12 * q + 6 + d];
+      r.patch[q].hi[d] = all[12 * q + 9 + d];
+    }
+    count[q] = int(r.patch[q].count()) * stride;
+    off[q + 1] = off[q] + count[q];
+  }
+  std::vector<double> flat(off[np]);
+  MPI_Allgatherv(a.data(), int(a.size()), MPI_DOUBLE, flat.data(), count.data(), off.data(), MPI_DOUBLE,
+                 MPI_COMM_WORLD);
+  for (int q = 0; q < np; ++q) r.data[q].assign(flat.begin() + off[q], flat.begin() + off[q + 1]);
+  return r;
+}
+
+bool same_bits(double x, double y) { return std::memcmp(&x, &y, sizeof x) == 0; }
+
+// Reverse sum of values whose sum depends on the order of the additions: each owned value must be
+// its own plus its images' in the exchange's order (this rank's periodic images first, then the
+// other ranks in rank order; images in the order of their shifts, z outermost), bit for bit.
+// The same sums in another order (ranks and shifts reversed) must differ somewhere when some node
+// has three or more terms, so that the check can tell orders apart. Forward: every patch node
+// holds its owner's value, bit for bit.
+void run_order_case(const Case &c, int stride) {
+  int me, np;
+  MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  MPI_Comm_size(MPI_COMM_WORLD, &np);
+  mpm::GridSpec g;
+  mpm::LocalGrid grid;
+  setup_case(c, g, grid);
+  const mpm::IndexBox &pb = grid.patch(), &ob = grid.owned();
+  std::mt19937_64 rng(12345 + 977 * me);
+  std::uniform_real_distribution<double> mant(1.0, 2.0);
+  std::uniform_int_distribution<int> expo(-20, 20);
+  std::vector<double> a(grid.size() * stride);
+  for (double &v : a) v = (rng() & 1 ? -1.0 : 1.0) * std::ldexp(mant(rng), expo(rng));
+  const AllPatches before = gather(grid, a, stride);
+  grid.reverse_sum(a.data(), stride);
+
+  // shifts of whole periods that can bring a patch node onto an owned one (the patches are at
+  // most ncell + 2 halo + 2 pad wide)
+  int kmax[3];
+  for (int d = 0; d < 3; ++d) kmax[d] = g.periodic[d] ? (2 * c.halo + 2) / g.ncell[d] + 2 : 0;
+  std::vector<int> order{me};
+  for (int q = 0; q < np; ++q)
+    if (q != me) order.push_back(q);
+  long checked = 0, multi = 0, differs = 0;
+  for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
+    for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
+      for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) {
+        std::vector<const double *> terms;  // in the exchange's order
+        for (const int q : order)
+          for (int kz = -kmax[2]; kz <= kmax[2]; ++kz)
+            for (int ky = -kmax[1]; ky <= kmax[1]; ++ky)
+              for (int kx = -kmax[0]; kx <= kmax[0]; ++kx) {
+                if (q == me && kx == 0 && ky == 0 && kz == 0) continue;
+                const double *v = before.at(g, q, i + kx * g.ncell[0], j + ky * g.ncell[1], k + kz * g.ncell[2], stride);
+                if (v) terms.push_back(v);
+              }
+        const double *own = before.at(g, me, i, j, k, stride);
+        const std::size_t n = grid.index(i, j, k);
+        for (int s = 0; s < stride; ++s) {
+          double sum = own[s], other = own[s];
+          for (const double *t : terms) sum += t[s];
+          for (auto t = terms.rbegin(); t != terms.rend(); ++t) other += (*t)[s];
+          ASSERT_TRUE(same_bits(a[n * stride + s], sum))
+              << "node " << i << " " << j << " " << k << " value " << s << ": " << a[n * stride + s] << " vs " << sum;
+          ++checked;
+          differs += !same_bits(sum, other);
+        }
+        multi += terms.size() >= 2;
+      }
+  EXPECT_GT(checked, 0);
+  if (multi > 0) EXPECT_GT(differs, 0) << "no node's sum depends on the order: the case cannot tell orders apart";
+
+  // forward: owners hold fresh values, the halo copies them
+  for (std::size_t n = 0; n < a.size(); ++n) a[n] = std::ldexp(mant(rng), expo(rng));
+  const AllPatches owners = gather(grid, a, stride);
+  grid.forward(a.data(), stride);
+  auto wrap_to = [&](int i, int d) { return g.periodic[d] ? wrap(i, g.ncell[d]) : i; };
+  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
+    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
+        const int w[3] = {wrap_to(i, 0), wrap_to(j, 1), wrap_to(k, 2)};
+        int owner = -1;
+        for (int q = 0; q < np; ++q) {
+          const mpm::IndexBox &o = owners.owned[q];
+          if (w[0] >= o.lo[0] && w[0] <= o.hi[0] && w[1] >= o.lo[1] && w[1] <= o.hi[1] && w[2] >= o.lo[2] &&
+              w[2] <= o.hi[2])
+            owner = q;
+        }
+        ASSERT_GE(owner, 0);
+        const double *v = owners.at(g, owner, w[0], w[1], w[2], stride);
+        ASSERT_NE(v, nullptr);
+        for (int s = 0; s < stride; ++s)
+          ASSERT_TRUE(same_bits(a[grid.index(i, j, k) * stride + s], v[s])) << "node " << i << " " << j << " " << k;
+      }
+}
+
+TEST(GridHaloOrder, WallsUnevenSplit) { run_order_case({{12, 5, 4}, {false, false, false}, 1, 5, 0.3717}, 3); }
+TEST(GridHaloOrder, PeriodicThinSlabManyImages) { run_order_case({{10, 1, 6}, {false, true, false}, 1, 4, 0.45}, 4); }
+TEST(GridHaloOrder, PeriodicAcrossRanks) { run_order_case({{9, 4, 3}, {true, false, true}, 1, 3, 0.61}, 5); }
+TEST(GridHaloOrder, PeriodicAllStride1) { run_order_case({{5, 3, 2}, {true, true, true}, 1, 3, 0.5}, 1); }
 
 }  // namespace
