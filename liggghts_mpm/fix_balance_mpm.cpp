@@ -28,6 +28,7 @@ using mpm::parse_int;
 
 /* ----------------------------------------------------------------------
    fix ID group-ID balance/mpm dim x|y|z [every N] [weight group-ID w]... [volume w] [thresh t]
+       [measured yes|no]
 ------------------------------------------------------------------------- */
 
 FixBalanceMpm::FixBalanceMpm(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
@@ -55,12 +56,16 @@ FixBalanceMpm::FixBalanceMpm(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg,
       wgroup_bits_.push_back(group->bitmask[ig]);
       wvalues_.push_back(wv);
       iarg += 3;
+    } else if (strcmp(kw, "measured") == 0) {
+      if (!v || (strcmp(v, "yes") != 0 && strcmp(v, "no") != 0)) bad_arg(kw, "yes or no", v);
+      measured_ = strcmp(v, "yes") == 0;
+      iarg += 2;
     } else if (strcmp(kw, "volume") == 0) {
       if (!v || !parse_double(v, wvol_) || wvol_ < 0.0) bad_arg(kw, "a weight per unit volume >= 0", v);
       iarg += 2;
     } else {
       error->all(FLERR, (std::string("Fix balance/mpm: unknown keyword '") + kw +
-                         "' (expected dim, every, weight, volume or thresh)").c_str());
+                         "' (expected dim, every, weight, volume, thresh or measured)").c_str());
     }
   }
   if (dim_ < 0) error->all(FLERR, "Fix balance/mpm: keyword 'dim' (x, y or z) is required");
@@ -91,12 +96,56 @@ void FixBalanceMpm::bad_arg(const char *keyword, const char *expected, const cha
 int FixBalanceMpm::setmask() { return FixConst::PRE_EXCHANGE; }
 
 
-double FixBalanceMpm::weight(int i) const {
+double FixBalanceMpm::base_weight(int i) const {
   const int mask = atom->mask[i];
   double w = (mask & groupbit) ? 1.0 : 0.0;
   for (std::size_t g = 0; g < wgroup_bits_.size(); ++g)
     if (mask & wgroup_bits_[g]) w = wvalues_[g];
   return w;
+}
+
+double FixBalanceMpm::weight(int i) const { return scale_ * base_weight(i); }
+
+/* Keyword measured: the work of fix mpm/fluid on each rank since the last balance (its wall time
+   less the waits for halo messages, FixMpmFluid::busy_seconds) over the rank's weight of atoms,
+   relative to the same ratio of all ranks, scales the weights of the rank's atoms: the cuts then
+   move by the work measured, which counts what point counts miss (grid nodes, the free surface
+   and the pressure solve of the projection, walls). Without a measurement (the first balance, a
+   rank without work or without atoms) the scale is 1. */
+void FixBalanceMpm::measure() {
+  double busy = 0.0;
+  for (int m = 0; m < modify->nfix; ++m)
+    if (strcmp(modify->fix[m]->style, "mpm/fluid") == 0)
+      busy += static_cast<FixMpmFluid *>(modify->fix[m])->busy_seconds();
+  const double d = busy - busy_last_;
+  busy_last_ = busy;
+  double w = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i) w += base_weight(i);
+  double loc[3] = {d, w, -d}, tot[3];
+  MPI_Allreduce(loc, tot, 2, MPI_DOUBLE, MPI_SUM, world);
+  MPI_Allreduce(loc + 2, tot + 2, 1, MPI_DOUBLE, MPI_MAX, world);  // -(smallest work)
+  int ok = have_busy_ && -tot[2] > 0.0 && w > 0.0 && tot[0] > 0.0 && tot[1] > 0.0, all = 0;
+  MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, world);
+  scaled_ = all != 0;
+  scale_ = scaled_ ? (d / w) / (tot[0] / tot[1]) : 1.0;
+  have_busy_ = true;
+}
+
+// max / mean of the weight in the slabs between the cuts, the atoms where they are now
+double FixBalanceMpm::slab_imbalance(const std::vector<double> &cut) const {
+  const int P = static_cast<int>(cut.size()) - 1;
+  std::vector<double> mine(P, 0.0), all(P, 0.0);
+  double **x = atom->x;
+  for (int i = 0; i < atom->nlocal; ++i) {
+    int k = static_cast<int>(std::upper_bound(cut.begin() + 1, cut.end() - 1, x[i][dim_]) - (cut.begin() + 1));
+    mine[k] += weight(i);
+  }
+  if (comm->me == 0)
+    for (int k = 0; k < P; ++k) mine[k] += volume_below(cut[k + 1]) - volume_below(cut[k]);
+  MPI_Allreduce(mine.data(), all.data(), P, MPI_DOUBLE, MPI_SUM, world);
+  double mx = 0.0, sum = 0.0;
+  for (double v : all) mx = std::max(mx, v), sum += v;
+  return sum > 0.0 ? mx / (sum / P) : 1.0;
 }
 
 // Weight of the box volume below coordinate c along dim_ (keyword volume).
@@ -250,6 +299,7 @@ void FixBalanceMpm::balance() {
   check_weights();  // on one rank too: the input is as wrong there
   const int P = comm->procgrid[dim_];
   if (P < 2) return;
+  if (measured_) measure();
   imb_before_ = imbalance();
   if (thresh_ > 1.0 && imb_before_ <= thresh_) {
     imb_after_ = imb_before_;
@@ -257,6 +307,9 @@ void FixBalanceMpm::balance() {
   }
   std::vector<double> cut;
   find_cuts(cut);
+  // measured: the atoms that change rank would take the new rank's scale; the imbalance of the new
+  // cuts is that of the measured weights where the atoms are now
+  if (scaled_) imb_after_ = slab_imbalance(cut);
 
   double *split = dim_ == 0 ? comm->xsplit : dim_ == 1 ? comm->ysplit : comm->zsplit;
   const double lo = domain->boxlo[dim_], len = domain->prd[dim_];
@@ -279,7 +332,7 @@ void FixBalanceMpm::balance() {
   for (int m = 0; m < modify->nfix; ++m)
     if (strcmp(modify->fix[m]->style, "mpm/fluid") == 0) static_cast<FixMpmFluid *>(modify->fix[m])->subdomain_changed();
 
-  imb_after_ = imbalance();
+  if (!scaled_) imb_after_ = imbalance();
   ++nbalance_;
   if (comm->me == 0) {
     std::ostringstream os;
@@ -287,7 +340,7 @@ void FixBalanceMpm::balance() {
     os << "fix balance/mpm: step " << update->ntimestep << ", cuts in " << char('x' + dim_) << ":";
     for (double x : cut_) os << " " << x;
     os.precision(4);
-    os << " (imbalance " << imb_before_ << " -> " << imb_after_ << ")\n";
+    os << (scaled_ ? " (measured imbalance " : " (imbalance ") << imb_before_ << " -> " << imb_after_ << ")\n";
     if (screen) fputs(os.str().c_str(), screen);
     if (logfile) fputs(os.str().c_str(), logfile);
   }

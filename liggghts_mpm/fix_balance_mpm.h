@@ -29,7 +29,10 @@ class FixBalanceMpm : public Fix {
  private:
   void bad_arg(const char *keyword, const char *expected, const char *given);
   void check_weights();                     // the total weight stays finite (collective)
-  double weight(int i) const;
+  double weight(int i) const;              // the atom's weight (times the rank's scale, measured)
+  double base_weight(int i) const;         // the atom's weight from its groups
+  void measure();                          // measured: scale_ and the measured imbalance (collective)
+  double slab_imbalance(const std::vector<double> &cut) const;  // of the weights cut there (collective)
   double volume_below(double c) const;      // weight of the box volume below c along dim_
   double imbalance() const;                 // max rank weight / mean rank weight (collective)
   void find_cuts(std::vector<double> &cut);  // new cut coordinates along dim_ (collective)
@@ -44,6 +47,10 @@ class FixBalanceMpm : public Fix {
   std::vector<double> cut_;  // current cuts (absolute), procgrid[dim]+1 values
   double imb_before_ = 1.0, imb_after_ = 1.0;
   int nbalance_ = 0;
+  bool measured_ = false;    // keyword measured: weights scaled by each rank's measured work
+  bool have_busy_ = false, scaled_ = false;
+  double busy_last_ = 0.0;   // fix mpm/fluid's work on this rank at the last balance (s)
+  double scale_ = 1.0;       // this rank's work per unit weight over the mean (measured)
 };
 
 }  // namespace LAMMPS_NS

@@ -298,6 +298,8 @@ void FixMpmFluid::pre_final_integrate() {
   vector_step = -1;
 }
 
+double FixMpmFluid::busy_seconds() const { return solver ? solver->busy_seconds() : 0.0; }
+
 void FixMpmFluid::subdomain_changed() {
   if (solver) solver->invalidate_grid();
 }

@@ -38,6 +38,9 @@ class FixMpmFluid : public Fix {
   void pre_final_integrate() override;
   // fix balance/mpm moved the subdomain cuts inside a run: the grid patch follows at the next step
   void subdomain_changed();
+  // this rank's work in the fluid and the coupling since the fix was made: their wall time less
+  // the waits for the halo exchanges (s; fix balance/mpm measured)
+  double busy_seconds() const;
   void end_of_step() override;
 
   double compute_vector(int) override;

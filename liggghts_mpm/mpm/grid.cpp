@@ -236,7 +236,9 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
       req_.emplace_back();
       MPI_Isend(sendbuf_.data() + soff[q], sendcount[q], MPI_DOUBLE, q, 7301, comm_, &req_.back());
     }
+  const double tw = MPI_Wtime();
   MPI_Waitall(int(req_.size()), req_.data(), MPI_STATUSES_IGNORE);
+  wait_seconds_ += MPI_Wtime() - tw;
   xpos_.assign(roff, roff + np);
   for (const auto &t : recv)
     if (t.peer != me_) {

@@ -124,6 +124,9 @@ class LocalGrid {
   // The boxes of patch nodes that reverse_sum() and forward() read or write (halo and owner side,
   // all peers, periodic self images included).
   std::vector<IndexBox> exchanged_boxes() const;
+  // wall time this rank waited for its peers' halo messages (MPI_Waitall of the exchanges), summed
+  // since construction (fix balance/mpm measured: the work is the time minus the waits)
+  double wait_seconds() const { return wait_seconds_; }
 
  private:
   struct Transfer {      // one box of nodes exchanged with one peer
@@ -147,6 +150,7 @@ class LocalGrid {
   std::vector<MPI_Request> req_;
   IndexBox work_;
   bool restricted_ = false;
+  double wait_seconds_ = 0.0;
 };
 
 // The sparse grid (keyword sparse, docs/performance.md): blocks of kSize^3 nodes of a rank's patch

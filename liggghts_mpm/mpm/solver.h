@@ -129,6 +129,9 @@ class FluidSolver {
   long n_outputs = 0;
   // wall time of the fluid's own work and of the coupling on this rank (s, cumulative)
   double time_fluid = 0.0, time_couple = 0.0;
+  // the wall time of the fluid and the coupling less the waits for the halo exchanges, since
+  // construction: this rank's work (fix balance/mpm measured)
+  double busy_seconds() const { return time_fluid + time_couple - grid_.wait_seconds(); }
   // pressure projection, this rank, cumulative: wall time in the pressure solver (hypre assembly,
   // setup, PCG; part of time_fluid), solves and their PCG iterations (0 with eos)
   double time_pressure_solver() const;

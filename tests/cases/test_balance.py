@@ -6,7 +6,8 @@ Standard library only.
 
 CASE: np2 (3-D dam break of inputs/bench on 2 ranks with the balance fix against 1 rank),
 every_fluid (the same re-balanced every 50 steps inside one run, eos and projection),
-every_dem (re-balancing inside a run, no fluid), volume_dem (keyword volume), bad_input, all. Exit status 0 when every check passes.
+every_dem (re-balancing inside a run, no fluid), volume_dem (keyword volume), measured (cuts by the
+measured work), bad_input, all. Exit status 0 when every check passes.
 """
 import argparse
 import os
@@ -22,9 +23,10 @@ from cases import check, read_csv  # noqa: E402
 def cut_lines(text):
     """[(step, [cuts], imbalance before, after)] from the fix's log lines."""
     out = []
-    for m in re.finditer(r"fix balance/mpm: step (\d+), cuts in \w:([-\d.eE+ ]+)\(imbalance (\S+) -> (\S+)\)", text):
-        out.append((int(m.group(1)), [float(v) for v in m.group(2).split()], float(m.group(3)),
-                    float(m.group(4))))
+    for m in re.finditer(r"fix balance/mpm: step (\d+), cuts in \w:([-\d.eE+ ]+)\((measured )?imbalance (\S+) -> (\S+)\)",
+                         text):
+        out.append((int(m.group(1)), [float(v) for v in m.group(2).split()], float(m.group(4)),
+                    float(m.group(5)), bool(m.group(3))))
     return out
 
 
@@ -44,7 +46,7 @@ def case_np2(r):
     print("  " + "\n  ".join(str(ln) for ln in lines))
     check(len(lines) == 4, f"balanced at the setup of every run ({len(lines)} of 4)")
     if lines:
-        step, cuts, before, after = lines[0]
+        step, cuts, before, after, _ = lines[0]
         # uniform cut of the 3 m box would be 1.5 m; the column occupies x < 1
         check(abs(cuts[1] - 1.5) > 0.5 and 0.0 < cuts[1] < 1.0, f"the cut moved into the column ({cuts[1]:.4f} m)")
         check(before > 1.9 and after < 1.05, f"imbalance {before:.3f} -> {after:.3f} (max rank / mean)")
@@ -72,6 +74,29 @@ def case_every_fluid(r):
         check(len(lines) == 8, f"{pressure}: balanced at both setups and every 50 steps ({len(lines)} of 8)")
         if pressure == "projection" and cuts:
             check(cuts[-1] > cuts[0] + 0.3, f"the cut follows the water ({cuts[0]:.3f} -> {cuts[-1]:.3f} m)")
+
+
+def case_measured(r):
+    """Keyword measured: 2 ranks re-balanced every 50 steps by the work fix mpm/fluid measured on each
+    rank = 1 rank (eos to 1e-10 m, projection to 1e-6 m); every balance after the first is by measured
+    work, its imbalance before >= 1 and the cuts it places even the measured weights out."""
+    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
+    for pressure, tol in (("eos", 1e-10), ("projection", 1e-6)):
+        v = dict(cells=8, warm=10, nsteps=300, segments=1, cellw=0, pressure=pressure)
+        d1, _ = r.run(f"balance_measured/{pressure}_np1", inp, v)
+        d2, p2 = r.run(f"balance_measured/{pressure}_np2", inp, dict(v, balance=1, rebal=50, measured="yes"), np=2)
+        f1 = read_csv(os.path.join(d1, "bench3d.csv"))
+        f2 = read_csv(os.path.join(d2, "bench3d.csv"))
+        for k in ("front_x", "front_y", "mass"):
+            diff = abs(f1[k][0] - f2[k][0])
+            check(diff < tol, f"{pressure}, {k}: np2 (measured work) = np1 to {tol:g} (|diff| = {diff:.1e})")
+        lines = cut_lines(p2.stdout)
+        print("  " + "\n  ".join(str(ln) for ln in lines))
+        check(len(lines) == 8, f"{pressure}: balanced at both setups and every 50 steps ({len(lines)} of 8)")
+        check(lines and not lines[0][4] and all(ln[4] for ln in lines[1:]),
+              f"{pressure}: the first balance by points (nothing measured yet), the others by measured work")
+        check(all(ln[2] >= 1.0 and 1.0 <= ln[3] <= ln[2] + 1e-9 for ln in lines[1:]),
+              f"{pressure}: measured imbalance >= 1 before, and not above it after each re-cut")
 
 
 def case_bad_input(r):
@@ -103,6 +128,8 @@ run 0
         ("dim x every 4294967296", "Fix balance/mpm: keyword 'every' expects a number of steps >= 0"),
         ("dim x weight all 1e308", "Fix balance/mpm: keyword 'weight' expects a weight per atom (dimensionless"),
         ("dim x volume 1e308", "Fix balance/mpm: keyword 'volume' expects a weight per unit volume (1/length^3) in"),
+        ("dim x measured maybe", "Fix balance/mpm: keyword 'measured' expects yes or no, got 'maybe'"),
+        ("dim x measured", "Fix balance/mpm: keyword 'measured' expects yes or no, got nothing"),
     ]
     for i, (args, expect) in enumerate(bad):
         r.expect_error(f"balance_bad_input/{i}", tmpl.format(args=args), (expect,), f"'{args}' -> \"{expect}\"")
@@ -174,7 +201,7 @@ def case_volume_dem(r):
     check(bool(lines0) and abs(lines0[0][1][1] - 0.45) < 1e-6, "without volume: cut at 0.45 m")
 
 
-CASES = {"np2": case_np2, "every_fluid": case_every_fluid, "bad_input": case_bad_input, "every_dem": case_every_dem,
+CASES = {"np2": case_np2, "every_fluid": case_every_fluid, "measured": case_measured, "bad_input": case_bad_input, "every_dem": case_every_dem,
          "volume_dem": case_volume_dem}
 
 
