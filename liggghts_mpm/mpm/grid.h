@@ -104,6 +104,7 @@ class LocalGrid {
     if (b) work_ = *b;
   }
   bool restricted() const { return restricted_; }
+  const IndexBox &work() const { return work_; }
   class WorkScope {
    public:
     WorkScope(LocalGrid &g, const IndexBox *b) : g_(g), was_(g.restricted_), old_(g.work_) { g.set_work(b); }

@@ -299,18 +299,43 @@ void Projection::extend_to_padding(const std::vector<double> &a, std::vector<dou
       }
 }
 
+// The nodes of box a that are not in box b, as up to 6 boxes (slabs along z, then y, then x).
+static std::vector<IndexBox> box_minus(const IndexBox &a, const IndexBox &b) {
+  std::vector<IndexBox> out;
+  if (a.empty()) return out;
+  const IndexBox c = a.cut(b);
+  if (c.empty()) return {a};
+  IndexBox rest = a;
+  for (int d = 2; d >= 0; --d) {
+    IndexBox lo = rest, hi = rest;
+    lo.hi[d] = c.lo[d] - 1;
+    hi.lo[d] = c.hi[d] + 1;
+    if (!lo.empty()) out.push_back(lo);
+    if (!hi.empty()) out.push_back(hi);
+    rest.lo[d] = c.lo[d];
+    rest.hi[d] = c.hi[d];
+  }
+  return out;
+}
+
 void Projection::retire(const IndexBox &work) {
   if (!have_prev_) return;
-  std::vector<std::pair<std::vector<double> *, int>> arrays = {
+  const std::pair<std::vector<double> *, int> arrays[] = {
       {&u_, 3}, {&grad_, 3}, {&grad_ext_, 3}, {&rhs_, 1}, {&p_, 1}, {&p_ext_, 1},
       {&acc_, 3}, {&p_acc_, 1}, {&p_acc_ext_, 1}, {&grad_acc_, 3}, {&grad_acc_ext_, 3},
       {&fold_mass_, 1}, {&gk_, 1}, {&pk_, 1}};
-  grid_.for_box(work_prev_.cut(grid_.patch()), [&](int i, int j, int k, std::size_t n) {
-    if (work.contains(i, j, k)) return;
-    for (auto &a : arrays)
-      if (a.first->size() == a.second * grid_.size())
-        for (int e = 0; e < a.second; ++e) (*a.first)[a.second * n + e] = 0.0;
-  });
+  const std::vector<IndexBox> gone = box_minus(work_prev_.cut(grid_.patch()), work);
+  for (const auto &a : arrays) {
+    if (a.first->size() != a.second * grid_.size()) continue;
+    double *v = a.first->data();
+    const int st = a.second;
+    for (const IndexBox &b : gone)
+      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
+          double *row = v + st * grid_.index(b.lo[0], j, k);
+          std::fill(row, row + st * (b.hi[0] - b.lo[0] + 1), 0.0);
+        }
+  }
 }
 
 /* Ghost-fluid surface: the EMPTY nodes that hold fluid mass (the B-spline spreads the points'
