@@ -179,16 +179,25 @@ void FluidSolver::compute_shapes() {
     base_lo_[d] = INT_MAX;
     base_hi_[d] = INT_MIN;
   }
+  // sparse grid: the blocks are marked here, in the pass that computes the stencils
+  // (mark_active_blocks)
+  static_assert(ActiveBlocks::kSize >= 4, "the grown stencil (bspline2: 5 nodes) spans two blocks at most");
+  if (sparse_) blocks_.begin();
+  const bool sparse = sparse_;
+  const IndexBox &pb = grid_.patch();
+  const int lo0 = pb.lo[0], lo1 = pb.lo[1], lo2 = pb.lo[2];
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
     plist_.push_back(i);
     check_point(i);
-    if (shape_of(x[i], shapes_[i]))
+    if (shape_of(x[i], shapes_[i])) {
+      const int *b = shapes_[i].base;
       for (int d = 0; d < 3; ++d) {
-        base_lo_[d] = std::min(base_lo_[d], shapes_[i].base[d]);
-        base_hi_[d] = std::max(base_hi_[d], shapes_[i].base[d]);
+        base_lo_[d] = std::min(base_lo_[d], b[d]);
+        base_hi_[d] = std::max(base_hi_[d], b[d]);
       }
-    else {
+      if (sparse) blocks_.mark_from(std::max(b[0] - 1, lo0), std::max(b[1] - 1, lo1), std::max(b[2] - 1, lo2));
+    } else {
       std::ostringstream os;
       os << "Fix mpm/fluid: material point " << pts.tag[i] << " at (" << x[i][0] << ", " << x[i][1] << ", "
          << x[i][2] << ") left the grid [" << gs.origin[0] << ", " << gs.upper(0) << "] x [" << gs.origin[1]
@@ -206,16 +215,7 @@ void FluidSolver::compute_shapes() {
    less than a cell away: its base within one node of the point's). Blocks that drop out are
    cleared, so that every node outside the active blocks is zero. */
 void FluidSolver::mark_active_blocks() {
-  const IndexBox &pb = grid_.patch();
-  static_assert(ActiveBlocks::kSize >= 4, "the grown stencil (bspline2: 5 nodes) spans two blocks at most");
-  blocks_.begin();
-  // in locals (registers): mark_from's byte store may alias them, they would be loaded per point
-  const int lo0 = pb.lo[0], lo1 = pb.lo[1], lo2 = pb.lo[2];
-  const Stencil *shapes = shapes_.data();
-  for (const int i : plist_) {
-    const int *b = shapes[i].base;
-    blocks_.mark_from(std::max(b[0] - 1, lo0), std::max(b[1] - 1, lo1), std::max(b[2] - 1, lo2));
-  }
+  // the points' blocks were marked in compute_shapes' pass (begin, one mark_from per point)
   blocks_.finish();
   zero_boxes(g_.p2g, P2gRec::N, blocks_.retired());
   zero_boxes(g_.vel, VelRec::N, blocks_.retired());
