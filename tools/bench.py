@@ -123,16 +123,17 @@ def mpm_run(a, cells, np_, balance, nsteps, tag, rss=False, h5every=0, pressure=
     loop = lt[1][0]  # the timed run (the first is the warm-up)
     r = dict(section="mpm3d", case=tag, cells=cells, np=np_, balance=balance, points=points, steps=nsteps,
              loop_s=loop, wall_s=wall, point_steps_per_s=points * nsteps / loop, peak_rss_kB=peak)
-    m = re.search(r"imbalance (\S+) -> (\S+)\)", out)
+    ms = re.findall(r"((?:measured )?imbalance) (\S+) -> (\S+)\)", out)
+    m = ms[-1] if ms else None  # the balance of the timed run (the last one)
     if m:
-        r["imbalance"] = "%s -> %s" % (m.group(1), m.group(2))
+        r["imbalance"] = "%s %s -> %s" % m
     if h5every > 0:  # the fix's output time in the timed run (slowest rank), printed after it
         w = re.findall(r"output \S+ s \((\d+) files, (\S+) s per file\)", out)[-1]
         r["h5_files"], r["h5_s_per_file"] = int(w[0]), float(w[1])
         r["h5_file_bytes"] = max(os.path.getsize(os.path.join(d, f)) for f in os.listdir(d) if f.endswith(".h5"))
     RUNS.append(r)
     say("    %-22s %8d points, %4d steps: loop %.3f s, %.3g point-steps/s%s" %
-        (tag, points, nsteps, loop, r["point_steps_per_s"], ", imbalance " + r["imbalance"] if m else ""))
+        (tag, points, nsteps, loop, r["point_steps_per_s"], ", " + r["imbalance"] if m else ""))
     return r
 
 
