@@ -409,24 +409,32 @@ def case_hdf5_np2_vs_np1(r):
     check(sorted(ids) == [float(i) for i in range(1, len(ids) + 1)], f"every point once ({len(ids)} ids)")
 
 
+def dambreak3d_sparse_same(r, group, base, runs, nfiles, xmin, moved):
+    """The 3-D bench dam break (inputs/bench/in.dambreak3d) with sparse no and yes for each run
+    (label, ranks, variables): the HDF5 series (rows by id, grid) identical to the bit, at least
+    nfiles step files, the same bench3d.csv, and the front beyond xmin column edges."""
+    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
+    for label, np_, v in runs:
+        dirs = []
+        for sp in ("no", "yes"):
+            d, _ = r.run(f"{group}/{label}_{sp}", inp, dict(base, sparse=sp, **v), np=np_)
+            dirs.append(d)
+        worst, files = h5_series_same(dirs[0], dirs[1], "bench3d", 0.0)
+        check(len(files) >= nfiles, f"{label}: several step files ({len(files)})")
+        a, b = (read_csv(os.path.join(d, "bench3d.csv")) for d in dirs)
+        check(a == b, f"{label}: the same front, height and mass ({a['front_x'][0]:.6f}, {a['front_y'][0]:.6f})")
+        check(a["front_x"][0] > xmin, f"{label}: the front {moved} (x = {a['front_x'][0]:.3f} a)")
+
+
 def case_sparse_grid(r):
     """The sparse grid (keyword sparse) against the dense one: the 3-D bench dam break
     (inputs/bench/in.dambreak3d, cells 8, 4096 points, bulk 2e5) in its tank and in a tank 10x longer, on 1
     and 2 ranks: the HDF5 series (points and grid) and the front identical to the bit; the same for
     the points of a dam break released by a lifted mesh-wall gate."""
-    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
     base = dict(cells=8, warm=0, nsteps=240, h5every=80, bulk=2e5)  # c = 14 m/s: the front runs
-    for label, np_, v in (("short", 1, dict(tank=3.0)), ("long", 1, dict(tank=30.0)),
-                          ("long_np2", 2, dict(tank=30.0, balance=1, cellw=0.0))):
-        dirs = []
-        for sp in ("no", "yes"):
-            d, _ = r.run(f"sparse_grid/{label}_{sp}", inp, dict(base, sparse=sp, **v), np=np_)
-            dirs.append(d)
-        worst, files = h5_series_same(dirs[0], dirs[1], "bench3d", 0.0)
-        check(len(files) >= 3, f"{label}: several step files ({len(files)})")
-        a, b = (read_csv(os.path.join(d, "bench3d.csv")) for d in dirs)
-        check(a == b, f"{label}: the same front, height and mass ({a['front_x'][0]:.6f}, {a['front_y'][0]:.6f})")
-        check(a["front_x"][0] > 1.3, f"{label}: the front left the column (x = {a['front_x'][0]:.3f} a)")
+    dambreak3d_sparse_same(r, "sparse_grid", base,
+                           (("short", 1, dict(tank=3.0)), ("long", 1, dict(tank=30.0)),
+                            ("long_np2", 2, dict(tank=30.0, balance=1, cellw=0.0))), 3, 1.3, "left the column")
     # a mesh wall (the lifted gate of tests/data/in.mesh_walls_gate, its traction reaching nodes
     # beyond the points' stencils): the points' state at full precision
     dumps = []
@@ -454,20 +462,11 @@ def case_sparse_grid_projection(r):
     is in use) and on 2 ranks (ghost surface, cut by fix balance/mpm), and the 2-D dam break of
     inputs/dambreak released by its gate (front.csv)."""
     import filecmp
-    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
     base = dict(cells=8, warm=0, nsteps=400, h5every=100, pressure="projection")
     extra = "pressure_average 0.02 pressure_output acceleration volume_correction 10"
-    for label, np_, v in (("long", 1, dict(tank=30.0, extra=extra)),
-                          ("long_np2", 2, dict(tank=10.0, balance=1, cellw=0.0))):
-        dirs = []
-        for sp in ("no", "yes"):
-            d, _ = r.run(f"sparse_grid_projection/{label}_{sp}", inp, dict(base, sparse=sp, **v), np=np_)
-            dirs.append(d)
-        worst, files = h5_series_same(dirs[0], dirs[1], "bench3d", 0.0)
-        check(len(files) >= 4, f"{label}: several step files ({len(files)})")
-        a, b = (read_csv(os.path.join(d, "bench3d.csv")) for d in dirs)
-        check(a == b, f"{label}: the same front, height and mass ({a['front_x'][0]:.6f}, {a['front_y'][0]:.6f})")
-        check(a["front_x"][0] > 2.0, f"{label}: the front ran down the tank (x = {a['front_x'][0]:.3f} a)")
+    dambreak3d_sparse_same(r, "sparse_grid_projection", base,
+                           (("long", 1, dict(tank=30.0, extra=extra)),
+                            ("long_np2", 2, dict(tank=10.0, balance=1, cellw=0.0))), 4, 2.0, "ran down the tank")
     ds = []
     for sp in ("no", "yes"):
         d, _ = r.run(f"sparse_grid_projection/dambreak2d_{sp}", os.path.join(r.inputs, "dambreak", "in.dambreak"),

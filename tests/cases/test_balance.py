@@ -52,20 +52,28 @@ def case_np2(r):
         check(before > 1.9 and after < 1.05, f"imbalance {before:.3f} -> {after:.3f} (max rank / mean)")
 
 
+def rebalanced_np2_same(r, group, pressure, tol, more, what):
+    """The 3-D dam break (cells 8, 300 steps) on 1 rank and on 2 re-balanced every 50 steps (more:
+    further variables): front, height and mass equal to tol. Returns np1's bench3d.csv and np2's
+    process."""
+    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
+    v = dict(cells=8, warm=10, nsteps=300, segments=1, cellw=0, pressure=pressure)
+    d1, _ = r.run(f"{group}/{pressure}_np1", inp, v)
+    d2, p2 = r.run(f"{group}/{pressure}_np2", inp, dict(v, balance=1, rebal=50, **more), np=2)
+    f1 = read_csv(os.path.join(d1, "bench3d.csv"))
+    f2 = read_csv(os.path.join(d2, "bench3d.csv"))
+    for k in ("front_x", "front_y", "mass"):
+        diff = abs(f1[k][0] - f2[k][0])
+        check(diff < tol, f"{pressure}, {k}: np2 ({what}) = np1 to {tol:g} (|diff| = {diff:.1e})")
+    return f1, p2
+
+
 def case_every_fluid(r):
     """2 ranks re-balanced every 50 steps inside one run of 300 (`every 50`: fix mpm/fluid builds its
     grid patch again after each re-cut, the projection's last solve carried into it) = 1 rank:
     eos to 1e-10 m, projection to 1e-6 m (the solver tolerance); the cut follows the front."""
-    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
     for pressure, tol in (("eos", 1e-10), ("projection", 1e-6)):
-        v = dict(cells=8, warm=10, nsteps=300, segments=1, cellw=0, pressure=pressure)
-        d1, _ = r.run(f"balance_every_fluid/{pressure}_np1", inp, v)
-        d2, p2 = r.run(f"balance_every_fluid/{pressure}_np2", inp, dict(v, balance=1, rebal=50), np=2)
-        f1 = read_csv(os.path.join(d1, "bench3d.csv"))
-        f2 = read_csv(os.path.join(d2, "bench3d.csv"))
-        for k in ("front_x", "front_y", "mass"):
-            diff = abs(f1[k][0] - f2[k][0])
-            check(diff < tol, f"{pressure}, {k}: np2 (re-balanced in the run) = np1 to {tol:g} (|diff| = {diff:.1e})")
+        f1, p2 = rebalanced_np2_same(r, "balance_every_fluid", pressure, tol, {}, "re-balanced in the run")
         lines = cut_lines(p2.stdout)
         cuts = [ln[1][1] for ln in lines]
         print(f"  {pressure}: {len(lines)} balances, cut {cuts[0]:.4f} -> {cuts[-1]:.4f} m, front {f1['front_x'][0]:.4f} m"
@@ -80,16 +88,8 @@ def case_measured(r):
     """Keyword measured: 2 ranks re-balanced every 50 steps by the work fix mpm/fluid measured on each
     rank = 1 rank (eos to 1e-10 m, projection to 1e-6 m); every balance after the first is by measured
     work, its imbalance before >= 1 and the cuts it places even the measured weights out."""
-    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
     for pressure, tol in (("eos", 1e-10), ("projection", 1e-6)):
-        v = dict(cells=8, warm=10, nsteps=300, segments=1, cellw=0, pressure=pressure)
-        d1, _ = r.run(f"balance_measured/{pressure}_np1", inp, v)
-        d2, p2 = r.run(f"balance_measured/{pressure}_np2", inp, dict(v, balance=1, rebal=50, measured="yes"), np=2)
-        f1 = read_csv(os.path.join(d1, "bench3d.csv"))
-        f2 = read_csv(os.path.join(d2, "bench3d.csv"))
-        for k in ("front_x", "front_y", "mass"):
-            diff = abs(f1[k][0] - f2[k][0])
-            check(diff < tol, f"{pressure}, {k}: np2 (measured work) = np1 to {tol:g} (|diff| = {diff:.1e})")
+        _, p2 = rebalanced_np2_same(r, "balance_measured", pressure, tol, {"measured": "yes"}, "measured work")
         lines = cut_lines(p2.stdout)
         print("  " + "\n  ".join(str(ln) for ln in lines))
         check(len(lines) == 8, f"{pressure}: balanced at both setups and every 50 steps ({len(lines)} of 8)")
