@@ -97,7 +97,7 @@ void NodeLabels::reset(const LocalGrid &grid, const IndexBox *work) {
   if (work) grid.for_box(work->cut(pb), [&](int, int, int, std::size_t n) { kind[n] = kFluid; });
   closed.assign(grid.size(), 0);
   wall_u.clear();
-  level.clear();
+  if (!work) level.clear();  // with a work box the caller fills the level in the box (kept sized)
   // the padding: the slabs of the patch below node 0 and above node ncell of each non-periodic d
   for (int d = 0; d < 3; ++d) {
     if (g.periodic[d]) continue;

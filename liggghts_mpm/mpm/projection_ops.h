@@ -45,7 +45,8 @@ struct NodeLabels {
   // Every node FLUID with open faces, except the padding nodes behind the box
   // walls (indices < 0 or > ncell in non-periodic dimensions), which are SOLID.
   // work (the projection's sparse sweeps): only the nodes of that box FLUID, the others EMPTY
-  // (they hold no fluid, which is what the labelling of their mass would find).
+  // (they hold no fluid, which is what the labelling of their mass would find); the level keeps
+  // its size and values (the caller sets it in the box).
   void reset(const LocalGrid &grid, const IndexBox *work = nullptr);
   void close_face(const LocalGrid &grid, int i, int j, int k, int d, double wall_velocity = 0.0);
   // Copies the owned nodes' labels into the halos (collective over the grid's comm).

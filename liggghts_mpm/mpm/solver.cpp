@@ -93,10 +93,12 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
   if (opt.projection && proj_) proj_->save(last);
   grid_.setup(opt.grid, comm_, sublo, subhi, halo);
   g_.assign(grid_.size(), opt.musl, opt.coupled, opt.theta_transport);
-  // the sparse grid covers the fluid's own phases with the equation of state, also with couple:
-  // the coupling reads the fluid's arrays (zero outside the active blocks, as on the dense grid)
-  // and writes only its own, which its phases sweep on the whole patch; the projection's phases
-  // and solve sweep the whole patch (docs/performance.md, "Sparse grid")
+  // the sparse grid covers the fluid's own phases, also with couple and with the projection: the
+  // coupling reads the fluid's arrays (zero outside the active blocks, as on the dense grid) and
+  // writes only its own, which its phases sweep on the whole patch; the projection writes the
+  // fluid's velocity only where there is mass, and sweeps its own arrays on the work box
+  // (projection_work_box; pure fluid without mesh walls) or the whole patch (docs/performance.md,
+  // "Sparse grid")
   sparse_ = opt.sparse;
   if (sparse_) blocks_.setup(grid_);
   th_prev_valid_ = false;
