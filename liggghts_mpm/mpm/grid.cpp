@@ -154,11 +154,16 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   const std::vector<Transfer> &send = reverse ? halo_side_ : owner_side_;
   const std::vector<Transfer> &recv = reverse ? owner_side_ : halo_side_;
   const std::size_t sv = std::size_t(stride), row_step = std::size_t(n_[0]) * sv;
+  // with a work box (the projection's sweeps) only its part of each box moves: the same part on
+  // both sides, since every rank's work box is one global box cut to its patch (the whole patch
+  // along periodic dimensions); outside it both sides hold the value of a node without fluid
+  auto box_of = [&](const Transfer &t) { return restricted_ ? t.mine.cut(work_) : t.mine; };
 
   // A box moves row by row along x: the stride values of the nodes of one row are contiguous in
   // data (x fastest). Buffers hold the boxes' rows one after the other (z, y, x, value: the order
   // node by node), so that the rows of one box follow each other in the message.
   auto pack = [&](const IndexBox &b, double *buf) {
+    if (b.empty()) return buf;
     const std::size_t len = std::size_t(b.hi[0] - b.lo[0] + 1) * sv;
     for (int k = b.lo[2]; k <= b.hi[2]; ++k) {
       const double *row = data + index(b.lo[0], b.lo[1], k) * sv;
@@ -170,6 +175,7 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   // reverse: each value added to its node once (per transfer, in list order: the same sums);
   // forward: stored
   auto unpack = [&](const IndexBox &b, const double *buf) {
+    if (b.empty()) return buf;
     const std::size_t len = std::size_t(b.hi[0] - b.lo[0] + 1) * sv;
     for (int k = b.lo[2]; k <= b.hi[2]; ++k) {
       double *row = data + index(b.lo[0], b.lo[1], k) * sv;
@@ -187,15 +193,15 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   {
     std::size_t n = 0;
     for (const auto &t : send)
-      if (t.peer == me_) n += std::size_t(t.mine.count()) * sv;
+      if (t.peer == me_) n += std::size_t(box_of(t).count()) * sv;
     if (n > 0) {
       if (selfbuf_.size() < n) selfbuf_.resize(n);
       double *w = selfbuf_.data();
       for (const auto &t : send)
-        if (t.peer == me_) w = pack(t.mine, w);
+        if (t.peer == me_) w = pack(box_of(t), w);
       const double *r = selfbuf_.data();
       for (const auto &t : recv)
-        if (t.peer == me_) r = unpack(t.mine, r);
+        if (t.peer == me_) r = unpack(box_of(t), r);
     }
   }
   if (nprocs_ == 1) return;
@@ -207,9 +213,9 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   xcount_.assign(2 * std::size_t(np), 0);
   int *sendcount = xcount_.data(), *recvcount = sendcount + np;
   for (const auto &t : send)
-    if (t.peer != me_) sendcount[t.peer] += int(t.mine.count()) * stride;
+    if (t.peer != me_) sendcount[t.peer] += int(box_of(t).count()) * stride;
   for (const auto &t : recv)
-    if (t.peer != me_) recvcount[t.peer] += int(t.mine.count()) * stride;
+    if (t.peer != me_) recvcount[t.peer] += int(box_of(t).count()) * stride;
   xoff_.resize(2 * (std::size_t(np) + 1));
   int *soff = xoff_.data(), *roff = soff + np + 1;
   soff[0] = roff[0] = 0;
@@ -222,8 +228,9 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   xpos_.assign(soff, soff + np);
   for (const auto &t : send)
     if (t.peer != me_) {
-      pack(t.mine, sendbuf_.data() + xpos_[t.peer]);
-      xpos_[t.peer] += int(t.mine.count()) * stride;
+      const IndexBox b = box_of(t);
+      pack(b, sendbuf_.data() + xpos_[t.peer]);
+      xpos_[t.peer] += int(b.count()) * stride;
     }
   req_.clear();
   for (int q = 0; q < np; ++q)
@@ -242,8 +249,9 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   xpos_.assign(roff, roff + np);
   for (const auto &t : recv)
     if (t.peer != me_) {
-      unpack(t.mine, recvbuf_.data() + xpos_[t.peer]);
-      xpos_[t.peer] += int(t.mine.count()) * stride;
+      const IndexBox b = box_of(t);
+      unpack(b, recvbuf_.data() + xpos_[t.peer]);
+      xpos_[t.peer] += int(b.count()) * stride;
     }
 }
 
