@@ -106,6 +106,14 @@ double FixBalanceMpm::base_weight(int i) const {
 
 double FixBalanceMpm::weight(int i) const { return scale_ * base_weight(i); }
 
+// the fix mpm/fluid instances of the run
+std::vector<FixMpmFluid *> FixBalanceMpm::fluid_fixes() const {
+  std::vector<FixMpmFluid *> out;
+  for (int m = 0; m < modify->nfix; ++m)
+    if (strcmp(modify->fix[m]->style, "mpm/fluid") == 0) out.push_back(static_cast<FixMpmFluid *>(modify->fix[m]));
+  return out;
+}
+
 /* Keyword measured: the work of fix mpm/fluid on each rank since the last balance (its wall time
    less the waits for halo messages, FixMpmFluid::busy_seconds) over the rank's weight of atoms,
    relative to the same ratio of all ranks, scales the weights of the rank's atoms: the cuts then
@@ -114,9 +122,7 @@ double FixBalanceMpm::weight(int i) const { return scale_ * base_weight(i); }
    rank without work or without atoms) the scale is 1. */
 void FixBalanceMpm::measure() {
   double busy = 0.0;
-  for (int m = 0; m < modify->nfix; ++m)
-    if (strcmp(modify->fix[m]->style, "mpm/fluid") == 0)
-      busy += static_cast<FixMpmFluid *>(modify->fix[m])->busy_seconds();
+  for (const FixMpmFluid *f : fluid_fixes()) busy += f->busy_seconds();
   const double d = busy - busy_last_;
   busy_last_ = busy;
   double w = 0.0;
@@ -329,8 +335,7 @@ void FixBalanceMpm::balance() {
   if (neighbor->style) neighbor->setup_bins();
   // fix mpm/fluid builds its grid patch from the subdomain: inside a run it builds it again at
   // its next step (at the setup of a run it builds it after this anyway)
-  for (int m = 0; m < modify->nfix; ++m)
-    if (strcmp(modify->fix[m]->style, "mpm/fluid") == 0) static_cast<FixMpmFluid *>(modify->fix[m])->subdomain_changed();
+  for (FixMpmFluid *f : fluid_fixes()) f->subdomain_changed();
 
   if (!scaled_) imb_after_ = imbalance();
   ++nbalance_;

@@ -31,6 +31,7 @@ class FixBalanceMpm : public Fix {
   void check_weights();                     // the total weight stays finite (collective)
   double weight(int i) const;              // the atom's weight (times the rank's scale, measured)
   double base_weight(int i) const;         // the atom's weight from its groups
+  std::vector<class FixMpmFluid *> fluid_fixes() const;
   void measure();                          // measured: scale_ and the measured imbalance (collective)
   double slab_imbalance(const std::vector<double> &cut) const;  // of the weights cut there (collective)
   double volume_below(double c) const;      // weight of the box volume below c along dim_
