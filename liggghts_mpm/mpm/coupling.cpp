@@ -217,11 +217,7 @@ void FluidSolver::fold_to_mirror(std::vector<double> &a, int stride) {
   for (int d = 0; d < 3; ++d) {
     if (gs.periodic[d]) continue;
     // only the patch's padding layers outside the low and the high face
-    const int layers[2][2] = {{pb.lo[d], std::min(pb.hi[d], -1)}, {std::max(pb.lo[d], gs.ncell[d] + 1), pb.hi[d]}};
-    for (const auto &L : layers) {
-      IndexBox b = pb;
-      b.lo[d] = L[0];
-      b.hi[d] = L[1];
+    for (const IndexBox &b : gs.padding_layers(pb, d)) {
       for (int k = b.lo[2]; k <= b.hi[2]; ++k)
         for (int j = b.lo[1]; j <= b.hi[1]; ++j)
           for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
@@ -289,7 +285,8 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
     }
   });
   MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_INT, MPI_MIN, comm_);
-  int lo[3], hi[3];
+  IndexBox nzb;  // the nodes with a nonzero fraction, grown by the passes
+  int *const lo = nzb.lo, *const hi = nzb.hi;
   for (int d = 0; d < 3; ++d) {
     lo[d] = box[d];
     hi[d] = box[3 + d] == INT_MAX ? INT_MIN : -box[3 + d];
@@ -298,17 +295,13 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
       hi[d] = INT_MAX / 2;
     }
   }
-  const bool any = lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2];
+  const bool any = !nzb.empty();
   grid_.forward(phi.data(), stride);
   const IndexBox &ob = grid_.owned();
   const IndexBox &pb = grid_.patch();
   const std::size_t step[3] = {1, grid_.stride_y(), grid_.stride_z()};
   const double *const V = vol.data();
-  IndexBox b;  // owned nodes inside the box
-  for (int e = 0; e < 3; ++e) {
-    b.lo[e] = std::max(ob.lo[e], lo[e]);
-    b.hi[e] = std::min(ob.hi[e], hi[e]);
-  }
+  IndexBox b = ob.cut(nzb);  // owned nodes inside the box
   for (int pass = 0; pass < passes && any; ++pass)
     for (int d = 0; d < 3; ++d) {
       if (!gs.periodic[d] && gs.ncell[d] < 2) continue;
@@ -316,10 +309,7 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
         --lo[d];
         ++hi[d];
       }
-      for (int e = 0; e < 3; ++e) {
-        b.lo[e] = std::max(ob.lo[e], lo[e]);
-        b.hi[e] = std::min(ob.hi[e], hi[e]);
-      }
+      b = ob.cut(nzb);
       const double *const p = phi.data();
       double *const q = phi_new.data();
       const std::size_t sd = step[d];

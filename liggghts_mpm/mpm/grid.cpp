@@ -15,15 +15,6 @@ int first_node_at_or_above(const GridSpec &g, int d, double x) {
   return static_cast<int>(std::ceil(xi - 1e-9));
 }
 
-IndexBox intersect(const IndexBox &a, const IndexBox &b) {
-  IndexBox r;
-  for (int d = 0; d < 3; ++d) {
-    r.lo[d] = std::max(a.lo[d], b.lo[d]);
-    r.hi[d] = std::min(a.hi[d], b.hi[d]);
-  }
-  return r;
-}
-
 IndexBox shifted(const IndexBox &a, const int s[3]) {
   IndexBox r = a;
   for (int d = 0; d < 3; ++d) {
@@ -122,7 +113,7 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
           for (int kx = kmin[0]; kx <= kmax[0]; ++kx) {
             int s[3] = {kx * spec.ncell[0], ky * spec.ncell[1], kz * spec.ncell[2]};
             if (q == me_ && s[0] == 0 && s[1] == 0 && s[2] == 0) continue;
-            IndexBox b = intersect(patch_, shifted(oq, s));
+            IndexBox b = patch_.cut(shifted(oq, s));
             if (!b.empty()) halo_side_.push_back({q, b, {s[0], s[1], s[2]}});
           }
     }
@@ -136,7 +127,7 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
           for (int kx = kmin[0]; kx <= kmax[0]; ++kx) {
             int s[3] = {kx * spec.ncell[0], ky * spec.ncell[1], kz * spec.ncell[2]};
             if (q == me_ && s[0] == 0 && s[1] == 0 && s[2] == 0) continue;
-            IndexBox b = intersect(pq, shifted(owned_, s));  // q's halo indices
+            IndexBox b = pq.cut(shifted(owned_, s));  // q's halo indices
             if (b.empty()) continue;
             int ms[3] = {-s[0], -s[1], -s[2]};
             owner_side_.push_back({q, shifted(b, ms), {s[0], s[1], s[2]}});
@@ -319,7 +310,7 @@ void ActiveBlocks::finish() {
     list_.push_back(q);
     const IndexBox b = box_of(q);
     boxes_.push_back(b);
-    const IndexBox o = intersect(b, owned_);
+    const IndexBox o = b.cut(owned_);
     if (!o.empty()) owned_boxes_.push_back(o);
   }
 }

@@ -29,9 +29,6 @@ struct IndexBox {
     }
     return r;
   }
-  bool contains(int i, int j, int k) const {
-    return i >= lo[0] && i <= hi[0] && j >= lo[1] && j <= hi[1] && k >= lo[2] && k <= hi[2];
-  }
 };
 
 struct GridSpec {
@@ -49,6 +46,24 @@ struct GridSpec {
   int mirror(int c, int d) const {
     if (periodic[d]) return c;
     return c < 0 ? -c : (c > ncell[d] ? 2 * ncell[d] - c : c);
+  }
+  // The nodes of b that are not padding: b cut to 0..ncell along every non-periodic dimension.
+  IndexBox interior(const IndexBox &b) const {
+    IndexBox in = b;
+    for (int d = 0; d < 3; ++d)
+      if (!periodic[d]) {
+        in.lo[d] = std::max(in.lo[d], 0);
+        in.hi[d] = std::min(in.hi[d], ncell[d]);
+      }
+    return in;
+  }
+  // The padding layers of b along a non-periodic d: its nodes below 0 and above ncell (either
+  // box empty when b has none there).
+  std::array<IndexBox, 2> padding_layers(const IndexBox &b, int d) const {
+    std::array<IndexBox, 2> out = {b, b};
+    out[0].hi[d] = std::min(b.hi[d], -1);
+    out[1].lo[d] = std::max(b.lo[d], ncell[d] + 1);
+    return out;
   }
 };
 
@@ -117,6 +132,18 @@ class LocalGrid {
     bool was_;
     IndexBox old_;
   };
+
+  // The nodes of the boxes (in the patch) set to 0 in a (stride doubles per node; nothing if a is
+  // not in use), row by row along x.
+  void zero_boxes(std::vector<double> &a, int stride, const std::vector<IndexBox> &boxes) const {
+    if (a.empty()) return;
+    for (const IndexBox &b : boxes) {
+      if (b.empty()) continue;
+      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+        for (int j = b.lo[1]; j <= b.hi[1]; ++j)
+          std::fill(a.begin() + stride * index(b.lo[0], j, k), a.begin() + stride * (index(b.hi[0], j, k) + 1), 0.0);
+    }
+  }
 
   // Adds the halo partial sums of data (stride doubles per node) into their owners.
   void reverse_sum(double *data, int stride);

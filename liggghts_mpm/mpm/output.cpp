@@ -109,16 +109,13 @@ void FluidSolver::write_output() {
   GridBlock gb;
   const bool want_grid = !gfields.empty();
   if (want_grid) {
-    const IndexBox &ob = grid_.owned();
-    int lo[3], hi[3];
+    const IndexBox in = gs.interior(grid_.owned());  // the owned nodes without padding
     for (int d = 0; d < 3; ++d) {
       gb.n[d] = gs.periodic[d] ? gs.ncell[d] : gs.ncell[d] + 1;
       gb.origin[d] = gs.origin[d];
       gb.spacing[d] = gs.dx;
-      lo[d] = std::max(ob.lo[d], 0);
-      hi[d] = std::min(ob.hi[d], gb.n[d] - 1);
-      gb.lo[d] = lo[d];
-      gb.count[d] = std::max(hi[d] - lo[d] + 1, 0);
+      gb.lo[d] = in.lo[d];
+      gb.count[d] = std::max(in.hi[d] - in.lo[d] + 1, 0);
     }
     if (gb.count[0] == 0 || gb.count[1] == 0 || gb.count[2] == 0)
       for (int d = 0; d < 3; ++d) gb.lo[d] = gb.count[d] = 0;  // owns no node
@@ -126,13 +123,10 @@ void FluidSolver::write_output() {
       gb.fields.push_back({f, f == "v" ? 3 : 1, {}});
       std::vector<double> &out = gb.fields.back().data;
       const bool mass = f == "mass";
-      for (int k = lo[2]; k <= hi[2]; ++k)
-        for (int j = lo[1]; j <= hi[1]; ++j)
-          for (int i = lo[0]; i <= hi[0]; ++i) {
-            const std::size_t n = grid_.index(i, j, k);
-            if (mass) out.push_back(g_.p2g[P2gRec::N * n + P2gRec::M]);
-            else out.insert(out.end(), &g_.vel[VelRec::N * n + VelRec::V_NEW], &g_.vel[VelRec::N * n + VelRec::V_NEW] + 3);
-          }
+      grid_.for_box(in, [&](int, int, int, std::size_t n) {
+        if (mass) out.push_back(g_.p2g[P2gRec::N * n + P2gRec::M]);
+        else out.insert(out.end(), &g_.vel[VelRec::N * n + VelRec::V_NEW], &g_.vel[VelRec::N * n + VelRec::V_NEW] + 3);
+      });
     }
   }
 

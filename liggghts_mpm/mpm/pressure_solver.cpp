@@ -176,18 +176,6 @@ bool PressureSolver::assemble_values(const NodeLabels &labels, const double *bet
   return true;
 }
 
-// nodes of box b that are not padding (indices 0..ncell along every non-periodic dimension)
-long PressureSolver::interior_count(const IndexBox &b) const {
-  const GridSpec &g = grid_.spec();
-  IndexBox in = b;
-  for (int d = 0; d < 3; ++d)
-    if (!g.periodic[d]) {
-      in.lo[d] = std::max(in.lo[d], 0);
-      in.hi[d] = std::min(in.hi[d], g.ncell[d]);
-    }
-  return in.count();
-}
-
 bool PressureSolver::any_periodic() const {
   const GridSpec &g = grid_.spec();
   return g.periodic[0] || g.periodic[1] || g.periodic[2];
@@ -319,7 +307,10 @@ PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *
   });
   // the projection's work box (pure fluid, no mesh walls): the owned nodes outside it are EMPTY,
   // but the padding behind the box walls, which is SOLID
-  if (grid_.restricted()) counts[0] += interior_count(ob) - interior_count(ob.cut(grid_.work()));
+  if (grid_.restricted()) {
+    const GridSpec &g = grid_.spec();
+    counts[0] += g.interior(ob).count() - g.interior(ob.cut(grid_.work())).count();
+  }
   MPI_Allreduce(counts, gcounts, 2, MPI_LONG, MPI_SUM, comm_);
   res.singular = gcounts[0] == 0 && gcounts[1] > 0;
   h.pin = -1;

@@ -80,7 +80,6 @@ class PressureSolver {
   bool assemble_values(const NodeLabels &labels, const double *beta);
   void setup_solver();
   bool any_periodic() const;
-  long interior_count(const IndexBox &b) const;
   long node_key(int i, int j, int k) const;
   bool unknown(const NodeLabels &labels, int i, int j, int k, std::size_t n) const;
 

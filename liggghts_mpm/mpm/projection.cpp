@@ -63,16 +63,10 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
   if (mesh_) mesh_wall_labels(*walls);
   const double dx = opt_.grid.dx, full = opt_.rho0 * dx * dx * dx;
   if (opt_.surface_ghost) {
-    if (sparse) {
-      // the work box's nodes as the full sweep sets them; outside it the level is never read (it
-      // enters only the faces of FLUID nodes) and fold_mass_ is 0 (retire)
-      lab_.level.resize(grid_.size(), 0.0);
-      fold_mass_.resize(grid_.size(), 0.0);
-      grid_.for_box(work_, [&](int, int, int, std::size_t n) { lab_.level[n] = fold_mass_[n] = 0.0; });
-    } else {
-      lab_.level.assign(grid_.size(), 0.0);
-      fold_mass_.assign(grid_.size(), 0.0);
-    }
+    // with a work box: outside it the level is never read (it enters only the faces of FLUID
+    // nodes) and fold_mass_ is 0 (retire)
+    zero_for_sweep(lab_.level);
+    zero_for_sweep(fold_mass_);
     grid_.for_owned([&](int, int, int, std::size_t n) { fold_mass_[n] = p2g[P2gRec::N * n + P2gRec::M]; });
     grid_.forward(fold_mass_.data(), 1);
   }
@@ -325,17 +319,18 @@ void Projection::retire(const IndexBox &work) {
       {&acc_, 3}, {&p_acc_, 1}, {&p_acc_ext_, 1}, {&grad_acc_, 3}, {&grad_acc_ext_, 3},
       {&fold_mass_, 1}, {&gk_, 1}, {&pk_, 1}};
   const std::vector<IndexBox> gone = box_minus(work_prev_.cut(grid_.patch()), work);
-  for (const auto &a : arrays) {
-    if (a.first->size() != a.second * grid_.size()) continue;
-    double *v = a.first->data();
-    const int st = a.second;
-    for (const IndexBox &b : gone)
-      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-        for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
-          double *row = v + st * grid_.index(b.lo[0], j, k);
-          std::fill(row, row + st * (b.hi[0] - b.lo[0] + 1), 0.0);
-        }
+  for (const auto &a : arrays) grid_.zero_boxes(*a.first, a.second, gone);  // (unused arrays are empty)
+}
+
+// a (one value per node) as a sweep starts it, 0 at every node it visits: the whole array, or with
+// a work box the box (sized on first use; outside the box it holds what retire left, 0, or is not read)
+void Projection::zero_for_sweep(std::vector<double> &a) const {
+  if (!grid_.restricted()) {
+    a.assign(grid_.size(), 0.0);
+    return;
   }
+  a.resize(grid_.size(), 0.0);
+  grid_.zero_boxes(a, 1, {work_});
 }
 
 /* Ghost-fluid surface: the EMPTY nodes that hold fluid mass (the B-spline spreads the points'
@@ -354,14 +349,8 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
   // per node: 1 if its gradient (gk) / pressure (pk) is known: FLUID nodes, and EMPTY nodes next
   // to a FLUID one for the gradient (pressure_gradient's one-sided surface face)
   std::vector<double> &gk = gk_, &pk = pk_;
-  if (grid_.restricted()) {  // 0 outside the work box (retire)
-    gk.resize(grid_.size(), 0.0);
-    pk.resize(grid_.size(), 0.0);
-    grid_.for_box(work_, [&](int, int, int, std::size_t n) { gk[n] = pk[n] = 0.0; });
-  } else {
-    gk.assign(grid_.size(), 0.0);
-    pk.assign(grid_.size(), 0.0);
-  }
+  zero_for_sweep(gk);
+  zero_for_sweep(pk);
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kFluid) {
       gk[n] = pk[n] = 1.0;

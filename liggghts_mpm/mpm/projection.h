@@ -108,6 +108,7 @@ class Projection {
   // sparse sweeps: the nodes of the last work box that are not in this one get the arrays' values
   // of a node without fluid within reach
   void retire(const IndexBox &work);
+  void zero_for_sweep(std::vector<double> &a) const;
   IndexBox work_, work_prev_;       // this step's work box (the patch when not sparse), the last one
   bool have_prev_ = false;
   std::vector<double> gk_, pk_;     // extrapolate_above_surface: gradient / pressure known

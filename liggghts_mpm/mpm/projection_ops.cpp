@@ -101,11 +101,8 @@ void NodeLabels::reset(const LocalGrid &grid, const IndexBox *work) {
   // the padding: the slabs of the patch below node 0 and above node ncell of each non-periodic d
   for (int d = 0; d < 3; ++d) {
     if (g.periodic[d]) continue;
-    IndexBox lo = pb, hi = pb;
-    lo.hi[d] = std::min(pb.hi[d], -1);
-    hi.lo[d] = std::max(pb.lo[d], g.ncell[d] + 1);
-    grid.for_box(lo, [&](int, int, int, std::size_t n) { kind[n] = kSolid; });
-    grid.for_box(hi, [&](int, int, int, std::size_t n) { kind[n] = kSolid; });
+    for (const IndexBox &layer : g.padding_layers(pb, d))
+      grid.for_box(layer, [&](int, int, int, std::size_t n) { kind[n] = kSolid; });
   }
 }
 

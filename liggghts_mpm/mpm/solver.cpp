@@ -219,21 +219,10 @@ void FluidSolver::compute_shapes() {
 void FluidSolver::mark_active_blocks() {
   // the points' blocks were marked in compute_shapes' pass (begin, one mark_from per point)
   blocks_.finish();
-  zero_boxes(g_.p2g, P2gRec::N, blocks_.retired());
-  zero_boxes(g_.vel, VelRec::N, blocks_.retired());
-  zero_boxes(g_.aux, AuxRec::N, blocks_.retired());
-  zero_boxes(g_.cell, CellRec::N, blocks_.retired());
-}
-
-// The nodes of the boxes in a (stride doubles per node; nothing if a is not in use) set to 0, row
-// by row along x.
-void FluidSolver::zero_boxes(std::vector<double> &a, int stride, const std::vector<IndexBox> &boxes) const {
-  if (a.empty()) return;
-  for (const IndexBox &b : boxes)
-    for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-      for (int j = b.lo[1]; j <= b.hi[1]; ++j)
-        std::fill(a.begin() + stride * grid_.index(b.lo[0], j, k), a.begin() + stride * (grid_.index(b.hi[0], j, k) + 1),
-                  0.0);
+  grid_.zero_boxes(g_.p2g, P2gRec::N, blocks_.retired());
+  grid_.zero_boxes(g_.vel, VelRec::N, blocks_.retired());
+  grid_.zero_boxes(g_.aux, AuxRec::N, blocks_.retired());
+  grid_.zero_boxes(g_.cell, CellRec::N, blocks_.retired());
 }
 
 void FluidSolver::clear_nodes(std::vector<double> &a, int stride) {
@@ -241,7 +230,7 @@ void FluidSolver::clear_nodes(std::vector<double> &a, int stride) {
     std::fill(a.begin(), a.end(), 0.0);
     return;
   }
-  zero_boxes(a, stride, blocks_.boxes());
+  grid_.zero_boxes(a, stride, blocks_.boxes());
 }
 
 long FluidSolver::nonzero_outside_active() const {

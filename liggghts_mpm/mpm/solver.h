@@ -190,7 +190,6 @@ class FluidSolver {
   void mark_active_blocks();
   // zeroes a node array (stride doubles per node): all of it, or the active blocks (sparse)
   void clear_nodes(std::vector<double> &a, int stride);
-  void zero_boxes(std::vector<double> &a, int stride, const std::vector<IndexBox> &boxes) const;
   // fn(i, j, k, n) for every owned node, or every owned node of an active block (sparse)
   template <class Fn> void for_owned_nodes(Fn &&fn) const {
     if (!sparse_) return grid_.for_owned(fn);
