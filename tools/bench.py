@@ -145,14 +145,18 @@ def section_projection(a, c):
     sb = mpm_run(a, c, a.np, 1, nsteps, "c%d_np%d_balance_projection" % (c, a.np), pressure="projection")
     note = "%d points, %d steps after 10 warm-up steps, pressure projection" % (s1["points"], nsteps)
     if a.quick:
-        s1 = faster(s1, mpm_run(a, c, 1, 0, nsteps, "c%d_np1_projection_repeat" % c, pressure="projection"))
-        sb = faster(sb, mpm_run(a, c, a.np, 1, nsteps, "c%d_np%d_balance_projection_repeat" % (c, a.np),
-                                pressure="projection"))
+        s1 = with_repeat(a, s1, c, 1, 0, nsteps, pressure="projection")
+        sb = with_repeat(a, sb, c, a.np, 1, nsteps, pressure="projection")
         note += ", faster of 2 interleaved repeats"
     add("mpm_point_steps_per_s_per_core_projection", s1["point_steps_per_s"], "point-steps/s",
         note + ", serial (loop s %s)" % s1.get("repeats_loop_s", "%.3f" % s1["loop_s"]))
     add("mpm_parallel_efficiency_%dranks_projection" % a.np, s1["loop_s"] / (a.np * sb["loop_s"]), "0..1",
         note + ", fix balance/mpm (loop s %s)" % sb.get("repeats_loop_s", "%.3f" % sb["loop_s"]))
+
+
+def with_repeat(a, r, cells, np_, balance, nsteps, **kw):
+    """The faster of run r and a repeat of it (tag r's case + '_repeat')."""
+    return faster(r, mpm_run(a, cells, np_, balance, nsteps, r["case"] + "_repeat", **kw))
 
 
 def faster(r1, r2):
@@ -175,8 +179,8 @@ def section_mpm(a):
         note = "%d points, %d steps after 10 warm-up steps" % (s1["points"], nsteps)
         mem = (s1["peak_rss_kB"] - base["peak_rss_kB"]) * 1024.0 / (s1["points"] - base["points"])
         if a.quick:  # interleaved repeats: a burst of load on the shared machine hits one of each at most
-            s1 = faster(s1, mpm_run(a, c, 1, 0, nsteps, "c%d_np1_repeat" % c))
-            sb = faster(sb, mpm_run(a, c, a.np, 1, nsteps, "c%d_np%d_balance_repeat" % (c, a.np)))
+            s1 = with_repeat(a, s1, c, 1, 0, nsteps)
+            sb = with_repeat(a, sb, c, a.np, 1, nsteps)
             note += ", faster of 2 interleaved repeats"
         eff_u = s1["loop_s"] / (a.np * su["loop_s"])
         eff_b = s1["loop_s"] / (a.np * sb["loop_s"])
