@@ -392,6 +392,33 @@ void FluidSolver::interpolate_pressure() {
    Anti-locking: the dilatation rate is averaged over each grid cell and the cell's pressure
    follows from the cell's mean density, so all points of a cell carry one pressure (Mast et al.
    2012). theta_only: the fluid fraction changed, the volume did not (refresh_pressure). */
+std::size_t FluidSolver::cell_node(int i) const {
+  const GridSpec &gs = opt.grid;
+  const double inv = 1.0 / gs.dx;
+  const double *xi = pts.x[i];
+  int c[3];
+  for (int d = 0; d < 3; ++d) c[d] = static_cast<int>(std::floor((xi[d] - gs.origin[d]) * inv));
+  for (int d = 0; d < 3; ++d)
+    if (!gs.periodic[d]) c[d] = std::min(std::max(c[d], 0), gs.ncell[d] - 1);
+  return grid_.index(c[0], c[1], c[2]);
+}
+
+// L == nullptr: the fluid fraction only (refresh_pressure), no divergence sums
+void FluidSolver::sum_cell(int i, const double *L, bool transport) {
+  const double *s = pts.state[i];
+  const std::size_t n = cell_node(i);
+  pcell_[i] = n;
+  double *c = &g_.cell[CellRec::N * n];
+  const double V = s[C_VOL];
+  c[CellRec::V] += V;
+  if (L) {
+    c[CellRec::VDIV] += V * (L[0] + L[4] + L[8]);
+    if (transport) c[CellRec::VDIVTHU] += V * divthu_[i];
+  }
+  c[CellRec::THV] += s[C_THETA] * V;
+  c[CellRec::M] += pts.rmass[i];
+}
+
 void FluidSolver::update_stress(double h, bool theta_only) {
   if (opt.projection) {
     // incompressible: density rho0 and the volume m / (theta rho0) held (the points' number per
@@ -407,37 +434,22 @@ void FluidSolver::update_stress(double h, bool theta_only) {
     }
     return;
   }
-  const GridSpec &gs = opt.grid;
   const int nlocal = pts.nlocal;
-  double **x = pts.x;
   const double *rmass = pts.rmass;
-  const double inv = 1.0 / gs.dx;
   // theta_transport: the fluid volume theta V changes by h V div(theta u) (grid operators), so
   // that flow through a fixed irregular bed keeps it; else theta stays, V changes by h V div u
   const bool transport = opt.coupled && opt.theta_transport && state.theta_initialized && !theta_only;
-  auto cell_node = [&](int i) {
-    int c[3];
-    for (int d = 0; d < 3; ++d) c[d] = static_cast<int>(std::floor((x[i][d] - gs.origin[d]) * inv));
-    for (int d = 0; d < 3; ++d)
-      if (!gs.periodic[d]) c[d] = std::min(std::max(c[d], 0), gs.ncell[d] - 1);
-    return grid_.index(c[0], c[1], c[2]);
-  };
   if (opt.antilock) {
-    clear_nodes(g_.cell, CellRec::N);
-    for (int i = 0; i < nlocal; ++i) {
-      if (!is_point(i)) continue;
-      const double *s = pts.state[i];
-      double *c = &g_.cell[CellRec::N * cell_node(i)];
-      const double V = s[C_VOL];
-      c[CellRec::V] += V;
-      if (!theta_only) {
-        const double *L = &velgrad_[9 * static_cast<std::size_t>(i)];
-        c[CellRec::VDIV] += V * (L[0] + L[4] + L[8]);
-        if (transport) c[CellRec::VDIVTHU] += V * divthu_[i];
+    // the cell sums: after MUSL already taken in its gradient pass (musl_gradient), else here
+    if (theta_only || !cells_summed_) {
+      if (pcell_.size() < static_cast<std::size_t>(nlocal)) pcell_.resize(nlocal);
+      clear_nodes(g_.cell, CellRec::N);
+      for (int i = 0; i < nlocal; ++i) {
+        if (!is_point(i)) continue;
+        sum_cell(i, theta_only ? nullptr : &velgrad_[9 * static_cast<std::size_t>(i)], transport);
       }
-      c[CellRec::THV] += s[C_THETA] * V;
-      c[CellRec::M] += rmass[i];
     }
+    cells_summed_ = false;
     grid_.reverse_sum(g_.cell.data(), CellRec::N);
     grid_.forward(g_.cell.data(), CellRec::N);
   }
@@ -450,7 +462,7 @@ void FluidSolver::update_stress(double h, bool theta_only) {
     double p;
     double fgrow = transport ? 1.0 + h * divthu_[i] / s[C_THETA] : 1.0;  // growth of theta V
     if (opt.antilock) {
-      const double *c = &g_.cell[CellRec::N * cell_node(i)];
+      const double *c = &g_.cell[CellRec::N * pcell_[i]];
       div = c[CellRec::VDIV] / c[CellRec::V];
       if (transport) fgrow = 1.0 + h * c[CellRec::VDIVTHU] / c[CellRec::THV];
       const double rho_cell = transport ? c[CellRec::M] / (c[CellRec::THV] * fgrow)

@@ -197,6 +197,11 @@ class FluidSolver {
   }
 
   bool shape_of(const double *x, Stencil &ps);
+  // anti-locking: the node index of the cell that holds point i (clamped at non-periodic faces)
+  std::size_t cell_node(int i) const;
+  // anti-locking: point i's share of its cell's sums (CellRec) for the stress update, velocity
+  // gradient L (9, row-major) and, with transport, div(theta u); stores pcell_[i]
+  void sum_cell(int i, const double *L, bool transport);
   void smooth_solid_volume();
   double solid_node_volume(int i, int j, int k) const;
   void init_theta();
@@ -222,6 +227,10 @@ class FluidSolver {
   std::vector<double> vpic_;        // grid (PIC) velocity at the points, for the position update
   std::vector<double> velgrad_;     // velocity gradient at the points, for the stress update
   std::vector<double> divthu_;      // theta_transport: div(theta u) at the points (MUSL pass)
+  // anti-locking (eos): the node index of each point's cell, and whether the MUSL gradient pass
+  // has already summed the cells of this sub-step's stress update (sum_cell)
+  std::vector<std::size_t> pcell_;
+  bool cells_summed_ = false;
   std::vector<double> grain_force_; // per local grain: fluid force averaged over sub-steps (3)
   // time-step diagnostics of the last check
   double dt_stable_ = 0.0, c_max_ = 0.0;

@@ -193,6 +193,14 @@ void FluidSolver::musl_gradient() {
   const bool transport = opt.coupled && opt.theta_transport;
   const double *const gth = transport ? g_.th.data() : nullptr;
   if (transport && divthu_.size() < static_cast<std::size_t>(pts.nlocal)) divthu_.resize(pts.nlocal);
+  // anti-locking (eos): the cell sums of the stress update (update_stress) are taken here, in the
+  // same point order, while the point's record is at hand (one pass over the points less)
+  const bool cells = opt.antilock && !opt.projection;
+  const bool cell_transport = transport && state.theta_initialized;
+  if (cells) {
+    if (pcell_.size() < static_cast<std::size_t>(pts.nlocal)) pcell_.resize(pts.nlocal);
+    clear_nodes(g_.cell, CellRec::N);
+  }
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     Row4 Lc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // Lc[e][d] = sum v_d dS/dx_e
@@ -210,7 +218,9 @@ void FluidSolver::musl_gradient() {
       for (int e = 0; e < 3; ++e) L[3 * d + e] = Lc[e][d];
     std::copy(L, L + 9, &velgrad_[9 * static_cast<std::size_t>(i)]);
     if (store_affine) std::copy(L, L + 9, pts.state[i] + C_AFF);
+    if (cells) sum_cell(i, L, cell_transport);
   }
+  cells_summed_ = cells;
 }
 
 }  // namespace mpm
