@@ -392,33 +392,6 @@ void FluidSolver::interpolate_pressure() {
    Anti-locking: the dilatation rate is averaged over each grid cell and the cell's pressure
    follows from the cell's mean density, so all points of a cell carry one pressure (Mast et al.
    2012). theta_only: the fluid fraction changed, the volume did not (refresh_pressure). */
-std::size_t FluidSolver::cell_node(int i) const {
-  const GridSpec &gs = opt.grid;
-  const double inv = 1.0 / gs.dx;
-  const double *xi = pts.x[i];
-  int c[3];
-  for (int d = 0; d < 3; ++d) c[d] = static_cast<int>(std::floor((xi[d] - gs.origin[d]) * inv));
-  for (int d = 0; d < 3; ++d)
-    if (!gs.periodic[d]) c[d] = std::min(std::max(c[d], 0), gs.ncell[d] - 1);
-  return grid_.index(c[0], c[1], c[2]);
-}
-
-// L == nullptr: the fluid fraction only (refresh_pressure), no divergence sums
-void FluidSolver::sum_cell(int i, const double *L, bool transport) {
-  const double *s = pts.state[i];
-  const std::size_t n = cell_node(i);
-  pcell_[i] = n;
-  double *c = &g_.cell[CellRec::N * n];
-  const double V = s[C_VOL];
-  c[CellRec::V] += V;
-  if (L) {
-    c[CellRec::VDIV] += V * (L[0] + L[4] + L[8]);
-    if (transport) c[CellRec::VDIVTHU] += V * divthu_[i];
-  }
-  c[CellRec::THV] += s[C_THETA] * V;
-  c[CellRec::M] += pts.rmass[i];
-}
-
 void FluidSolver::update_stress(double h, bool theta_only) {
   if (opt.projection) {
     // incompressible: density rho0 and the volume m / (theta rho0) held (the points' number per

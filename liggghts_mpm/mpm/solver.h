@@ -258,4 +258,32 @@ inline void with_stencil(ShapeKind k, Fn &&fn) {
     fn(std::integral_constant<int, 2>());
 }
 
+// the anti-locking cell sums (update_stress, musl_gradient), inline in both hot loops
+inline std::size_t FluidSolver::cell_node(int i) const {
+  const GridSpec &gs = opt.grid;
+  const double inv = 1.0 / gs.dx;
+  const double *xi = pts.x[i];
+  int c[3];
+  for (int d = 0; d < 3; ++d) c[d] = static_cast<int>(std::floor((xi[d] - gs.origin[d]) * inv));
+  for (int d = 0; d < 3; ++d)
+    if (!gs.periodic[d]) c[d] = std::min(std::max(c[d], 0), gs.ncell[d] - 1);
+  return grid_.index(c[0], c[1], c[2]);
+}
+
+// L == nullptr: the fluid fraction only (refresh_pressure), no divergence sums
+inline void FluidSolver::sum_cell(int i, const double *L, bool transport) {
+  const double *s = pts.state[i];
+  const std::size_t n = cell_node(i);
+  pcell_[i] = n;
+  double *c = &g_.cell[CellRec::N * n];
+  const double V = s[C_VOL];
+  c[CellRec::V] += V;
+  if (L) {
+    c[CellRec::VDIV] += V * (L[0] + L[4] + L[8]);
+    if (transport) c[CellRec::VDIVTHU] += V * divthu_[i];
+  }
+  c[CellRec::THV] += s[C_THETA] * V;
+  c[CellRec::M] += pts.rmass[i];
+}
+
 }  // namespace mpm
