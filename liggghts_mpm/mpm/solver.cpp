@@ -401,7 +401,7 @@ void FluidSolver::update_stress(double h, bool theta_only) {
       s[C_RHO] = opt.rho0;
       s[C_VOL] = pts.rmass[i] / (s[C_THETA] * opt.rho0);
       if (theta_only) continue;
-      const double *L = &velgrad_[9 * static_cast<std::size_t>(i)];
+      const double *L = velgrad(i);
       const double Lm[3][3] = {{L[0], L[1], L[2]}, {L[3], L[4], L[5]}, {L[6], L[7], L[8]}};
       newtonian_deviatoric_stress(opt.viscosity, Lm, s + C_TAU);
     }
@@ -419,7 +419,7 @@ void FluidSolver::update_stress(double h, bool theta_only) {
       clear_nodes(g_.cell, CellRec::N);
       for (int i = 0; i < nlocal; ++i) {
         if (!is_point(i)) continue;
-        sum_cell(i, theta_only ? nullptr : &velgrad_[9 * static_cast<std::size_t>(i)], transport);
+        sum_cell(i, theta_only ? nullptr : velgrad(i), transport);
       }
     }
     cells_summed_ = false;
@@ -430,7 +430,7 @@ void FluidSolver::update_stress(double h, bool theta_only) {
     if (!is_point(i)) continue;
     double *s = pts.state[i];
     // theta_only: velgrad belongs to the last step's atom order then and is not read
-    const double *L = theta_only ? nullptr : &velgrad_[9 * static_cast<std::size_t>(i)];
+    const double *L = theta_only ? nullptr : velgrad(i);
     double div = theta_only ? 0.0 : L[0] + L[4] + L[8];
     double p;
     double fgrow = transport ? 1.0 + h * divthu_[i] / s[C_THETA] : 1.0;  // growth of theta V

@@ -226,6 +226,12 @@ class FluidSolver {
   std::vector<int> plist_;          // local indices of the material points (this sub-step)
   std::vector<double> vpic_;        // grid (PIC) velocity at the points, for the position update
   std::vector<double> velgrad_;     // velocity gradient at the points, for the stress update
+  // the velocity gradient of the last transfer sits in the points' affine record (FLIP/PIC with
+  // MUSL store it there anyway), not in velgrad_: one stream of 9 doubles per point less
+  bool grad_in_state_ = false;
+  const double *velgrad(int i) const {
+    return grad_in_state_ ? pts.state[i] + C_AFF : &velgrad_[9 * static_cast<std::size_t>(i)];
+  }
   std::vector<double> divthu_;      // theta_transport: div(theta u) at the points (MUSL pass)
   // anti-locking (eos): the node index of each point's cell, and whether the MUSL gradient pass
   // has already summed the cells of this sub-step's stress update (sum_cell)

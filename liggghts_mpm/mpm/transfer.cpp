@@ -77,6 +77,7 @@ void FluidSolver::g2p_kernel() {
   const double dinv = apic_dinv_bspline2() / (opt.grid.dx * opt.grid.dx);
   const bool flip = opt.transfer == Transfer::Flip;
   const double alpha = opt.flip_alpha;
+  if (P::need_L) grad_in_state_ = false;  // velgrad_ holds this transfer's gradient
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     double *s = pts.state[i];
@@ -216,11 +217,14 @@ void FluidSolver::musl_gradient() {
     double L[9];
     for (int d = 0; d < 3; ++d)
       for (int e = 0; e < 3; ++e) L[3 * d + e] = Lc[e][d];
-    std::copy(L, L + 9, &velgrad_[9 * static_cast<std::size_t>(i)]);
-    if (store_affine) std::copy(L, L + 9, pts.state[i] + C_AFF);
+    if (store_affine)
+      std::copy(L, L + 9, pts.state[i] + C_AFF);
+    else
+      std::copy(L, L + 9, &velgrad_[9 * static_cast<std::size_t>(i)]);
     if (cells) sum_cell(i, L, cell_transport);
   }
   cells_summed_ = cells;
+  grad_in_state_ = store_affine;
 }
 
 }  // namespace mpm
