@@ -238,6 +238,7 @@ void FixMpmFluid::mark_run_start() {
   run_time_start[4] = static_cast<double>(s.pressure_iterations_summed());
   run_time_start[5] = s.time_output;
   run_time_start[6] = static_cast<double>(s.n_outputs);
+  run_time_start[7] = s.grid().wait_seconds();
 }
 
 /* Where the fix's time went in the run just finished (slowest rank), next
@@ -260,6 +261,18 @@ void FixMpmFluid::post_run() {
   if (s.opt.coupled) os << ", coupling " << g[1] << " s (" << (g[0] > 0.0 ? g[1] / g[0] : 0.0) << " of the fluid time)";
   const double nout = static_cast<double>(s.n_outputs) - run_time_start[6];  // the same on every rank
   if (nout > 0.0) os << ", output " << g[3] << " s (" << nout << " files, " << g[3] / nout << " s per file)";
+  if (comm->nprocs > 1) {
+    // the balance as it held: each rank's fluid and coupling time less its waits for halo
+    // messages (busy, what fix balance/mpm measured yes cuts by), and the waits
+    const double wait = s.grid().wait_seconds() - run_time_start[7];
+    const double busy = t[0] + t[1] - wait;
+    double r[4] = {busy, -busy, wait, -wait}, rg[4], sum = 0.0;
+    MPI_Allreduce(r, rg, 4, MPI_DOUBLE, MPI_MAX, world);
+    MPI_Allreduce(&busy, &sum, 1, MPI_DOUBLE, MPI_SUM, world);
+    const double mean = sum / comm->nprocs;
+    os << "; per rank: busy " << -rg[1] << " to " << rg[0] << " s (max/mean " << (mean > 0.0 ? rg[0] / mean : 1.0)
+       << "), waits for halo messages " << -rg[3] << " to " << rg[2] << " s";
+  }
   os << "\n";
   print(os.str());
   mark_run_start();

@@ -67,7 +67,7 @@ class FixMpmFluid : public Fix {
   class FixPropertyAtom *fix_dragforce = nullptr;  // per-atom vector 'dragforce' (LIGGGHTS convention)
   bool filled = false;
   // the solver's fluid, coupling and pressure-solver wall time, solves and PCG iterations at the setup of the run
-  double run_time_start[7] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  double run_time_start[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};  // [7]: halo waits (this rank)
   void mark_run_start();
   double **pdata = nullptr;  // per-point state rows (mpm::Column)
   int pdata_rows = 0;

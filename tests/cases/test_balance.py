@@ -97,6 +97,15 @@ def case_measured(r):
               f"{pressure}: the first balance by points (nothing measured yet), the others by measured work")
         check(all(ln[2] >= 1.0 and 1.0 <= ln[3] <= ln[2] + 1e-9 for ln in lines[1:]),
               f"{pressure}: measured imbalance >= 1 before, and not above it after each re-cut")
+        # the end-of-run line: per-rank busy time and halo waits, consistent with the fluid timer
+        runs = re.findall(r"wall time in this run: fluid (\S+) s.*; per rank: busy (\S+) to (\S+) s \(max/mean (\S+)\), "
+                          r"waits for halo messages (\S+) to (\S+) s", p2.stdout)
+        print(f"  per-rank lines: {runs}")
+        check(len(runs) == 2, f"{pressure}: both runs print the per-rank busy time and halo waits ({len(runs)} of 2)")
+        check(all(0.0 <= float(b0) <= float(b1) and 0.0 <= float(w0) <= float(w1) and float(mm) >= 1.0 - 1e-12
+                  and float(b1) + float(w0) <= float(fl) * (1 + 1e-9) + 1e-6 for fl, b0, b1, mm, w0, w1 in runs),
+              f"{pressure}: busy and waits are ordered min <= max, max/mean >= 1, and busy + wait of a rank "
+              f"is not more than the slowest rank's fluid time")
 
 
 def case_bad_input(r):
