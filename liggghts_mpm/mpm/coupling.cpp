@@ -378,14 +378,29 @@ bool FluidSolver::near_face(const int base[3], int ns) const {
   return false;
 }
 
+/* a + w v with the rounding of a loop that only sums w v into a: the build with FMA (MPM_SIMD)
+   contracts that to one fused multiply-add (the product not rounded), whereas pressure_moments,
+   which uses w V for its own sums too, rounds the product once for all of them */
+static inline double add_product(double a, double w, double v) {
+#if defined(__FMA__)
+  return std::fma(w, v, a);
+#else
+  return a + w * v;
+#endif
+}
+
 /* Moments of the points' pressures for the linear least-squares fit at each node: with
    e = (1, x_s - x_j) for the point's sample position x_s, the node collects r = sum S V p e and
-   the normal matrix M = sum S V e e^T (PfitRec). */
-template <int NS>
+   the normal matrix M = sum S V e e^T (PfitRec). VOL (reaction points with grad_p nodal or fit):
+   the same pass also sums the points' volume sum S V at every node of their stencils into rq[3 n]
+   (route_reaction), point by point in the order of plist_ as the pass of its own that it replaces
+   (point_sums), with the same rounding (add_product): the same sums bit for bit. */
+template <int NS, bool VOL>
 void FluidSolver::pressure_moments() {
   const GridSpec &gs = opt.grid;
   double **x = pts.x;
   double *const g = g_.pfit.data();
+  double *const rq = VOL ? g_.rq.data() : nullptr;
   const double *const need = g_.need.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   const bool nodal = opt.grad_p == GradP::Nodal;
@@ -396,8 +411,10 @@ void FluidSolver::pressure_moments() {
       // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
         double *cn = g + PfitRec::N * n;
-        cn[PfitRec::R] += w * V * p;
-        cn[PfitRec::MAT] += w * V;
+        const double wV = w * V;
+        cn[PfitRec::R] += wV * p;
+        cn[PfitRec::MAT] += wV;
+        if (VOL) rq[3 * n] = add_product(rq[3 * n], w, V);
       });
       continue;
     }
@@ -422,15 +439,17 @@ void FluidSolver::pressure_moments() {
       for (int q = 0; q < 3; ++q)
         nf[a][q] = nodal && near_face_along(a, ps.base[a] + q);
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
+      if (VOL) rq[3 * n] = add_product(rq[3 * n], w, V);  // every node of the stencil, needed or not
       if (need[n] == 0.0) return;
       double *cn = g + PfitRec::N * n;
+      const double wV = w * V;
       if (nodal && !(nf[0][a] || nf[1][b] || nf[2][c])) {
-        cn[PfitRec::R] += w * V * p;
-        cn[PfitRec::MAT] += w * V;
+        cn[PfitRec::R] += wV * p;
+        cn[PfitRec::MAT] += wV;
         return;
       }
       const Row4 e = {1.0, dn[0][a], dn[1][b], dn[2][c]};
-      const Row4 we = (w * V) * e;
+      const Row4 we = wV * e;
       row4(cn + PfitRec::R) += p * we;
       row4(cn + PfitRec::MAT) += we;
       row4(cn + PfitRec::MAT + 4) += e[1] * we;
@@ -464,16 +483,24 @@ void FluidSolver::couple_kernel(double h) {
   // and the fluid gets no pressure reaction (its share -theta grad p is in the projection)
   const bool proj = opt.projection;
   const bool weak = opt.grad_p == GradP::Weak || proj;
-  if (!proj && (weak || opt.reaction_points)) point_sums<NS>();
+  if (!proj && weak) point_sums<NS>();
   if (proj) {
     projection_gradient_to_grains();
   } else if (weak) {
     weak_pressure_gradient();
     smooth_weak_gradient<NS>();
   } else {
-    // pressure at the nodes for the force on the grains (fit_linear_pressure)
+    // pressure at the nodes for the force on the grains (fit_linear_pressure); reaction points:
+    // the points' volume at the nodes (rq[3 n], folded) in the same pass over the points
     std::fill(g_.pfit.begin(), g_.pfit.end(), 0.0);
-    pressure_moments<NS>();
+    if (opt.reaction_points) {
+      std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
+      pressure_moments<NS, true>();
+      fold_to_mirror(g_.rq, 3);
+      grid_.reverse_sum(g_.rq.data(), 3);
+    } else {
+      pressure_moments<NS, false>();
+    }
     grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
   }
 
@@ -624,26 +651,12 @@ void FluidSolver::couple_kernel(double h) {
   }
 }
 
-/* The points' volume and external force at the nodes (WkRec, reverse-summed, grad_p weak), and
-   the volume again folded at the faces (rq[3 n], for route_reaction). */
+/* grad_p weak: the points' volume and external force at the nodes (WkRec, reverse-summed), and
+   with reaction points the volume again folded at the faces (rq[3 n], for route_reaction; with
+   grad_p nodal or fit pressure_moments sums it in its pass over the points). */
 template <int NS>
 void FluidSolver::point_sums() {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  if (!(opt.grad_p == GradP::Weak || opt.projection)) {
-    // reaction points alone (grad_p nodal, fit) reads only the points' volume folded (rq[3 n]):
-    // summed straight there (the same sums wk[V] had before it was copied), no wk
-    double *const rq = g_.rq.data();
-    std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
-    for (const int i : plist_) {
-      const double V = pts.state[i][C_VOL];
-      for_stencil<NS>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-        rq[3 * n] += w * V;
-      });
-    }
-    fold_to_mirror(g_.rq, 3);
-    grid_.reverse_sum(g_.rq.data(), 3);
-    return;
-  }
   double *const wk = g_.wk.data();
   std::fill(g_.wk.begin(), g_.wk.end(), 0.0);
   for (const int i : plist_) {
