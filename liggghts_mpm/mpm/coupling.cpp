@@ -389,6 +389,36 @@ static inline double add_product(double a, double w, double v) {
 #endif
 }
 
+// The nodes of the stencils with bases lo..hi (per direction; none if hi = INT_MIN), in the patch.
+static IndexBox stencil_box(const int lo[3], const int hi[3], int ns, const IndexBox &patch) {
+  IndexBox b;
+  for (int d = 0; d < 3; ++d) {
+    b.lo[d] = lo[d];
+    b.hi[d] = hi[d] == INT_MIN ? INT_MIN : hi[d] + ns - 1;
+  }
+  return b.cut(patch);
+}
+
+// The smallest box holding b and the boxes of more.
+static IndexBox bounding_box(IndexBox b, const std::vector<IndexBox> &more) {
+  for (const IndexBox &m : more) {
+    if (m.empty()) continue;
+    if (b.empty()) {
+      b = m;
+      continue;
+    }
+    for (int d = 0; d < 3; ++d) {
+      b.lo[d] = std::min(b.lo[d], m.lo[d]);
+      b.hi[d] = std::max(b.hi[d], m.hi[d]);
+    }
+  }
+  return b;
+}
+
+static bool in_box(const IndexBox &b, int i, int j, int k) {
+  return i >= b.lo[0] && i <= b.hi[0] && j >= b.lo[1] && j <= b.hi[1] && k >= b.lo[2] && k <= b.hi[2];
+}
+
 /* Moments of the points' pressures for the linear least-squares fit at each node: with
    e = (1, x_s - x_j) for the point's sample position x_s, the node collects r = sum S V p e and
    the normal matrix M = sum S V e e^T (PfitRec). VOL (reaction points with grad_p nodal or fit):
@@ -491,8 +521,8 @@ void FluidSolver::couple_kernel(double h) {
     smooth_weak_gradient<NS>();
   } else {
     // pressure at the nodes for the force on the grains (fit_linear_pressure); reaction points:
-    // the points' volume at the nodes (rq[3 n], folded) in the same pass over the points
-    std::fill(g_.pfit.begin(), g_.pfit.end(), 0.0);
+    // the points' volume at the nodes (rq[3 n], folded) in the same pass over the points. pfit is
+    // 0 here (see the end of this function)
     if (opt.reaction_points) {
       std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
       pressure_moments<NS, true>();
@@ -504,9 +534,15 @@ void FluidSolver::couple_kernel(double h) {
     grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
   }
 
+  // pfit is 0 outside the points' stencils and the exchanged boxes (with grad_p weak and the
+  // projection everywhere): there the node reads a record of zeros, not the array
+  const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
+  const IndexBox pbox = stencil_box(base_lo_, base_hi_, NS, grid_.patch());
+  const IndexBox rbox = !proj && !weak ? bounding_box(pbox, xboxes) : IndexBox();
+  static const double kZeroPfit[PfitRec::N] = {};
   const double mmin = mass_min();
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double *c = &g_.pfit[PfitRec::N * n];
+    const double *c = in_box(rbox, i, j, k) ? &g_.pfit[PfitRec::N * n] : kZeroPfit;
     const double *g = &g_.p2g[P2gRec::N * n];
     double *st = &g_.st[StRec::N * n];
     for (int q = 0; q < StRec::N; ++q) st[q] = 0.0;
@@ -543,10 +579,15 @@ void FluidSolver::couple_kernel(double h) {
   // reaction goes to the nodes too.
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
   std::vector<double> Kgrain(static_cast<std::size_t>(nlocal), 0.0);
-  std::fill(g_.dr.begin(), g_.dr.end(), 0.0);
+  // dr is 0 here (see the end of this function); the box of the grains' stencil bases
+  int glo[3] = {INT_MAX, INT_MAX, INT_MAX}, ghi[3] = {INT_MIN, INT_MIN, INT_MIN};
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
     const Stencil &ps = grain_shapes_[k];
+    for (int d = 0; d < 3; ++d) {
+      glo[d] = std::min(glo[d], ps.base[d]);
+      ghi[d] = std::max(ghi[d], ps.base[d]);
+    }
     // one pass over the stencil: velocity of the wet nodes (and their total weight, the record's
     // 4th entry), fitted gradients of the determined nodes (and their weight), fluid fraction,
     // gradient of the nodal pressures
@@ -606,21 +647,31 @@ void FluidSolver::couple_kernel(double h) {
       row4(q + DrRec::KA) += w * r2;
     });
   }
+  // the nodes the grains wrote (dr is 0 elsewhere until the reverse sum)
+  const IndexBox gbox = stencil_box(glo, ghi, NS, grid_.patch());
+  const IndexBox dbox = bounding_box(gbox, xboxes);  // dr is 0 outside after the reverse sum
   if (opt.reaction_points && !proj) {
     // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
-    for (std::size_t n = 0; n < grid_.size(); ++n)
-      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
+    std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
+    if (!gbox.empty())
+      grid_.for_box(gbox, [&](int, int, int, std::size_t n) {
+        for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
+      });
     fold_to_mirror(g_.rp, 3);
     grid_.reverse_sum(g_.rp.data(), 3);
   }
   grid_.reverse_sum(g_.dr.data(), DrRec::N);
 
-  // node-wise exchange; the fluid's share of it stays on the owner
-  std::fill(g_.rx.begin(), g_.rx.end(), 0.0);
-  grid_.for_owned([&](int, int, int, std::size_t n) {
+  // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned
+  // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    double *rx = &g_.rx[3 * n];
+    if (!in_box(dbox, i, j, k)) {  // no grain here: K = 0, J = 0, the record keeps its zeros
+      rx[0] = rx[1] = rx[2] = 0.0;  // 0 - 0 / h
+      return;
+    }
     double *q = &g_.dr[DrRec::N * n];
     const double *st = &g_.st[StRec::N * n];
-    double *rx = &g_.rx[3 * n];
     double J[3] = {0, 0, 0};
     if (q[DrRec::K] > 0.0 && st[StRec::M] > mmin) {
       const double K = q[DrRec::K];
@@ -648,6 +699,18 @@ void FluidSolver::couple_kernel(double h) {
     });
     for (int d = 0; d < 3; ++d)
       grain_force_[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
+  }
+  // pfit and dr are 0 at the next call (they are allocated 0 and no other code writes them): only
+  // the nodes written are cleared, the stencils of the points (pfit) and of the grains (dr) and
+  // the halo and owner boxes of the exchanges; the drag exchange above wrote +0 to dr at the
+  // other owned nodes (K = 0 there). This replaces clearing the whole arrays before their use
+  // (pfit 20 doubles a node, dr 12; the points and grains of C3 fill a small part of the grid).
+  std::vector<IndexBox> boxes = xboxes;
+  boxes.push_back(gbox);
+  grid_.zero_boxes(g_.dr, DrRec::N, boxes);
+  if (!proj && !weak) {
+    boxes.back() = pbox;
+    grid_.zero_boxes(g_.pfit, PfitRec::N, boxes);
   }
 }
 
@@ -760,14 +823,27 @@ void FluidSolver::route_reaction() {
   grid_.forward(g_.rq.data(), 3);
   // padding nodes take their mirror's value, as the fluid fraction does
   const IndexBox &pb = grid_.patch();
-  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
-    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
-      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-        const int mi[3] = {opt.grid.mirror(i, 0), opt.grid.mirror(j, 1), opt.grid.mirror(k, 2)};
-        if ((mi[0] == i && mi[1] == j && mi[2] == k) || !grid_.in_patch(mi[0], mi[1], mi[2])) continue;
-        const std::size_t n = grid_.index(i, j, k), m = grid_.index(mi[0], mi[1], mi[2]);
-        for (int d = 0; d < 3; ++d) g_.rq[3 * n + d] = g_.rq[3 * m + d];
-      }
+  auto copy = [&](int i, int j, int k) {
+    const int mi[3] = {opt.grid.mirror(i, 0), opt.grid.mirror(j, 1), opt.grid.mirror(k, 2)};
+    if ((mi[0] == i && mi[1] == j && mi[2] == k) || !grid_.in_patch(mi[0], mi[1], mi[2])) return;
+    const std::size_t n = grid_.index(i, j, k), m = grid_.index(mi[0], mi[1], mi[2]);
+    for (int d = 0; d < 3; ++d) g_.rq[3 * n + d] = g_.rq[3 * m + d];
+  };
+  // only a padding node has a mirror other than itself; when the padding is no deeper than the
+  // grid every mirror lies inside, where no copy writes, and the padding layers along each
+  // direction are visited alone (a corner node more than once, with the same copy)
+  bool shallow = true;
+  for (int e = 0; e < 3; ++e)
+    if (!opt.grid.periodic[e]) shallow = shallow && pb.lo[e] >= -opt.grid.ncell[e] && pb.hi[e] <= 2 * opt.grid.ncell[e];
+  if (shallow) {
+    for (int e = 0; e < 3; ++e) {
+      if (opt.grid.periodic[e]) continue;
+      for (const IndexBox &b : opt.grid.padding_layers(pb, e))
+        if (!b.empty()) grid_.for_box(b, [&](int i, int j, int k, std::size_t) { copy(i, j, k); });
+    }
+  } else {
+    grid_.for_box(pb, [&](int i, int j, int k, std::size_t) { copy(i, j, k); });
+  }
   through_points<NS>(g_.rq.data(), g_.rp);
   const double *const rr = g_.rp.data();
   grid_.for_owned([&](int, int, int, std::size_t n) {
