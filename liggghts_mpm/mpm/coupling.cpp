@@ -534,14 +534,31 @@ void FluidSolver::couple_kernel(double h) {
     grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
   }
 
+  // the box of the grains' stencils (fluid_fraction found them for this sub-step)
+  int glo[3] = {INT_MAX, INT_MAX, INT_MAX}, ghi[3] = {INT_MIN, INT_MIN, INT_MIN};
+  for (int k = 0; k < nlocal; ++k) {
+    if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
+    for (int d = 0; d < 3; ++d) {
+      glo[d] = std::min(glo[d], grain_shapes_[k].base[d]);
+      ghi[d] = std::max(ghi[d], grain_shapes_[k].base[d]);
+    }
+  }
+  const IndexBox gbox = stencil_box(glo, ghi, NS, grid_.patch());
+  const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
+  // What the grains read (st) is read only at their stencils, here and, through the forward, at
+  // the owned nodes of the exchanged boxes, and by the drag exchange below in the same box: st is
+  // set only at the owned nodes of the bounding box of those (the rest keeps stale values nobody
+  // reads). dr is 0 outside that box after the reverse sum.
+  const IndexBox dbox = bounding_box(gbox, xboxes);
+  IndexBox sbox = grid_.owned().cut(dbox);
+  if (grid_.restricted()) sbox = sbox.cut(grid_.work());
   // pfit is 0 outside the points' stencils and the exchanged boxes (with grad_p weak and the
   // projection everywhere): there the node reads a record of zeros, not the array
-  const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
   const IndexBox pbox = stencil_box(base_lo_, base_hi_, NS, grid_.patch());
   const IndexBox rbox = !proj && !weak ? bounding_box(pbox, xboxes) : IndexBox();
   static const double kZeroPfit[PfitRec::N] = {};
   const double mmin = mass_min();
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+  if (!sbox.empty()) grid_.for_box(sbox, [&](int i, int j, int k, std::size_t n) {
     const double *c = in_box(rbox, i, j, k) ? &g_.pfit[PfitRec::N * n] : kZeroPfit;
     const double *g = &g_.p2g[P2gRec::N * n];
     double *st = &g_.st[StRec::N * n];
@@ -579,15 +596,10 @@ void FluidSolver::couple_kernel(double h) {
   // reaction goes to the nodes too.
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
   std::vector<double> Kgrain(static_cast<std::size_t>(nlocal), 0.0);
-  // dr is 0 here (see the end of this function); the box of the grains' stencil bases
-  int glo[3] = {INT_MAX, INT_MAX, INT_MAX}, ghi[3] = {INT_MIN, INT_MIN, INT_MIN};
+  // dr is 0 here (see the end of this function)
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
     const Stencil &ps = grain_shapes_[k];
-    for (int d = 0; d < 3; ++d) {
-      glo[d] = std::min(glo[d], ps.base[d]);
-      ghi[d] = std::max(ghi[d], ps.base[d]);
-    }
     // one pass over the stencil: velocity of the wet nodes (and their total weight, the record's
     // 4th entry), fitted gradients of the determined nodes (and their weight), fluid fraction,
     // gradient of the nodal pressures
@@ -647,9 +659,7 @@ void FluidSolver::couple_kernel(double h) {
       row4(q + DrRec::KA) += w * r2;
     });
   }
-  // the nodes the grains wrote (dr is 0 elsewhere until the reverse sum)
-  const IndexBox gbox = stencil_box(glo, ghi, NS, grid_.patch());
-  const IndexBox dbox = bounding_box(gbox, xboxes);  // dr is 0 outside after the reverse sum
+  // the grains wrote dr in gbox only (0 elsewhere until the reverse sum)
   if (opt.reaction_points && !proj) {
     // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
     std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
