@@ -378,14 +378,59 @@ bool FluidSolver::near_face(const int base[3], int ns) const {
   return false;
 }
 
+/* a + w v with the rounding of a loop that only sums w v into a: the build with FMA (MPM_SIMD)
+   contracts that to one fused multiply-add (the product not rounded), whereas pressure_moments,
+   which uses w V for its own sums too, rounds the product once for all of them */
+static inline double add_product(double a, double w, double v) {
+#if defined(__FMA__)
+  return std::fma(w, v, a);
+#else
+  return a + w * v;
+#endif
+}
+
+// The nodes of the stencils with bases lo..hi (per direction; none if hi = INT_MIN), in the patch.
+static IndexBox stencil_box(const int lo[3], const int hi[3], int ns, const IndexBox &patch) {
+  IndexBox b;
+  for (int d = 0; d < 3; ++d) {
+    b.lo[d] = lo[d];
+    b.hi[d] = hi[d] == INT_MIN ? INT_MIN : hi[d] + ns - 1;
+  }
+  return b.cut(patch);
+}
+
+// The smallest box holding b and the boxes of more.
+static IndexBox bounding_box(IndexBox b, const std::vector<IndexBox> &more) {
+  for (const IndexBox &m : more) {
+    if (m.empty()) continue;
+    if (b.empty()) {
+      b = m;
+      continue;
+    }
+    for (int d = 0; d < 3; ++d) {
+      b.lo[d] = std::min(b.lo[d], m.lo[d]);
+      b.hi[d] = std::max(b.hi[d], m.hi[d]);
+    }
+  }
+  return b;
+}
+
+static bool in_box(const IndexBox &b, int i, int j, int k) {
+  return i >= b.lo[0] && i <= b.hi[0] && j >= b.lo[1] && j <= b.hi[1] && k >= b.lo[2] && k <= b.hi[2];
+}
+
 /* Moments of the points' pressures for the linear least-squares fit at each node: with
    e = (1, x_s - x_j) for the point's sample position x_s, the node collects r = sum S V p e and
-   the normal matrix M = sum S V e e^T (PfitRec). */
-template <int NS>
+   the normal matrix M = sum S V e e^T (PfitRec). VOL (reaction points with grad_p nodal or fit):
+   the same pass also sums the points' volume sum S V at every node of their stencils into rq[3 n]
+   (route_reaction), point by point in the order of plist_ as the pass of its own that it replaces
+   (point_sums), with the same rounding (add_product): the same sums bit for bit. */
+template <int NS, bool VOL>
 void FluidSolver::pressure_moments() {
   const GridSpec &gs = opt.grid;
   double **x = pts.x;
   double *const g = g_.pfit.data();
+  double *const rq = VOL ? g_.rq.data() : nullptr;
   const double *const need = g_.need.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   const bool nodal = opt.grad_p == GradP::Nodal;
@@ -396,8 +441,10 @@ void FluidSolver::pressure_moments() {
       // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
         double *cn = g + PfitRec::N * n;
-        cn[PfitRec::R] += w * V * p;
-        cn[PfitRec::MAT] += w * V;
+        const double wV = w * V;
+        cn[PfitRec::R] += wV * p;
+        cn[PfitRec::MAT] += wV;
+        if (VOL) rq[3 * n] = add_product(rq[3 * n], w, V);
       });
       continue;
     }
@@ -422,15 +469,17 @@ void FluidSolver::pressure_moments() {
       for (int q = 0; q < 3; ++q)
         nf[a][q] = nodal && near_face_along(a, ps.base[a] + q);
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
+      if (VOL) rq[3 * n] = add_product(rq[3 * n], w, V);  // every node of the stencil, needed or not
       if (need[n] == 0.0) return;
       double *cn = g + PfitRec::N * n;
+      const double wV = w * V;
       if (nodal && !(nf[0][a] || nf[1][b] || nf[2][c])) {
-        cn[PfitRec::R] += w * V * p;
-        cn[PfitRec::MAT] += w * V;
+        cn[PfitRec::R] += wV * p;
+        cn[PfitRec::MAT] += wV;
         return;
       }
       const Row4 e = {1.0, dn[0][a], dn[1][b], dn[2][c]};
-      const Row4 we = (w * V) * e;
+      const Row4 we = wV * e;
       row4(cn + PfitRec::R) += p * we;
       row4(cn + PfitRec::MAT) += we;
       row4(cn + PfitRec::MAT + 4) += e[1] * we;
@@ -464,22 +513,53 @@ void FluidSolver::couple_kernel(double h) {
   // and the fluid gets no pressure reaction (its share -theta grad p is in the projection)
   const bool proj = opt.projection;
   const bool weak = opt.grad_p == GradP::Weak || proj;
-  if (!proj && (weak || opt.reaction_points)) point_sums<NS>();
+  if (!proj && weak) point_sums<NS>();
   if (proj) {
     projection_gradient_to_grains();
   } else if (weak) {
     weak_pressure_gradient();
     smooth_weak_gradient<NS>();
   } else {
-    // pressure at the nodes for the force on the grains (fit_linear_pressure)
-    std::fill(g_.pfit.begin(), g_.pfit.end(), 0.0);
-    pressure_moments<NS>();
+    // pressure at the nodes for the force on the grains (fit_linear_pressure); reaction points:
+    // the points' volume at the nodes (rq[3 n], folded) in the same pass over the points. pfit is
+    // 0 here (see the end of this function)
+    if (opt.reaction_points) {
+      std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
+      pressure_moments<NS, true>();
+      fold_to_mirror(g_.rq, 3);
+      grid_.reverse_sum(g_.rq.data(), 3);
+    } else {
+      pressure_moments<NS, false>();
+    }
     grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
   }
 
+  // the box of the grains' stencils (fluid_fraction found them for this sub-step)
+  int glo[3] = {INT_MAX, INT_MAX, INT_MAX}, ghi[3] = {INT_MIN, INT_MIN, INT_MIN};
+  for (int k = 0; k < nlocal; ++k) {
+    if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
+    for (int d = 0; d < 3; ++d) {
+      glo[d] = std::min(glo[d], grain_shapes_[k].base[d]);
+      ghi[d] = std::max(ghi[d], grain_shapes_[k].base[d]);
+    }
+  }
+  const IndexBox gbox = stencil_box(glo, ghi, NS, grid_.patch());
+  const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
+  // What the grains read (st) is read only at their stencils, here and, through the forward, at
+  // the owned nodes of the exchanged boxes, and by the drag exchange below in the same box: st is
+  // set only at the owned nodes of the bounding box of those (the rest keeps stale values nobody
+  // reads). dr is 0 outside that box after the reverse sum.
+  const IndexBox dbox = bounding_box(gbox, xboxes);
+  IndexBox sbox = grid_.owned().cut(dbox);
+  if (grid_.restricted()) sbox = sbox.cut(grid_.work());
+  // pfit is 0 outside the points' stencils and the exchanged boxes (with grad_p weak and the
+  // projection everywhere): there the node reads a record of zeros, not the array
+  const IndexBox pbox = stencil_box(base_lo_, base_hi_, NS, grid_.patch());
+  const IndexBox rbox = !proj && !weak ? bounding_box(pbox, xboxes) : IndexBox();
+  static const double kZeroPfit[PfitRec::N] = {};
   const double mmin = mass_min();
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double *c = &g_.pfit[PfitRec::N * n];
+  if (!sbox.empty()) grid_.for_box(sbox, [&](int i, int j, int k, std::size_t n) {
+    const double *c = in_box(rbox, i, j, k) ? &g_.pfit[PfitRec::N * n] : kZeroPfit;
     const double *g = &g_.p2g[P2gRec::N * n];
     double *st = &g_.st[StRec::N * n];
     for (int q = 0; q < StRec::N; ++q) st[q] = 0.0;
@@ -516,7 +596,7 @@ void FluidSolver::couple_kernel(double h) {
   // reaction goes to the nodes too.
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
   std::vector<double> Kgrain(static_cast<std::size_t>(nlocal), 0.0);
-  std::fill(g_.dr.begin(), g_.dr.end(), 0.0);
+  // dr is 0 here (see the end of this function)
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
     const Stencil &ps = grain_shapes_[k];
@@ -579,21 +659,29 @@ void FluidSolver::couple_kernel(double h) {
       row4(q + DrRec::KA) += w * r2;
     });
   }
+  // the grains wrote dr in gbox only (0 elsewhere until the reverse sum)
   if (opt.reaction_points && !proj) {
     // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
-    for (std::size_t n = 0; n < grid_.size(); ++n)
-      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
+    std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
+    if (!gbox.empty())
+      grid_.for_box(gbox, [&](int, int, int, std::size_t n) {
+        for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
+      });
     fold_to_mirror(g_.rp, 3);
     grid_.reverse_sum(g_.rp.data(), 3);
   }
   grid_.reverse_sum(g_.dr.data(), DrRec::N);
 
-  // node-wise exchange; the fluid's share of it stays on the owner
-  std::fill(g_.rx.begin(), g_.rx.end(), 0.0);
-  grid_.for_owned([&](int, int, int, std::size_t n) {
+  // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned
+  // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    double *rx = &g_.rx[3 * n];
+    if (!in_box(dbox, i, j, k)) {  // no grain here: K = 0, J = 0, the record keeps its zeros
+      rx[0] = rx[1] = rx[2] = 0.0;  // 0 - 0 / h
+      return;
+    }
     double *q = &g_.dr[DrRec::N * n];
     const double *st = &g_.st[StRec::N * n];
-    double *rx = &g_.rx[3 * n];
     double J[3] = {0, 0, 0};
     if (q[DrRec::K] > 0.0 && st[StRec::M] > mmin) {
       const double K = q[DrRec::K];
@@ -622,28 +710,26 @@ void FluidSolver::couple_kernel(double h) {
     for (int d = 0; d < 3; ++d)
       grain_force_[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
   }
+  // pfit and dr are 0 at the next call (they are allocated 0 and no other code writes them): only
+  // the nodes written are cleared, the stencils of the points (pfit) and of the grains (dr) and
+  // the halo and owner boxes of the exchanges; the drag exchange above wrote +0 to dr at the
+  // other owned nodes (K = 0 there). This replaces clearing the whole arrays before their use
+  // (pfit 20 doubles a node, dr 12; the points and grains of C3 fill a small part of the grid).
+  std::vector<IndexBox> boxes = xboxes;
+  boxes.push_back(gbox);
+  grid_.zero_boxes(g_.dr, DrRec::N, boxes);
+  if (!proj && !weak) {
+    boxes.back() = pbox;
+    grid_.zero_boxes(g_.pfit, PfitRec::N, boxes);
+  }
 }
 
-/* The points' volume and external force at the nodes (WkRec, reverse-summed, grad_p weak), and
-   the volume again folded at the faces (rq[3 n], for route_reaction). */
+/* grad_p weak: the points' volume and external force at the nodes (WkRec, reverse-summed), and
+   with reaction points the volume again folded at the faces (rq[3 n], for route_reaction; with
+   grad_p nodal or fit pressure_moments sums it in its pass over the points). */
 template <int NS>
 void FluidSolver::point_sums() {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  if (!(opt.grad_p == GradP::Weak || opt.projection)) {
-    // reaction points alone (grad_p nodal, fit) reads only the points' volume folded (rq[3 n]):
-    // summed straight there (the same sums wk[V] had before it was copied), no wk
-    double *const rq = g_.rq.data();
-    std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
-    for (const int i : plist_) {
-      const double V = pts.state[i][C_VOL];
-      for_stencil<NS>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-        rq[3 * n] += w * V;
-      });
-    }
-    fold_to_mirror(g_.rq, 3);
-    grid_.reverse_sum(g_.rq.data(), 3);
-    return;
-  }
   double *const wk = g_.wk.data();
   std::fill(g_.wk.begin(), g_.wk.end(), 0.0);
   for (const int i : plist_) {
@@ -747,14 +833,27 @@ void FluidSolver::route_reaction() {
   grid_.forward(g_.rq.data(), 3);
   // padding nodes take their mirror's value, as the fluid fraction does
   const IndexBox &pb = grid_.patch();
-  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
-    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
-      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-        const int mi[3] = {opt.grid.mirror(i, 0), opt.grid.mirror(j, 1), opt.grid.mirror(k, 2)};
-        if ((mi[0] == i && mi[1] == j && mi[2] == k) || !grid_.in_patch(mi[0], mi[1], mi[2])) continue;
-        const std::size_t n = grid_.index(i, j, k), m = grid_.index(mi[0], mi[1], mi[2]);
-        for (int d = 0; d < 3; ++d) g_.rq[3 * n + d] = g_.rq[3 * m + d];
-      }
+  auto copy = [&](int i, int j, int k) {
+    const int mi[3] = {opt.grid.mirror(i, 0), opt.grid.mirror(j, 1), opt.grid.mirror(k, 2)};
+    if ((mi[0] == i && mi[1] == j && mi[2] == k) || !grid_.in_patch(mi[0], mi[1], mi[2])) return;
+    const std::size_t n = grid_.index(i, j, k), m = grid_.index(mi[0], mi[1], mi[2]);
+    for (int d = 0; d < 3; ++d) g_.rq[3 * n + d] = g_.rq[3 * m + d];
+  };
+  // only a padding node has a mirror other than itself; when the padding is no deeper than the
+  // grid every mirror lies inside, where no copy writes, and the padding layers along each
+  // direction are visited alone (a corner node more than once, with the same copy)
+  bool shallow = true;
+  for (int e = 0; e < 3; ++e)
+    if (!opt.grid.periodic[e]) shallow = shallow && pb.lo[e] >= -opt.grid.ncell[e] && pb.hi[e] <= 2 * opt.grid.ncell[e];
+  if (shallow) {
+    for (int e = 0; e < 3; ++e) {
+      if (opt.grid.periodic[e]) continue;
+      for (const IndexBox &b : opt.grid.padding_layers(pb, e))
+        if (!b.empty()) grid_.for_box(b, [&](int i, int j, int k, std::size_t) { copy(i, j, k); });
+    }
+  } else {
+    grid_.for_box(pb, [&](int i, int j, int k, std::size_t) { copy(i, j, k); });
+  }
   through_points<NS>(g_.rq.data(), g_.rp);
   const double *const rr = g_.rp.data();
   grid_.for_owned([&](int, int, int, std::size_t n) {

@@ -171,9 +171,9 @@ class FluidSolver {
   template <int NS, class P> void g2p_kernel();
   template <int NS, class P> void musl_scatter();
   template <int NS> void musl_gradient();
-  template <int NS> void pressure_moments();
+  template <int NS, bool VOL> void pressure_moments();  // VOL: also the points' volume (rq)
   template <int NS> void couple_kernel(double h);
-  template <int NS> void point_sums();             // grad_p weak, reaction points: WkRec
+  template <int NS> void point_sums();             // grad_p weak: WkRec (reaction points: rq)
   void weak_pressure_gradient();                   // grad_p weak
   void weak_face_copy();                           // grad_p weak: face and padding nodes
   template <int NS> void smooth_weak_gradient();   // grad_p weak: the points' view of it
