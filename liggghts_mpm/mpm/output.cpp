@@ -60,9 +60,15 @@ void FluidSolver::global_vector(double out[kGlobalSize]) {
   out[18] = std::isfinite(gmx[7]) ? gmx[7] : 0.0;
 }
 
-double FluidSolver::time_pressure_solver() const { return proj_ ? proj_->solver_seconds() : 0.0; }
-long FluidSolver::pressure_solves() const { return proj_ ? proj_->solves() : 0; }
-long FluidSolver::pressure_iterations_summed() const { return proj_ ? proj_->iterations_summed() : 0; }
+// since the fix was created: the Projection of each grid patch (a new one at every re-cut) adds
+// to what the ones before it counted
+double FluidSolver::time_pressure_solver() const {
+  return proj_seconds_before_ + (proj_ ? proj_->solver_seconds() : 0.0);
+}
+long FluidSolver::pressure_solves() const { return proj_solves_before_ + (proj_ ? proj_->solves() : 0); }
+long FluidSolver::pressure_iterations_summed() const {
+  return proj_iterations_before_ + (proj_ ? proj_->iterations_summed() : 0);
+}
 
 namespace {
 int point_field_size(const std::string &f) { return f == "v" ? 3 : f == "tau" ? 6 : f == "affine" ? 9 : 1; }

@@ -90,7 +90,12 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
   // Projection (its owned box, or the whole grid if a rank's box changed), else from a
   // restart file
   ProjectionState last;
-  if (opt.projection && proj_) proj_->save(last);
+  if (opt.projection && proj_) {
+    proj_->save(last);
+    proj_seconds_before_ += proj_->solver_seconds();
+    proj_solves_before_ += proj_->solves();
+    proj_iterations_before_ += proj_->iterations_summed();
+  }
   grid_.setup(opt.grid, comm_, sublo, subhi, halo);
   g_.assign(grid_.size(), opt.musl, opt.coupled, opt.theta_transport);
   // the sparse grid covers the fluid's own phases, also with couple and with the projection: the

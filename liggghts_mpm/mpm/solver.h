@@ -249,6 +249,9 @@ class FluidSolver {
   void check_grain(int k) const;      // finite position, velocity, radius, mass (fluid_fraction)
   std::unique_ptr<Hdf5Series> series_;
   std::unique_ptr<Projection> proj_;  // pressure projection (opt.projection)
+  // the pressure solver's time, solves and PCG iterations of the Projections of earlier patches
+  double proj_seconds_before_ = 0.0;
+  long proj_solves_before_ = 0, proj_iterations_before_ = 0;
   std::vector<double> pvol_;          // volume_correction: sum S V of the points per node
   double vmax_ = 0.0;                 // |v|max of the points at the last time-step check
   long last_output_step_ = -1;

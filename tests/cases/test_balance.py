@@ -58,8 +58,15 @@ def rebalanced_np2_same(r, group, pressure, tol, more, what):
     process."""
     inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
     v = dict(cells=8, warm=10, nsteps=300, segments=1, cellw=0, pressure=pressure)
-    d1, _ = r.run(f"{group}/{pressure}_np1", inp, v)
+    d1, p1 = r.run(f"{group}/{pressure}_np1", inp, v)
     d2, p2 = r.run(f"{group}/{pressure}_np2", inp, dict(v, balance=1, rebal=50, **more), np=2)
+    if pressure == "projection":
+        # the end-of-run line counts every solve of the run, also across the re-cuts (each builds
+        # a new patch and pressure solver)
+        s1 = re.findall(r"wall time in this run: fluid \S+ s \(pressure solver \S+ s = \S+ of it, (\d+) solves", p1.stdout)
+        s2 = re.findall(r"wall time in this run: fluid \S+ s \(pressure solver \S+ s = \S+ of it, (\d+) solves", p2.stdout)
+        check(len(s1) == 2 and s1 == s2 and int(s1[-1]) >= 300,
+              f"{pressure}: solves per run reported on 2 re-balanced ranks = 1 rank ({s2} and {s1})")
     f1 = read_csv(os.path.join(d1, "bench3d.csv"))
     f2 = read_csv(os.path.join(d2, "bench3d.csv"))
     for k in ("front_x", "front_y", "mass"):
