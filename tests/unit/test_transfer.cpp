@@ -52,8 +52,8 @@ std::vector<RefNode> ref_nodes(bool quad, const mpm::GridSpec &gs, const double 
   return out;
 }
 
-// ---- the set-up: random points in the middle of a 10^3 grid (no wall is within reach) ----
-struct Scene {
+// ---- the host's arrays (what LIGGGHTS hands the fix) and the solver on them ----
+struct Host {
   std::vector<std::string> words;
   mpm::Options opt;
   std::vector<double> xs, vs, fs, rows;
@@ -61,15 +61,22 @@ struct Scene {
   std::vector<double> rmass, radius;
   std::vector<int> mask, tag, type;
   std::unique_ptr<mpm::FluidSolver> solver;
-
-  explicit Scene(const std::string &args, int n = 40, bool periodic = false) {
-    std::istringstream is("f all mpm/fluid cell 0.1 density 1000 bulk 1e5 viscosity 1e-3 " + args);
-    for (std::string s; is >> s;) words.push_back(s);
+  // the fix's arguments (after "f all mpm/fluid"), parsed as the fix does
+  void parse(const std::string &args, const mpm::ParseEnv &env) {
+    std::istringstream is("f all mpm/fluid " + args);
+    for (std::string w; is >> w;) words.push_back(w);
     std::vector<char *> argv;
-    for (auto &s : words) argv.push_back(&s[0]);
+    for (auto &w : words) argv.push_back(&w[0]);
+    opt = mpm::parse_options(static_cast<int>(argv.size()), argv.data(), env);
+  }
+};
+
+// ---- the set-up: random points in the middle of a 10^3 grid (no wall is within reach) ----
+struct Scene : Host {
+  explicit Scene(const std::string &args, int n = 40, bool periodic = false) {
     mpm::ParseEnv env;
     for (int d = 0; d < 3; ++d) env.periodic[d] = periodic;
-    opt = mpm::parse_options(static_cast<int>(argv.size()), argv.data(), env);
+    parse("cell 0.1 density 1000 bulk 1e5 viscosity 1e-3 " + args, env);
     std::mt19937_64 gen(7);
     std::uniform_real_distribution<double> pos(0.25, 0.75), val(-1.0, 1.0), pos1(0.5, 1.5);
     xs.resize(3 * n), vs.resize(3 * n), fs.resize(3 * n), rows.assign(n * mpm::NCOL, 0.0);
@@ -217,24 +224,13 @@ TEST(TransferReference, G2pLinearPic) { check_g2p("shape linear transfer pic upd
 // fresh solver gives for it (a value left over from the first step would change the pressure fit,
 // the drag or the grains' records). Points fill the lower middle of a 1 m box of cells 0.1, grains
 // sit among them, left in the first step and right in the second; both coupled steps run whole.
-struct CoupledScene {
-  std::vector<std::string> words;
-  mpm::Options opt;
-  std::vector<double> xs, vs, fs, rows;
-  std::vector<double *> x, v, f, state;
-  std::vector<double> rmass, radius;
-  std::vector<int> mask, tag, type;
-  std::unique_ptr<mpm::FluidSolver> solver;
+struct CoupledScene : Host {
   int npts = 0;
 
   CoupledScene(const std::string &args, double grain_x) {
-    std::istringstream is("f all mpm/fluid cell 0.1 density 1000 bulk 1e5 viscosity 1e-3 couple beads " + args);
-    for (std::string s; is >> s;) words.push_back(s);
-    std::vector<char *> argv;
-    for (auto &s : words) argv.push_back(&s[0]);
     mpm::ParseEnv env;
     env.group_exists = [](const char *g) { return std::string(g) == "beads"; };
-    opt = mpm::parse_options(static_cast<int>(argv.size()), argv.data(), env);
+    parse("cell 0.1 density 1000 bulk 1e5 viscosity 1e-3 couple beads " + args, env);
     std::mt19937_64 gen(11);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     for (int k = 0; k < 8; ++k)  // points 2 x 2 x 2 per cell in [0.2, 0.8] x [0.2, 0.8] x [0, 0.5]
