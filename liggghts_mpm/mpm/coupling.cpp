@@ -146,6 +146,10 @@ void FluidSolver::fluid_fraction() {
   if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
   std::fill(g_.sol.begin(), g_.sol.end(), 0.0);
   std::fill(g_.need.begin(), g_.need.end(), 0.0);
+  for (int d = 0; d < 3; ++d) {
+    grain_base_lo_[d] = INT_MAX;
+    grain_base_hi_[d] = INT_MIN;
+  }
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k)) continue;
     check_grain(k);
@@ -153,6 +157,10 @@ void FluidSolver::fluid_fraction() {
     if (!shape_of(x[k], ps)) {
       ps.base[0] = INT_MIN;  // outside the grid: no fluid there
       continue;
+    }
+    for (int d = 0; d < 3; ++d) {
+      grain_base_lo_[d] = std::min(grain_base_lo_[d], ps.base[d]);
+      grain_base_hi_[d] = std::max(grain_base_hi_[d], ps.base[d]);
     }
     const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
     for_nodes(ps, [&](std::size_t n, double w) {
@@ -401,22 +409,8 @@ static IndexBox stencil_box(const int lo[3], const int hi[3], int ns, const Inde
 
 // The smallest box holding b and the boxes of more.
 static IndexBox bounding_box(IndexBox b, const std::vector<IndexBox> &more) {
-  for (const IndexBox &m : more) {
-    if (m.empty()) continue;
-    if (b.empty()) {
-      b = m;
-      continue;
-    }
-    for (int d = 0; d < 3; ++d) {
-      b.lo[d] = std::min(b.lo[d], m.lo[d]);
-      b.hi[d] = std::max(b.hi[d], m.hi[d]);
-    }
-  }
+  for (const IndexBox &m : more) b = b.hull(m);
   return b;
-}
-
-static bool in_box(const IndexBox &b, int i, int j, int k) {
-  return i >= b.lo[0] && i <= b.hi[0] && j >= b.lo[1] && j <= b.hi[1] && k >= b.lo[2] && k <= b.hi[2];
 }
 
 /* Moments of the points' pressures for the linear least-squares fit at each node: with
@@ -535,15 +529,7 @@ void FluidSolver::couple_kernel(double h) {
   }
 
   // the box of the grains' stencils (fluid_fraction found them for this sub-step)
-  int glo[3] = {INT_MAX, INT_MAX, INT_MAX}, ghi[3] = {INT_MIN, INT_MIN, INT_MIN};
-  for (int k = 0; k < nlocal; ++k) {
-    if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
-    for (int d = 0; d < 3; ++d) {
-      glo[d] = std::min(glo[d], grain_shapes_[k].base[d]);
-      ghi[d] = std::max(ghi[d], grain_shapes_[k].base[d]);
-    }
-  }
-  const IndexBox gbox = stencil_box(glo, ghi, NS, grid_.patch());
+  const IndexBox gbox = stencil_box(grain_base_lo_, grain_base_hi_, NS, grid_.patch());
   const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
   // What the grains read (st) is read only at their stencils, here and, through the forward, at
   // the owned nodes of the exchanged boxes, and by the drag exchange below in the same box: st is
@@ -559,7 +545,7 @@ void FluidSolver::couple_kernel(double h) {
   static const double kZeroPfit[PfitRec::N] = {};
   const double mmin = mass_min();
   if (!sbox.empty()) grid_.for_box(sbox, [&](int i, int j, int k, std::size_t n) {
-    const double *c = in_box(rbox, i, j, k) ? &g_.pfit[PfitRec::N * n] : kZeroPfit;
+    const double *c = rbox.contains(i, j, k) ? &g_.pfit[PfitRec::N * n] : kZeroPfit;
     const double *g = &g_.p2g[P2gRec::N * n];
     double *st = &g_.st[StRec::N * n];
     for (int q = 0; q < StRec::N; ++q) st[q] = 0.0;
@@ -676,7 +662,7 @@ void FluidSolver::couple_kernel(double h) {
   // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     double *rx = &g_.rx[3 * n];
-    if (!in_box(dbox, i, j, k)) {  // no grain here: K = 0, J = 0, the record keeps its zeros
+    if (!dbox.contains(i, j, k)) {  // no grain here: K = 0, J = 0, the record keeps its zeros
       rx[0] = rx[1] = rx[2] = 0.0;  // 0 - 0 / h
       return;
     }

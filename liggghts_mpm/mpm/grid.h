@@ -29,6 +29,20 @@ struct IndexBox {
     }
     return r;
   }
+  // the smallest box that holds both (an empty box adds nothing)
+  IndexBox hull(const IndexBox &b) const {
+    if (b.empty()) return *this;
+    if (empty()) return b;
+    IndexBox r;
+    for (int d = 0; d < 3; ++d) {
+      r.lo[d] = std::min(lo[d], b.lo[d]);
+      r.hi[d] = std::max(hi[d], b.hi[d]);
+    }
+    return r;
+  }
+  bool contains(int i, int j, int k) const {
+    return i >= lo[0] && i <= hi[0] && j >= lo[1] && j <= hi[1] && k >= lo[2] && k <= hi[2];
+  }
 };
 
 struct GridSpec {

@@ -219,6 +219,9 @@ class FluidSolver {
   // compute_shapes: the smallest and largest stencil base of this rank's points (INT_MAX / INT_MIN
   // without any), for the projection's work box
   int base_lo_[3] = {0, 0, 0}, base_hi_[3] = {-1, -1, -1};
+  // fluid_fraction: the same for the stencils of this rank's grains inside the grid (couple_kernel's
+  // box of the grains' nodes)
+  int grain_base_lo_[3] = {0, 0, 0}, grain_base_hi_[3] = {-1, -1, -1};
   IndexBox projection_work_box();
   bool grid_ready_ = false;
   bool th_prev_valid_ = false;
