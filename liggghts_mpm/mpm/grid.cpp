@@ -216,13 +216,17 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   }
   if (sendbuf_.size() < std::size_t(soff[np])) sendbuf_.resize(soff[np]);
   if (recvbuf_.size() < std::size_t(roff[np])) recvbuf_.resize(roff[np]);
-  xpos_.assign(soff, soff + np);
-  for (const auto &t : send)
-    if (t.peer != me_) {
-      const IndexBox b = box_of(t);
-      pack(b, sendbuf_.data() + xpos_[t.peer]);
-      xpos_[t.peer] += int(b.count()) * stride;
-    }
+  // each peer's boxes, in list order, at consecutive places of its part of buf (offsets off)
+  auto peer_boxes = [&](const std::vector<Transfer> &list, const int *off, double *buf, auto &&move) {
+    xpos_.assign(off, off + np);
+    for (const auto &t : list)
+      if (t.peer != me_) {
+        const IndexBox b = box_of(t);
+        move(b, buf + xpos_[t.peer]);
+        xpos_[t.peer] += int(b.count()) * stride;
+      }
+  };
+  peer_boxes(send, soff, sendbuf_.data(), pack);
   req_.clear();
   for (int q = 0; q < np; ++q)
     if (recvcount[q] > 0) {
@@ -237,13 +241,7 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   const double tw = MPI_Wtime();
   MPI_Waitall(int(req_.size()), req_.data(), MPI_STATUSES_IGNORE);
   wait_seconds_ += MPI_Wtime() - tw;
-  xpos_.assign(roff, roff + np);
-  for (const auto &t : recv)
-    if (t.peer != me_) {
-      const IndexBox b = box_of(t);
-      unpack(b, recvbuf_.data() + xpos_[t.peer]);
-      xpos_[t.peer] += int(b.count()) * stride;
-    }
+  peer_boxes(recv, roff, recvbuf_.data(), unpack);
 }
 
 std::vector<IndexBox> LocalGrid::exchanged_boxes() const {
