@@ -102,8 +102,11 @@ void Boundaries::add_traction(const Stencil &ps, const double *xp, double V, dou
 void Boundaries::add_face_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g) {
   const GridSpec &gs = opt_->grid;
   const double inv = 1.0 / gs.dx;
+  const std::size_t stride[3] = {1, grid_->stride_y(), grid_->stride_z()};
   for (int d = 0; d < 3; ++d) {
-    if (gs.periodic[d]) continue;
+    // A dimension one cell wide (the slab of a 2-D run) has no node inside its walls: both are
+    // face nodes, whose velocity along d the wall condition sets to 0 whatever force they get.
+    if (gs.periodic[d] || gs.ncell[d] < 2) continue;
     const double xi = (xp[d] - gs.origin[d]) * inv;
     int node, dir;
     if (xi < 1.0) {
@@ -116,14 +119,16 @@ void Boundaries::add_face_traction(const Stencil &ps, const double *xp, double V
       continue;
     const int e = (d + 1) % 3, f = (d + 2) % 3;
     const double push = face_traction_push(dir, p, V, inv);
-    for (int b = 0; b < 3; ++b)
+    // the node's flat index from the stencil's: node - base along d, the stencil's planes along
+    // e and f (those with weight exactly 0, as for_stencil leaves out, would add only zeros)
+    const std::size_t row = ps.n0 + static_cast<std::size_t>(node - ps.base[d]) * stride[d];
+    for (int b = 0; b < 3; ++b) {
+      if (ps.w[e][b] == 0.0) continue;
       for (int c = 0; c < 3; ++c) {
-        int idx[3];
-        idx[d] = node;
-        idx[e] = ps.base[e] + b;
-        idx[f] = ps.base[f] + c;
-        p2g[P2gRec::N * grid_->index(idx[0], idx[1], idx[2]) + P2gRec::F + d] += push * ps.w[e][b] * ps.w[f][c];
+        if (ps.w[f][c] == 0.0) continue;
+        p2g[P2gRec::N * (row + b * stride[e] + c * stride[f]) + P2gRec::F + d] += push * ps.w[e][b] * ps.w[f][c];
       }
+    }
   }
 }
 
