@@ -44,18 +44,18 @@ void FluidSolver::p2g_kernel(Fn &&after_point) {
     const Row4 mv = {m, m * v[i][0], m * v[i][1], m * v[i][2]};
     const Row4 fe = {f[i][0], f[i][1], f[i][2], 0.0};
     const Row4 sx = {sxx, sxy, sxz, 0.0}, sy_ = {sxy, syy, syz, 0.0}, sz_ = {sxz, syz, szz, 0.0};
-    double mC[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, o[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    // APIC: the affine momentum in the momentum lanes 1..3 of the row
+    Row4 col[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
+    double o[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
     if (P::apic) {
+      double mC[9];
       for (int c = 0; c < 9; ++c) mC[c] = m * s[C_AFF + c];
+      affine_columns(mC, 1, col);
       stencil_offsets(opt.grid, ps, x[i], o);
     }
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double gx, double gy, double gz) {
       Row4 u = mv;
-      if (P::apic) {
-        double d[3];
-        affine_momentum(mC, o, a, b, c, d);
-        for (int r = 0; r < 3; ++r) u[1 + r] += d[r];
-      }
+      if (P::apic) u = mv + affine_row(col, o, a, b, c);
       double *gn = g + P2gRec::N * n;
       row4(gn + P2gRec::M) += w * u;
       row4(gn + P2gRec::F) += w * fe + gx * sx + gy * sy_ + gz * sz_;
@@ -169,18 +169,17 @@ void FluidSolver::musl_scatter() {
     const double *s = pts.state[i];
     const double m = rmass[i];
     const Row4 mv = {m * v[i][0], m * v[i][1], m * v[i][2], 0.0};
-    double mC[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, o[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
+    Row4 col[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};
+    double o[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
     if (P::apic) {
+      double mC[9];
       for (int c = 0; c < 9; ++c) mC[c] = m * s[C_AFF + c];
+      affine_columns(mC, 0, col);
       stencil_offsets(opt.grid, ps, x[i], o);
     }
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
       Row4 u = mv;
-      if (P::apic) {
-        double d[3];
-        affine_momentum(mC, o, a, b, c, d);
-        for (int r = 0; r < 3; ++r) u[r] += d[r];
-      }
+      if (P::apic) u = mv + affine_row(col, o, a, b, c);
       row4(ga + AuxRec::N * n + AuxRec::U) += w * u;
     });
   }

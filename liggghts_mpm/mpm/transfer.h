@@ -55,4 +55,18 @@ inline void affine_momentum(const double mC[9], const double o[3][3], int a, int
   for (int r = 0; r < 3; ++r) d[r] = mC[3 * r] * ox + mC[3 * r + 1] * oy + mC[3 * r + 2] * oz;
 }
 
+// The same as three 4-wide columns, the momentum's components in lanes lane0 .. lane0 + 2 (the
+// other lane 0): col[e][lane0 + r] = mC[3 r + e], so that the node's affine momentum is
+// o[0][a] col[0] + o[1][b] col[1] + o[2][c] col[2] (affine_row), each lane the sum of
+// affine_momentum in the same order.
+inline void affine_columns(const double mC[9], int lane0, Row4 col[3]) {
+  for (int e = 0; e < 3; ++e) {
+    col[e] = Row4{0, 0, 0, 0};
+    for (int r = 0; r < 3; ++r) col[e][lane0 + r] = mC[3 * r + e];
+  }
+}
+inline Row4 affine_row(const Row4 col[3], const double o[3][3], int a, int b, int c) {
+  return o[0][a] * col[0] + o[1][b] * col[1] + o[2][c] * col[2];
+}
+
 }  // namespace mpm

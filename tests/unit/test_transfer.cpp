@@ -15,6 +15,7 @@
 
 #include "mpm/options.h"
 #include "mpm/solver.h"
+#include "mpm/transfer.h"
 
 namespace {
 
@@ -216,6 +217,33 @@ TEST(TransferReference, G2pBSplineApic) { check_g2p("shape bspline2 transfer api
 TEST(TransferReference, G2pBSplineFlip) { check_g2p("shape bspline2 transfer flip 0.9 update usl"); }
 TEST(TransferReference, G2pLinearApic) { check_g2p("shape linear transfer apic"); }
 TEST(TransferReference, G2pLinearPic) { check_g2p("shape linear transfer pic update usl"); }
+
+// The 4-wide affine momentum of P2G and the MUSL remap (affine_row, in lanes 1..3 and 0..2) holds
+// in each lane the scalar sum of affine_momentum, bit for bit (the kernels' outputs did not change
+// when the rows replaced the scalar form); the unused lane is 0.
+TEST(TransferReference, AffineRowIsTheScalarSum) {
+  std::mt19937 gen(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    double mC[9], o[3][3];
+    for (double &c : mC) c = 1e3 * u(gen);
+    for (auto &row : o)
+      for (double &x : row) x = 0.01 * u(gen);
+    for (int lane0 = 0; lane0 <= 1; ++lane0) {
+      mpm::Row4 col[3];
+      mpm::affine_columns(mC, lane0, col);
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          for (int c = 0; c < 3; ++c) {
+            double d[3];
+            mpm::affine_momentum(mC, o, a, b, c, d);
+            const mpm::Row4 r = mpm::affine_row(col, o, a, b, c);
+            for (int q = 0; q < 3; ++q) EXPECT_EQ(r[lane0 + q], d[q]);
+            EXPECT_EQ(r[lane0 == 0 ? 3 : 0], 0.0);
+          }
+    }
+  }
+}
 
 // ---- the coupling's node scratch (coupling.cpp) ----
 // couple_kernel keeps pfit and dr at 0 between calls and clears only the nodes it wrote (the
