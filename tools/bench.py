@@ -110,13 +110,19 @@ def lig(a, np_):
 
 # ---------------------------------------------------------------- 3-D pure-fluid dam break
 
+REBAL = 50  # fix balance/mpm ... every REBAL measured yes in the balanced runs
+
+
 def mpm_run(a, cells, np_, balance, nsteps, tag, rss=False, h5every=0, pressure="eos"):
     d = os.path.join(a.out, "mpm3d", tag)
     shutil.rmtree(d, ignore_errors=True)
     cmd = lig(a, np_) + ["-in", os.path.join(TOP, "inputs", "bench", "in.dambreak3d"), "-echo", "none",
                          "-var", "cells", str(cells), "-var", "nsteps", str(nsteps), "-var", "warm", "10",
                          "-var", "balance", str(balance), "-var", "h5every", str(h5every),
-                         "-var", "pressure", pressure, "-var", "measured", "yes" if balance else "no"]
+                         "-var", "pressure", pressure, "-var", "measured", "yes" if balance else "no",
+                         # balanced runs re-cut every REBAL steps by the work measured since the last cut, so
+                         # that a cut from a disturbed warm-up does not stay for the whole timed run
+                         "-var", "rebal", str(REBAL if balance else 0)]
     wall, out, peak = run(cmd, d, rss=rss)
     lt = loop_times(out)
     points = int(re.search(r"created (\d+) material points", out).group(1))
@@ -191,7 +197,8 @@ def section_mpm(a):
         add("mpm_point_steps_per_s_%dranks%s" % (a.np, sfx), sb["point_steps_per_s"], "point-steps/s",
             note + ", %d ranks, fix balance/mpm (loop s %s)" % (a.np, sb.get("repeats_loop_s", "%.3f" % sb["loop_s"])))
         add("mpm_parallel_efficiency_%dranks%s" % (a.np, sfx), eff_b, "0..1",
-            note + ", fix balance/mpm measured yes (cut at the setup of the timed run by the work measured in the warm-up)")
+            note + ", fix balance/mpm measured yes (cut at the setup of the timed run by the work measured in the warm-up "
+            "and every %d steps by the work since the last cut)" % REBAL)
         add("mpm_parallel_efficiency_%dranks_uniform%s" % (a.np, sfx), eff_u, "0..1",
             "%d points, %d steps, uniform LIGGGHTS cuts (all points on one rank), one run" % (s1["points"], nsteps))
         add("mpm_memory_per_point" + sfx, mem, "bytes/point",
