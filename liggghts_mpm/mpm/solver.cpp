@@ -97,6 +97,18 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
     proj_iterations_before_ += proj_->iterations_summed();
   }
   grid_.setup(opt.grid, comm_, sublo, subhi, halo);
+  {
+    const GridSpec &gs = opt.grid;
+    ShapeCtx &c = shape_ctx_;
+    c.inv = 1.0 / gs.dx;
+    for (int d = 0; d < 3; ++d) {
+      c.origin[d] = gs.origin[d];
+      c.ncell[d] = gs.ncell[d];
+      c.periodic[d] = gs.periodic[d];
+      c.lo[d] = grid_.patch().lo[d];
+      c.hi[d] = grid_.patch().hi[d];
+    }
+  }
   g_.assign(grid_.size(), opt.musl, opt.coupled, opt.theta_transport);
   // the sparse grid covers the fluid's own phases, also with couple and with the projection: the
   // coupling reads the fluid's arrays (zero outside the active blocks, as on the dense grid) and
@@ -193,11 +205,12 @@ void FluidSolver::compute_shapes() {
   const bool sparse = sparse_;
   const IndexBox &pb = grid_.patch();
   const int lo0 = pb.lo[0], lo1 = pb.lo[1], lo2 = pb.lo[2];
+  const bool quad = opt.shape == ShapeKind::QuadraticBSpline;
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
     plist_.push_back(i);
     check_point(i);
-    if (shape_of(x[i], shapes_[i])) {
+    if (quad ? shape_at<true>(x[i], shapes_[i]) : shape_at<false>(x[i], shapes_[i])) {
       const int *b = shapes_[i].base;
       for (int d = 0; d < 3; ++d) {
         base_lo_[d] = std::min(base_lo_[d], b[d]);
@@ -256,7 +269,7 @@ long FluidSolver::nonzero_outside_active() const {
 }
 
 // What the step reads of point i (position, velocity, mass) is finite, the mass positive.
-void FluidSolver::check_point(int i) const {
+void FluidSolver::bad_point(int i) const {
   const double *x = pts.x[i], *v = pts.v[i];
   const char *what = nullptr;
   if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))) what = "position";
@@ -273,29 +286,40 @@ void FluidSolver::check_point(int i) const {
 
 // Weights and gradients of the nodes around x; false if x is outside the grid.
 bool FluidSolver::shape_of(const double *x, Stencil &ps) {
-  const GridSpec &gs = opt.grid;
-  const int ns = support(opt.shape);
-  const double inv = 1.0 / gs.dx;
-  const IndexBox &pb = grid_.patch();
+  return opt.shape == ShapeKind::QuadraticBSpline ? shape_at<true>(x, ps) : shape_at<false>(x, ps);
+}
+
+// (shape_functions.h's shape_eval for one kind, the weights and gradients written straight into
+// the stencil; the same operations, so the same values)
+template <bool QUAD>
+bool FluidSolver::shape_at(const double *x, Stencil &ps) const {
+  const ShapeCtx &c = shape_ctx_;
+  const double inv = c.inv;
+  constexpr int ns = QUAD ? 3 : 2;
   for (int d = 0; d < 3; ++d) {
-    const double xi = (x[d] - gs.origin[d]) * inv;
-    if (!gs.periodic[d] && (xi < 0.0 || xi > gs.ncell[d])) return false;
+    const double xi = (x[d] - c.origin[d]) * inv;
+    if (!c.periodic[d] && (xi < 0.0 || xi > c.ncell[d])) return false;
     Shape1D s;
-    shape_eval(opt.shape, xi, s);
+    if (QUAD)
+      shape_bspline2(xi, s);
+    else
+      shape_linear(xi, s);
     ps.base[d] = s.base;
     for (int a = 0; a < 3; ++a) {
       ps.w[d][a] = s.w[a];
       ps.dw[d][a] = s.dw[a] * inv;
     }
-    if (s.base < pb.lo[d] || s.base + ns - 1 > pb.hi[d]) {
-      std::ostringstream os;
-      os << "Fix mpm/fluid: atom at (" << x[0] << ", " << x[1] << ", " << x[2] << ") is outside the grid patch of rank "
-         << me_ << "; it moved too far between re-neighbourings (use neigh_modify every 1 check yes)";
-      throw LocalError(os.str());
-    }
+    if (s.base < c.lo[d] || s.base + ns - 1 > c.hi[d]) outside_patch(x);
   }
   ps.n0 = grid_.index(ps.base[0], ps.base[1], ps.base[2]);
   return true;
+}
+
+void FluidSolver::outside_patch(const double *x) const {
+  std::ostringstream os;
+  os << "Fix mpm/fluid: atom at (" << x[0] << ", " << x[1] << ", " << x[2] << ") is outside the grid patch of rank "
+     << me_ << "; it moved too far between re-neighbourings (use neigh_modify every 1 check yes)";
+  throw LocalError(os.str());
 }
 
 /* grid momentum update (8-35), velocity (8-36), boundary conditions */

@@ -197,6 +197,17 @@ class FluidSolver {
   }
 
   bool shape_of(const double *x, Stencil &ps);
+  // shape_of for one kind of shape function (QUAD: quadratic B-spline, else linear), with the grid's
+  // constants taken once per grid set-up (shape_ctx_)
+  template <bool QUAD> bool shape_at(const double *x, Stencil &ps) const;
+  [[noreturn]] void outside_patch(const double *x) const;
+  struct ShapeCtx {
+    double inv = 0.0;         // 1 / dx
+    double origin[3] = {0, 0, 0};
+    double ncell[3] = {0, 0, 0};
+    bool periodic[3] = {false, false, false};
+    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // the patch; a stencil's last node within hi
+  } shape_ctx_;
   // anti-locking: the node index of the cell that holds point i (clamped at non-periodic faces)
   std::size_t cell_node(int i) const;
   // anti-locking: point i's share of its cell's sums (CellRec) for the stress update, velocity
@@ -248,7 +259,16 @@ class FluidSolver {
   double rho_range_[2] = {0.0, 0.0};  // lowest and highest density of the points at the last check
   bool density_warned_ = false;       // density_warning() given in this run
   std::string density_warning();
-  void check_point(int i) const;      // finite position, velocity, mass (compute_shapes)
+  // finite position, velocity, mass (compute_shapes): q - q is 0 for a finite q and NaN for an
+  // infinite or NaN one, one test for the usual case (the build does not assume finite math);
+  // bad_point names the first bad value
+  void check_point(int i) const {
+    const double *x = pts.x[i], *v = pts.v[i];
+    const double m = pts.rmass[i];
+    const double z = ((x[0] - x[0]) + (x[1] - x[1]) + (x[2] - x[2])) + ((v[0] - v[0]) + (v[1] - v[1]) + (v[2] - v[2])) + (m - m);
+    if (!(z == 0.0 && m > 0.0)) bad_point(i);
+  }
+  void bad_point(int i) const;
   void check_grain(int k) const;      // finite position, velocity, radius, mass (fluid_fraction)
   std::unique_ptr<Hdf5Series> series_;
   std::unique_ptr<Projection> proj_;  // pressure projection (opt.projection)
