@@ -87,11 +87,6 @@ bool Boundaries::near_wall(const double *x) {
   return near_[node_walls(c[0], c[1], c[2])] != 0;
 }
 
-void Boundaries::add_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g) {
-  add_face_traction(ps, xp, V, p, p2g);
-  if (walls_) add_mesh_traction(xp, V, p, p2g);
-}
-
 /* Wall traction, the boundary term (8-23) f_j = int_wall S_j sigma n ds, for the quadratic
    B-spline. Its shape function of the first node inside a wall is 1/8 on the wall, so that node
    must carry 1/8 of the wall's pressure push; the internal force (8-24) alone pulls it towards the

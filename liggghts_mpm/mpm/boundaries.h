@@ -35,7 +35,19 @@ class Boundaries {
   void apply(double *vel, int i, int j, int k, double h);
   // (8-23) of one point (P2G, after its own scatter so that each node sums in point order):
   // grid faces and mesh walls, into the force rows of the P2G records.
-  void add_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g);
+  void add_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g) {
+    if (near_grid_face(ps)) add_face_traction(ps, xp, V, p, p2g);
+    if (walls_) add_mesh_traction(xp, V, p, p2g);
+  }
+  // False only if the point of stencil ps is more than a cell from every grid face that gets a
+  // traction (add_face_traction): its quadratic B-spline base node b = floor(xi + 1/2) - 1 is 0 or
+  // less for xi < 1 and ncell - 2 or more for xi > ncell - 1.
+  bool near_grid_face(const Stencil &ps) const {
+    const GridSpec &gs = opt_->grid;
+    for (int d = 0; d < 3; ++d)
+      if (!gs.periodic[d] && gs.ncell[d] >= 2 && (ps.base[d] < 1 || ps.base[d] > gs.ncell[d] - 3)) return true;
+    return false;
+  }
   // A point moved from xold to x: put back on the fluid side of a mesh wall, a grid face or the
   // closed gate. Returns the number of corrections.
   int put_back(double x[3], double v[3], const double xold[3]);

@@ -10,6 +10,9 @@
 #include <cmath>
 #include <vector>
 
+#include <random>
+
+#include "mpm/boundaries.h"
 #include "mpm/shape_functions.h"
 #include "mpm/stencil.h"
 
@@ -111,3 +114,39 @@ TEST(Row4, ArithmeticMatchesScalarsOnUnalignedRecords) {
 }
 
 }  // namespace
+
+// Boundaries::near_grid_face, the early-out of the grid-face traction, is false only for points
+// more than a cell from every non-periodic face along which add_face_traction pushes (dimensions of
+// two cells or more): random points and the cells' edges, quadratic B-spline bases.
+TEST(WallTraction, NearGridFaceNeverMissesAPointWithinACell) {
+  mpm::Options o;
+  o.grid.ncell[0] = 7;
+  o.grid.ncell[1] = 1;  // a slab: no traction along y
+  o.grid.ncell[2] = 2;
+  o.grid.periodic[0] = o.grid.periodic[1] = o.grid.periodic[2] = false;
+  mpm::Boundaries bc;
+  bc.setup(&o, nullptr);
+  std::mt19937 gen(3);
+  std::vector<double> xs = {0.0, 0.5, 0.999999, 1.0, 1.5, 2.0, 5.0, 5.5, 6.0, 6.000001, 6.5, 7.0};
+  for (int t = 0; t < 2000; ++t) xs.push_back(std::uniform_real_distribution<double>(0.0, 7.0)(gen));
+  long far = 0;
+  for (double xi : xs) {
+    mpm::Stencil ps{};
+    mpm::Shape1D s;
+    mpm::shape_bspline2(xi, s);
+    ps.base[0] = s.base;
+    ps.base[1] = 0;
+    mpm::shape_bspline2(1.0, s);  // z: the middle node of two cells, within a cell of both faces
+    ps.base[2] = s.base;
+    EXPECT_TRUE(bc.near_grid_face(ps)) << "z within a cell of both faces";
+    ps.base[2] = 100;  // a z the test takes out of play: x alone decides
+    o.grid.ncell[2] = 1000;
+    const bool near_x = xi < 1.0 || xi > 6.0;
+    if (near_x) EXPECT_TRUE(bc.near_grid_face(ps)) << "xi = " << xi;
+    far += !bc.near_grid_face(ps);
+    o.grid.ncell[2] = 2;
+  }
+  EXPECT_GT(far, 1000);  // and it does skip the interior
+}
+
+
