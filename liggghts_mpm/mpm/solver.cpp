@@ -496,11 +496,24 @@ void FluidSolver::update_stress(double h, bool theta_only) {
    by less than a cell is put back on the fluid side */
 void FluidSolver::advance_positions(double h) {
   double **x = pts.x, **v = pts.v;
+  // without mesh walls and gate, a point inside the grid's box along every non-periodic dimension
+  // has nothing to be put back from (Boundaries::put_back would change nothing): tested here
+  const GridSpec &gs = opt.grid;
+  const bool box_only = !bc.has_walls() && !opt.gate.active;
+  double lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = gs.periodic[d] ? -HUGE_VAL : gs.origin[d];
+    hi[d] = gs.periodic[d] ? HUGE_VAL : gs.upper(d);
+  }
   for (int i = 0; i < pts.nlocal; ++i) {
     if (!is_point(i)) continue;
-    const double xold[3] = {x[i][0], x[i][1], x[i][2]};
-    for (int d = 0; d < 3; ++d) x[i][d] += h * vpic_[3 * i + d];
-    state.n_clamped += bc.put_back(x[i], v[i], xold);
+    double *xi = x[i];
+    const double xold[3] = {xi[0], xi[1], xi[2]};
+    for (int d = 0; d < 3; ++d) xi[d] += h * vpic_[3 * i + d];
+    if (box_only && xi[0] >= lo[0] && xi[0] <= hi[0] && xi[1] >= lo[1] && xi[1] <= hi[1] && xi[2] >= lo[2] &&
+        xi[2] <= hi[2])
+      continue;
+    state.n_clamped += bc.put_back(xi, v[i], xold);
   }
 }
 
