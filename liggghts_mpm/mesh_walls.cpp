@@ -73,7 +73,7 @@ void *MeshWalls::resolve(int k) const {
 // ---------------------------------------------------------------------------------------------
 // Gathering
 
-void MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], double margin) {
+bool MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], double margin) {
   MPI_Comm world = lmp_->world;
   int me = 0, nprocs = 1;
   MPI_Comm_rank(world, &me);
@@ -179,7 +179,7 @@ void MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
     t.key = static_cast<long long>(r[19]) * 27 + static_cast<long long>(r[20]);
     if (WallGeometry::finish_tri(t)) tris.push_back(t);  // degenerate (zero area) ones are dropped
   }
-  geo_.set_triangles(std::move(tris), mybox, margin);
+  return geo_.set_triangles(std::move(tris), mybox, margin);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -34,7 +34,9 @@ class MeshWalls {
   // of the first and last patch nodes), from the ranks that own them, including periodic images.
   // A rank with an empty patch passes lo > hi in any dimension. Re-looks the fixes up by ID (throws
   // if one was deleted). Call once per fluid sub-step (after the meshes moved, before the grid BCs).
-  void refresh(const double patch_lo[3], const double patch_hi[3], double margin);
+  // Returns false if this rank's triangles, box and margin are those of the last call to the bit
+  // (WallGeometry::set_triangles).
+  bool refresh(const double patch_lo[3], const double patch_hi[3], double margin);
 
   // Collective. For every mesh with side SIDE_AUTO: the points x[0..n-1] vote
   // (WallGeometry::side_votes); the majority over all ranks fixes the side. Throws if a mesh gets

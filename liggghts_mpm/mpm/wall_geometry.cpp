@@ -3,6 +3,7 @@
 #include "mpm/wall_geometry.h"
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -93,15 +94,28 @@ WallGeometry::WallGeometry(std::vector<WallSpec> walls) : walls_(std::move(walls
 // ---------------------------------------------------------------------------------------------
 // Triangles and bins
 
-void WallGeometry::set_triangles(std::vector<Tri> tris, const double box[6], double margin) {
-  tris_ = std::move(tris);
-  margin_ = std::max(0.0, margin);
+// The same triangle to the bit (positions, velocities, normal, bounds, wall, key).
+static bool same_tri(const WallGeometry::Tri &a, const WallGeometry::Tri &b) {
+  static_assert(sizeof(a.p) + sizeof(a.w) + sizeof(a.n) + sizeof(a.lo) + sizeof(a.hi) == 27 * sizeof(double),
+                "Tri's leading doubles");
+  return a.mesh == b.mesh && a.key == b.key && std::memcmp(&a.p[0][0], &b.p[0][0], 27 * sizeof(double)) == 0;
+}
+
+bool WallGeometry::set_triangles(std::vector<Tri> tris, const double box[6], double margin) {
+  margin = std::max(0.0, margin);
   // A fixed order (mesh, triangle ID, image), whatever the ranks: where triangles with different
   // wall velocities act on one node (a rotating mesh), the last one applied wins, so the result
   // must not depend on the decomposition.
-  std::sort(tris_.begin(), tris_.end(), [](const Tri &a, const Tri &b) {
+  std::sort(tris.begin(), tris.end(), [](const Tri &a, const Tri &b) {
     return a.mesh != b.mesh ? a.mesh < b.mesh : a.key < b.key;
   });
+  if (have_set_ && margin == margin_ && std::memcmp(box, box_, sizeof(box_)) == 0 && tris.size() == tris_.size() &&
+      std::equal(tris.begin(), tris.end(), tris_.begin(), same_tri))
+    return false;
+  have_set_ = true;
+  std::memcpy(box_, box, sizeof(box_));
+  tris_ = std::move(tris);
+  margin_ = margin;
 
   // bins over my box
   for (int d = 0; d < 3; ++d) {
@@ -110,6 +124,7 @@ void WallGeometry::set_triangles(std::vector<Tri> tris, const double box[6], dou
   }
   bins_.clear();
   if (box[0] <= box[3] && box[1] <= box[4] && box[2] <= box[5]) bins_build(box);
+  return true;
 }
 
 void WallGeometry::bins_build(const double box[6]) {

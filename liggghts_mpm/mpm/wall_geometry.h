@@ -101,8 +101,10 @@ class WallGeometry {
   static bool finish_tri(Tri &t);
   // Replaces the triangles (finished, t.mesh < number of walls). Queries within 'margin' of the
   // box [box[0..2], box[3..5]] use bins (an empty box, lo > hi in some dimension: no bins, every
-  // query scans all triangles).
-  void set_triangles(std::vector<Tri> tris, const double box[6], double margin);
+  // query scans all triangles). Returns false, and keeps what it has, if the triangles (after
+  // sorting), the box and the margin are those of the last call to the bit: walls at rest need no
+  // new constraints at the nodes.
+  bool set_triangles(std::vector<Tri> tris, const double box[6], double margin);
 
   // Applies the wall condition to the velocity vel of a grid node at x, for every triangle within
   // 'reach' of x on its fluid side, or within 'reach_behind' (default: reach) of x behind it
@@ -184,6 +186,8 @@ class WallGeometry {
   std::vector<Tri> tris_;
   bool use_bins_ = true;
   double margin_ = 0.0;
+  double box_[6] = {0, 0, 0, 0, 0, 0};  // of the last set_triangles
+  bool have_set_ = false;
   double nu_ = 0.0;  // kinematic viscosity (shear walls)
   // uniform bins over [blo_, blo_ + nb_*bsize_]
   double blo_[3] = {0, 0, 0}, bsize_ = 1.0;

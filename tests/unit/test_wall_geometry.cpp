@@ -389,3 +389,28 @@ TEST(WallGeometry, CrossingCarriesTheNormalVelocityOnly) {
   double wd = 99.0;
   EXPECT_FALSE(g.crosses(x, 1, 0.1, &wd));  // parallel to the wall
 }
+
+// set_triangles reports whether anything changed (the fix then keeps the nodes' wall constraints
+// for walls at rest): the same triangles in another order, box and margin: no change; a node moved
+// by one ulp, a node velocity, the box or the margin: a change.
+TEST(WallGeometry, SetTrianglesReportsChange) {
+  const double w0[3] = {0.0, 0.0, 0.0};
+  WallGeometry g({wall(mpm::WALL_NOSLIP)});
+  std::vector<Tri> t = plate(0.5, w0);
+  EXPECT_TRUE(g.set_triangles(t, kBox, 0.1));  // the first set
+  std::vector<Tri> r(t.rbegin(), t.rend());
+  EXPECT_FALSE(g.set_triangles(r, kBox, 0.1));  // sorted, it is the same set
+  std::vector<Tri> moved = t;
+  moved[1].p[2][2] = std::nextafter(moved[1].p[2][2], 1.0);
+  EXPECT_TRUE(g.set_triangles(moved, kBox, 0.1));
+  EXPECT_FALSE(g.set_triangles(moved, kBox, 0.1));
+  std::vector<Tri> faster = moved;
+  faster[0].w[0][0] = 1e-12;
+  EXPECT_TRUE(g.set_triangles(faster, kBox, 0.1));
+  const double box2[6] = {-0.5, -0.5, -0.5, 1.5, 1.5, 1.25};
+  EXPECT_TRUE(g.set_triangles(faster, box2, 0.1));
+  EXPECT_TRUE(g.set_triangles(faster, box2, 0.2));
+  EXPECT_FALSE(g.set_triangles(faster, box2, 0.2));
+  EXPECT_TRUE(g.set_triangles({faster[0]}, box2, 0.2));  // a triangle fewer
+  EXPECT_EQ(g.gathered(), 1);
+}
