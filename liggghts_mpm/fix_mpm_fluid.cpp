@@ -189,15 +189,14 @@ void FixMpmFluid::refresh_walls() {
   } catch (const std::exception &e) {
     error->all(FLERR, e.what());
   }
-  // walls at rest on an unchanged grid patch keep the constraints the nodes collected
-  if (changed || walls_stale) solver->bc.walls_moved();
-  walls_stale = false;
+  // walls at rest keep the constraints the nodes collected (a new grid patch renews them:
+  // FluidSolver::setup_grid)
+  if (changed) solver->bc.walls_moved();
 }
 
 void FixMpmFluid::setup(int) {
   mpm::FluidSolver &s = sync();
   s.setup_grid(domain->sublo, domain->subhi, neighbor->skin);
-  walls_stale = true;  // the nodes' wall constraints are indexed by the patch
   if (!mesh_specs.empty()) {
     try {
       std::vector<mpm::MeshWallSpec> sp = mesh_specs;  // sides found in an earlier run are kept
@@ -216,7 +215,7 @@ void FixMpmFluid::setup(int) {
     } catch (const std::exception &e) {
       error->all(FLERR, (std::string("Fix mpm/fluid: ") + e.what()).c_str());
     }
-    walls_stale = true;  // the sides are set now: the first step collects the constraints anew
+    s.bc.walls_moved();  // the constraints depend on the sides set now
   }
   guarded([&] {
     s.setup_coupling();
@@ -294,7 +293,6 @@ void FixMpmFluid::pre_final_integrate() {
     // a new grid patch inside a run (fix balance/mpm every N): as at the setup of a run, the
     // projection's last solve goes on into it and theta_transport takes its nodal reference again
     s.setup_grid(domain->sublo, domain->subhi, neighbor->skin);
-    walls_stale = true;  // the nodes' wall constraints are indexed by the patch
     guarded([&] { s.setup_coupling(); });
   }
   mpm::Gate &gate = s.opt.gate;

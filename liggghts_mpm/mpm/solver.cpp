@@ -110,6 +110,7 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
     }
   }
   g_.assign(grid_.size(), opt.musl, opt.coupled, opt.theta_transport);
+  bc.walls_moved();  // the nodes' mesh-wall constraints are indexed by the patch
   // the sparse grid covers the fluid's own phases, also with couple and with the projection: the
   // coupling reads the fluid's arrays (zero outside the active blocks, as on the dense grid) and
   // writes only its own, which its phases sweep on the whole patch; the projection writes the
