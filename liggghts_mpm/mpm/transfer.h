@@ -49,16 +49,10 @@ inline void stencil_offsets(const GridSpec &gs, const Stencil &ps, const double 
 }
 
 // APIC: the affine part m C (x_i - x_p) of the momentum a point gives node (a, b, c) of its
-// stencil, from mC = m C (row-major) and the node-plane offsets o.
-inline void affine_momentum(const double mC[9], const double o[3][3], int a, int b, int c, double d[3]) {
-  const double ox = o[0][a], oy = o[1][b], oz = o[2][c];
-  for (int r = 0; r < 3; ++r) d[r] = mC[3 * r] * ox + mC[3 * r + 1] * oy + mC[3 * r + 2] * oz;
-}
-
-// The same as three 4-wide columns, the momentum's components in lanes lane0 .. lane0 + 2 (the
-// other lane 0): col[e][lane0 + r] = mC[3 r + e], so that the node's affine momentum is
-// o[0][a] col[0] + o[1][b] col[1] + o[2][c] col[2] (affine_row), each lane the sum of
-// affine_momentum in the same order.
+// stencil, from mC = m C (row-major) and the node-plane offsets o, as three 4-wide columns, the
+// momentum's components in lanes lane0 .. lane0 + 2 (the other lane 0): col[e][lane0 + r] =
+// mC[3 r + e], so that the node's affine momentum is o[0][a] col[0] + o[1][b] col[1] +
+// o[2][c] col[2] (affine_row), each lane sum_e mC[3 r + e] o[e] in the order e = 0, 1, 2.
 inline void affine_columns(const double mC[9], int lane0, Row4 col[3]) {
   for (int e = 0; e < 3; ++e) {
     col[e] = Row4{0, 0, 0, 0};

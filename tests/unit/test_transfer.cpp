@@ -218,6 +218,12 @@ TEST(TransferReference, G2pBSplineFlip) { check_g2p("shape bspline2 transfer fli
 TEST(TransferReference, G2pLinearApic) { check_g2p("shape linear transfer apic"); }
 TEST(TransferReference, G2pLinearPic) { check_g2p("shape linear transfer pic update usl"); }
 
+// The scalar form the kernels had before the 4-wide rows: d[r] = sum_e mC[3 r + e] o[e][.].
+void affine_momentum(const double mC[9], const double o[3][3], int a, int b, int c, double d[3]) {
+  const double ox = o[0][a], oy = o[1][b], oz = o[2][c];
+  for (int r = 0; r < 3; ++r) d[r] = mC[3 * r] * ox + mC[3 * r + 1] * oy + mC[3 * r + 2] * oz;
+}
+
 // The 4-wide affine momentum of P2G and the MUSL remap (affine_row, in lanes 1..3 and 0..2) holds
 // in each lane the scalar sum of affine_momentum, bit for bit (the kernels' outputs did not change
 // when the rows replaced the scalar form); the unused lane is 0.
@@ -236,7 +242,7 @@ TEST(TransferReference, AffineRowIsTheScalarSum) {
         for (int b = 0; b < 3; ++b)
           for (int c = 0; c < 3; ++c) {
             double d[3];
-            mpm::affine_momentum(mC, o, a, b, c, d);
+            affine_momentum(mC, o, a, b, c, d);
             const mpm::Row4 r = mpm::affine_row(col, o, a, b, c);
             for (int q = 0; q < 3; ++q) EXPECT_EQ(r[lane0 + q], d[q]);
             EXPECT_EQ(r[lane0 == 0 ? 3 : 0], 0.0);
