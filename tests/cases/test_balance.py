@@ -63,8 +63,8 @@ def rebalanced_np2_same(r, group, pressure, tol, more, what):
     if pressure == "projection":
         # the end-of-run line counts every solve of the run, also across the re-cuts (each builds
         # a new patch and pressure solver)
-        s1 = re.findall(r"wall time in this run: fluid \S+ s \(pressure solver \S+ s = \S+ of it, (\d+) solves", p1.stdout)
-        s2 = re.findall(r"wall time in this run: fluid \S+ s \(pressure solver \S+ s = \S+ of it, (\d+) solves", p2.stdout)
+        solves = r"wall time in this run: fluid \S+ s \(pressure solver \S+ s = \S+ of it, (\d+) solves"
+        s1, s2 = re.findall(solves, p1.stdout), re.findall(solves, p2.stdout)
         check(len(s1) == 2 and s1 == s2 and int(s1[-1]) >= 300,
               f"{pressure}: solves per run reported on 2 re-balanced ranks = 1 rank ({s2} and {s1})")
     f1 = read_csv(os.path.join(d1, "bench3d.csv"))
