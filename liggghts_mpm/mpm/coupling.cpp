@@ -87,15 +87,7 @@ double FluidSolver::solid_node_volume(int i, int j, int k) const {
 
 void FluidSolver::setup_coupling() {
   if (!opt.coupled) return;
-  if (!state.theta_initialized) {
-    init_theta();
-  } else if (opt.theta_transport) {
-    // the nodes' fraction of the grains' present positions, from which the next sub-step's
-    // change is taken (the points keep their own theta, also across a restart)
-    compute_shapes();
-    fluid_fraction();
-    refresh_pressure();
-  }
+  if (!state.theta_initialized) init_theta();
 }
 
 // At the first run with grains: the fluid present in a point's volume is theta of it, so its
@@ -189,27 +181,10 @@ void FluidSolver::fluid_fraction() {
   });
   grid_.forward(g_.th.data(), 1);
   const double *const gth = g_.th.data();
-  if (!opt.theta_transport || !state.theta_initialized) {
-    for (const int i : plist_) {
-      double th = 0.0;
-      for_nodes(shapes_[i], [&](std::size_t n, double w) { th += w * gth[n]; });
-      pts.state[i][C_THETA] = th;
-    }
-  } else if (th_prev_valid_) {
-    // theta_transport: the point keeps its own fluid fraction; here it takes the change of the
-    // nodes' fraction since the last sub-step (the grains moved), the fluid's motion enters in
-    // update_stress through the divergence of theta u (docs/fix_mpm_fluid.md)
-    const double *const gprev = g_.th_prev.data();
-    for (const int i : plist_) {
-      double dth = 0.0;
-      for_nodes(shapes_[i], [&](std::size_t n, double w) { dth += w * (gth[n] - gprev[n]); });
-      double *s = pts.state[i];
-      s[C_THETA] = std::min(1.0, std::max(opt.theta_min, s[C_THETA] + dth));
-    }
-  }
-  if (opt.theta_transport) {
-    g_.th_prev = g_.th;
-    th_prev_valid_ = true;
+  for (const int i : plist_) {
+    double th = 0.0;
+    for_nodes(shapes_[i], [&](std::size_t n, double w) { th += w * gth[n]; });
+    pts.state[i][C_THETA] = th;
   }
 }
 
@@ -368,24 +343,6 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
   });
 }
 
-// A node within one node of a grid face of a non-periodic dimension (padding nodes included).
-bool FluidSolver::near_face(int i, int j, int k) const {
-  return near_face_along(0, i) || near_face_along(1, j) || near_face_along(2, k);
-}
-
-// node index idx along d lies within one node of a (non-periodic) grid face
-bool FluidSolver::near_face_along(int d, int idx) const {
-  const GridSpec &gs = opt.grid;
-  return !gs.periodic[d] && (idx <= 1 || idx >= gs.ncell[d] - 1);
-}
-
-// Some node of a stencil of ns nodes per direction from base is near_face.
-bool FluidSolver::near_face(const int base[3], int ns) const {
-  for (int d = 0; d < 3; ++d)  // the stencil's first or last node plane along d
-    if (near_face_along(d, base[d]) || near_face_along(d, base[d] + ns - 1)) return true;
-  return false;
-}
-
 /* a + w v with the rounding of a loop that only sums w v into a: the build with FMA (MPM_SIMD)
    contracts that to one fused multiply-add (the product not rounded), whereas pressure_moments,
    which uses w V for its own sums too, rounds the product once for all of them */
@@ -415,7 +372,7 @@ static IndexBox bounding_box(IndexBox b, const std::vector<IndexBox> &more) {
 
 /* Moments of the points' pressures for the linear least-squares fit at each node: with
    e = (1, x_s - x_j) for the point's sample position x_s, the node collects r = sum S V p e and
-   the normal matrix M = sum S V e e^T (PfitRec). VOL (reaction points with grad_p nodal or fit):
+   the normal matrix M = sum S V e e^T (PfitRec). VOL (reaction points with the fit):
    the same pass also sums the points' volume sum S V at every node of their stencils into rq[3 n]
    (route_reaction), point by point in the order of plist_ as the pass of its own that it replaces
    (point_sums), with the same rounding (add_product): the same sums bit for bit. */
@@ -427,51 +384,25 @@ void FluidSolver::pressure_moments() {
   double *const rq = VOL ? g_.rq.data() : nullptr;
   const double *const need = g_.need.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  const bool nodal = opt.grad_p == GradP::Nodal;
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     const double V = pts.state[i][C_VOL], p = pts.state[i][C_P];
-    if (nodal && !near_face(ps.base, NS)) {
-      // grad_p nodal: only the volume-weighted mean, sum S V p / sum S V
-      for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-        double *cn = g + PfitRec::N * n;
-        const double wV = w * V;
-        cn[PfitRec::R] += wV * p;
-        cn[PfitRec::MAT] += wV;
-        if (VOL) rq[3 * n] = add_product(rq[3 * n], w, V);
-      });
-      continue;
-    }
     const double *xp = x[i];
     // With anti-locking the pressure is the cell's (its mean density): it belongs to the cell's
     // centre, not to the point (a fit to the points' own positions sees a staircase and, near a
     // wall, a flat one).
     double dn[3][3];  // x_s - x_j per direction, for the stencil's node planes
     for (int a = 0; a < 3; ++a) {
-      double xs = xp[a];
-      if (opt.antilock) {
-        int c = static_cast<int>(std::floor((xp[a] - gs.origin[a]) / gs.dx));
-        if (!gs.periodic[a]) c = std::min(std::max(c, 0), gs.ncell[a] - 1);
-        xs = gs.origin[a] + (c + 0.5) * gs.dx;
-      }
+      int c = static_cast<int>(std::floor((xp[a] - gs.origin[a]) / gs.dx));
+      if (!gs.periodic[a]) c = std::min(std::max(c, 0), gs.ncell[a] - 1);
+      const double xs = gs.origin[a] + (c + 0.5) * gs.dx;
       for (int q = 0; q < 3; ++q) dn[a][q] = xs - (gs.origin[a] + (ps.base[a] + q) * gs.dx);
     }
-    // grad_p nodal fits only the nodes near a face (near_face(i, j, k)); the others take the mean
-    // (the fit's first entries r[0] = sum S V p and M[0][0] = sum S V are the same sums)
-    bool nf[3][3];  // node plane q along a is near a face
-    for (int a = 0; a < 3; ++a)
-      for (int q = 0; q < 3; ++q)
-        nf[a][q] = nodal && near_face_along(a, ps.base[a] + q);
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double, double) {
       if (VOL) rq[3 * n] = add_product(rq[3 * n], w, V);  // every node of the stencil, needed or not
       if (need[n] == 0.0) return;
       double *cn = g + PfitRec::N * n;
       const double wV = w * V;
-      if (nodal && !(nf[0][a] || nf[1][b] || nf[2][c])) {
-        cn[PfitRec::R] += wV * p;
-        cn[PfitRec::MAT] += wV;
-        return;
-      }
       const Row4 e = {1.0, dn[0][a], dn[1][b], dn[2][c]};
       const Row4 we = wV * e;
       row4(cn + PfitRec::R) += p * we;
@@ -552,13 +483,7 @@ void FluidSolver::couple_kernel(double h) {
     st[StRec::TH] = g_.th[n];
     st[StRec::P] = !weak && c[PfitRec::MAT] > 0.0 ? c[PfitRec::R] / c[PfitRec::MAT] : 0.0;
     double fit[4];
-    if (opt.grad_p == GradP::Nodal && c[PfitRec::MAT] > 0.0 && g_.need[n] > 0.0 && near_face(i, j, k) &&
-        fit_linear_pressure(c, opt.grid.dx, fit)) {
-      // grad_p nodal next to a grid face: the nodal mean there is the pressure of the points'
-      // centre, up to half a cell off the node (a bed on the floor felt 0.79 of Archimedes); the
-      // value of the node's linear fit is exact for a hydrostatic field
-      st[StRec::P] = fit[0];
-    } else if (opt.grad_p == GradP::Fit && c[PfitRec::MAT] > 0.0 && g_.need[n] > 0.0 && fit_linear_pressure(c, opt.grid.dx, fit)) {
+    if (opt.grad_p == GradP::Fit && c[PfitRec::MAT] > 0.0 && g_.need[n] > 0.0 && fit_linear_pressure(c, opt.grid.dx, fit)) {
       st[StRec::P] = fit[0];
       for (int a = 0; a < 3; ++a) st[StRec::FIT + a] = fit[1 + a];
       st[StRec::FIT + 3] = 1.0;  // the fit (value and gradient) is determined

@@ -29,8 +29,8 @@ struct P2gRec { enum { M = 0, MV = 1, F = 4, N = 8 }; };
 struct VelRec { enum { V_NEW = 0, V_OLD = 4, N = 8 }; };
 // MUSL remap: momentum, then velocity, of the updated points (3), pad
 struct AuxRec { enum { U = 0, N = 4 }; };
-// anti-locking, per cell keyed by its low node: V, V div u, theta V, m, V div(theta u)
-struct CellRec { enum { V = 0, VDIV = 1, THV = 2, M = 3, VDIVTHU = 4, N = 5 }; };
+// anti-locking, per cell keyed by its low node: V, V div u, theta V, m
+struct CellRec { enum { V = 0, VDIV = 1, THV = 2, M = 3, N = 4 }; };
 // coupling, moments of the points' pressure for the node's linear fit: r (4), normal matrix (4 x 4)
 struct PfitRec { enum { R = 0, MAT = 4, N = 20 }; };
 // coupling, what a grain reads (forwarded): fluid velocity (3), 1 if the node holds fluid;
@@ -51,7 +51,6 @@ struct GridFields {
   std::vector<double> th;       // fluid fraction (forwarded)
   std::vector<double> need;     // > 0 where a grain's shape functions reach (reverse-summed)
   std::vector<double> rx;       // force of the grains on the fluid (3), owned nodes
-  std::vector<double> th_prev;  // theta_transport: nodal fraction of the last sub-step
   std::vector<double> phi, phi_new;  // smoothing work arrays
   std::vector<double> vnode;    // smoothing: node volume (solid_node_volume, forwarded), filled on first use
   bool vnode_ready = false;     // (a flag, not vnode.empty(): a rank may have no node, and filling is collective)
@@ -59,17 +58,18 @@ struct GridFields {
   std::vector<double> gw;       // grad_p weak: the fluid's pressure gradient (3), every patch node
   std::vector<double> rp, rq;   // reaction points: the grains' pressure reaction, its density (3)
 
-  void assign(std::size_t nodes, bool musl, bool coupled, bool theta_transport) {
+  // cells: anti-locking (pressure eos); fit: the grains' pressure from the points' least-squares
+  // fit (the text's coupling, model yang2016)
+  void assign(std::size_t nodes, bool musl, bool cells, bool coupled, bool fit) {
     p2g.assign(nodes * P2gRec::N, 0.0);
     vel.assign(nodes * VelRec::N, 0.0);
-    cell.assign(nodes * CellRec::N, 0.0);
+    if (cells) cell.assign(nodes * CellRec::N, 0.0);
     if (musl) aux.assign(nodes * AuxRec::N, 0.0);
     if (coupled) {
-      pfit.assign(nodes * PfitRec::N, 0.0);
+      if (fit) pfit.assign(nodes * PfitRec::N, 0.0);
       sol.assign(nodes, 0.0);
       need.assign(nodes, 0.0);
       th.assign(nodes, 1.0);
-      if (theta_transport) th_prev.assign(nodes, 1.0);
       st.assign(nodes * StRec::N, 0.0);
       rx.assign(nodes * 3, 0.0);
       dr.assign(nodes * DrRec::N, 0.0);

@@ -91,9 +91,10 @@ void parse_transfer(Options &o, Args &a, const ParseEnv &) {
 }
 
 void parse_update(Options &o, Args &a, const ParseEnv &) { choice(a, "musl", "usl", o.musl); }
-void parse_free_surface(Options &o, Args &a, const ParseEnv &) {
-  choice(a, "ghost", "node", o.surface_ghost);
-  o.surface_given = true;
+void parse_model(Options &o, Args &a, const ParseEnv &) {
+  bool standard = true;
+  choice(a, "standard", "yang2016", standard);
+  o.model = standard ? Model::Standard : Model::Yang2016;
 }
 
 // 'multiplier' or 'acceleration' (true) of the projection's pressure kinds
@@ -110,19 +111,6 @@ void parse_grain_pressure(Options &o, Args &a, const ParseEnv &) {
   multiplier_or_acceleration(a, o.grain_pressure_acceleration);
 }
 
-void parse_grad_p(Options &o, Args &a, const ParseEnv &) {
-  a.need(1, "grad_p", "'weak', 'fit' or 'nodal'");
-  if (strcmp(a.at(1), "weak") == 0)
-    o.grad_p = GradP::Weak;
-  else if (strcmp(a.at(1), "fit") == 0)
-    o.grad_p = GradP::Fit;
-  else if (strcmp(a.at(1), "nodal") == 0)
-    o.grad_p = GradP::Nodal;
-  else
-    bad_arg("grad_p", "'weak', 'fit' or 'nodal'", a.at(1));
-  a.iarg += 2;
-}
-void parse_reaction(Options &o, Args &a, const ParseEnv &) { choice(a, "points", "direct", o.reaction_points); }
 
 // boundary FACE KIND [value], also for fix_modify (a.iarg at the keyword)
 void parse_face(Options &o, Args &a) {
@@ -201,7 +189,10 @@ void parse_drag(Options &o, Args &a, const ParseEnv &) {
   a.need(1, "drag", "a drag law ergun_wenyu, difelice or stokes");
   if (!parse_drag_law(a.at(1), o.drag_law)) bad_arg("drag", "a drag law ergun_wenyu, difelice or stokes", a.at(1));
   a.iarg += 2;
-  if (a.iarg < a.narg && parse_drag_form(a.at(0), o.drag_form)) ++a.iarg;
+  DragForm form;
+  if (a.iarg < a.narg && parse_drag_form(a.at(0), form))
+    throw Error(std::string("Fix mpm/fluid: keyword 'drag' takes the law only, got the form '") + a.at(0) +
+                "' after it; the text's literal form belongs to 'model yang2016'");
 }
 
 void parse_pmin(Options &o, Args &a, const ParseEnv &) {
@@ -317,10 +308,9 @@ void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
 
 // Keywords that belong to one pressure model only: an error under the other, naming them.
 void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
-  static const char *const eos_only[] = {"bulk", "eos", "antilock", "pmin"};
-  static const char *const projection_only[] = {"tolerance", "max_iterations", "dtheta_source", "free_surface",
-                                                 "volume_correction", "pressure_average", "pressure_output",
-                                                 "grain_pressure"};
+  static const char *const eos_only[] = {"bulk", "eos", "pmin"};
+  static const char *const projection_only[] = {"tolerance", "max_iterations", "volume_correction",
+                                                 "pressure_average", "pressure_output", "grain_pressure"};
   std::string bad;
   for (const std::string &kw : seen)
     for (const char *w : o.projection ? std::vector<const char *>(std::begin(eos_only), std::end(eos_only))
@@ -329,12 +319,10 @@ void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
   // The ghost-fluid surface finds the surface from the nodal fill, which next to a mesh wall lacks
   // the mass the B-spline puts behind it (no mirror image of a triangle): measured beside a
   // vertical and a 30 degree mesh wall, a column at rest moved at 3.5e-3 and 6.6e-2 m/s after 1 s.
-  if (o.projection && o.surface_ghost && std::find(seen.begin(), seen.end(), "mesh_wall") != seen.end()) {
-    if (o.surface_given)
-      throw Error("Fix mpm/fluid: keyword 'free_surface ghost' does not support keyword 'mesh_wall' yet; use "
-                  "'free_surface node' (the default with mesh walls)");
-    o.surface_ghost = false;
-  }
+  if (o.projection && std::find(seen.begin(), seen.end(), "mesh_wall") != seen.end()) o.surface_ghost = false;
+  if (o.projection && o.model == Model::Yang2016)
+    throw Error("Fix mpm/fluid: keyword 'model yang2016' is the dissertation's weakly compressible model and "
+                "needs 'pressure eos' (with 'bulk'); remove 'pressure projection' or the model");
   if (bad.empty()) return;
   if (o.projection)
     throw Error("Fix mpm/fluid: keyword 'pressure projection' does not use keyword(s) " + bad +
@@ -444,8 +432,8 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_transfer, false},
     {"update", "musl | usl", "-", "", "musl", "'musl' or 'usl'",
      nullptr, 0, 0, false, false, nullptr, parse_update, false},
-    {"antilock", "yes/no", "-", "", "yes", "'yes' or 'no'",
-     nullptr, 0, 0, false, false, &Options::antilock, nullptr, true},
+    {"model", "standard | yang2016", "-", "", "standard", "'standard' or 'yang2016'",
+     nullptr, 0, 0, false, false, nullptr, parse_model, false},
     {"boundary", "face kind [value]", "-", "sticky in [0,1], delta > 0", "all noslip",
      "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip', 'partial f' or 'shear delta'",
      nullptr, 0, 0, false, false, nullptr, parse_boundary, true},
@@ -469,10 +457,6 @@ const std::vector<Keyword> kTable = {
      REAL(pressure_tolerance), 0.0, kInf, true, true, nullptr, nullptr, false},
     {"max_iterations", "integer", "-", ">= 1", "200", "an integer >= 1 (iterations of the pressure solve)",
      nullptr, 0, 0, false, false, nullptr, parse_max_iterations, false},
-    {"dtheta_source", "yes/no", "-", "", "yes", "'yes' or 'no'",
-     nullptr, 0, 0, false, false, &Options::projection_dtheta, nullptr, false},
-    {"free_surface", "ghost | node", "-", "", "ghost (node with mesh_wall)", "'ghost' or 'node'",
-     nullptr, 0, 0, false, false, nullptr, parse_free_surface, false},
     {"volume_correction", "real", "1/time", ">= 0", "0", "a rate (1/time) >= 0 at which compressed points are pushed apart",
      REAL(volume_correction), 0.0, kInf, false, true, nullptr, nullptr, false},
     {"pressure_output", "multiplier | acceleration", "-", "", "multiplier", "'multiplier' or 'acceleration'",
@@ -490,7 +474,7 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_pmin, false},
     {"couple", "group-ID", "-", "an existing group of grains", "none", "the group-ID of the DEM grains",
      nullptr, 0, 0, false, false, nullptr, parse_couple, false},
-    {"drag", "law [consistent | literal]", "-", "ergun_wenyu, difelice, stokes", "ergun_wenyu consistent",
+    {"drag", "law", "-", "ergun_wenyu, difelice, stokes", "ergun_wenyu consistent",
      "a drag law ergun_wenyu, difelice or stokes", nullptr, 0, 0, false, false, nullptr, parse_drag, false},
     {"cell_check", "yes/no", "-", "", "yes", "'yes' or 'no'",
      nullptr, 0, 0, false, false, &Options::cell_check, nullptr, true},
@@ -498,14 +482,6 @@ const std::vector<Keyword> kTable = {
      REAL(theta_min), 0.0, 1.0, true, true, nullptr, nullptr, false},
     {"theta_smooth", "real", "length", ">= 0", "0", "a smoothing length >= 0 for the grains' volume fraction",
      REAL(theta_smooth), 0.0, kInf, false, true, nullptr, nullptr, false},
-    {"wall_traction", "yes/no", "-", "", "yes", "'yes' or 'no'",
-     nullptr, 0, 0, false, false, &Options::wall_traction, nullptr, true},
-    {"theta_transport", "yes/no", "-", "", "no", "'yes' or 'no'",
-     nullptr, 0, 0, false, false, &Options::theta_transport, nullptr, true},
-    {"grad_p", "weak | nodal | fit", "-", "", "weak", "'weak', 'fit' or 'nodal'",
-     nullptr, 0, 0, false, false, nullptr, parse_grad_p, false},
-    {"reaction", "points | direct", "-", "", "points", "'points' or 'direct'",
-     nullptr, 0, 0, false, false, nullptr, parse_reaction, false},
     {"front", "axis", "-", "x, y or z", "x", "an axis x, y or z",
      nullptr, 0, 0, false, false, nullptr, parse_front, false},
     {"height", "axis wall-axis wall-position", "length", "two different axes", "z x (grid's low x)",
@@ -580,6 +556,11 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
   // grain_pressure: the pressure the grains feel; without grains there is none to choose (and the
   // default acceleration would cost a second solve for nothing)
   if (!o.projection) o.grain_pressure_acceleration = false;  // the keyword itself: an error above
+  // the model's coupling forms
+  const bool text = o.model == Model::Yang2016;
+  o.grad_p = text ? GradP::Fit : GradP::Weak;
+  o.reaction_points = !text;
+  o.drag_form = text ? DragForm::Literal : DragForm::Consistent;
   if (!o.coupled) {
     if (std::find(seen.begin(), seen.end(), "grain_pressure") != seen.end())
       throw Error("Fix mpm/fluid: keyword 'grain_pressure' needs keyword 'couple' (the grains that feel the pressure)");

@@ -35,7 +35,12 @@ struct Gate {
   double release_time = -1;  // simulation time of removal; < 0 = only by fix_modify
 };
 enum class Transfer { Apic, Pic, Flip };
-enum class GradP { Weak, Fit, Nodal };  // docs/background/well_balanced.md
+// The coupling's forms (docs/theory): standard, the project's (the grains' pressure force is the
+// gradient the fluid itself feels, its reaction goes through the points that displaced it, the
+// drag's consistent form); yang2016, the dissertation's literal one (the least-squares fitted
+// nodal gradient (8-27), the reaction spread to the nodes (8-26), the drag of (7-7) as written).
+enum class Model { Standard, Yang2016 };
+enum class GradP { Weak, Fit };  // set by the model
 
 struct Options {
   // fluid and grid
@@ -50,17 +55,14 @@ struct Options {
   Transfer transfer = Transfer::Flip;  // the text's MUSL: FLIP velocity (8-40), grid velocity for x (8-41)
   double flip_alpha = 1.0;          // FLIP fraction of a FLIP/PIC blend
   bool musl = true;
-  bool antilock = true;
-  bool wall_traction = true;        // (8-23) at grid-face walls for bspline2
-  // grad p at the grains: the gradient the fluid feels at the nodes, -(internal force)/volume
-  // (at least half a cell), as the points see it (weak, default: Archimedes at rest also at walls
-  // and under a free surface), the gradient of the nodal mean pressures (nodal: the derivative of
-  // the fluid's energy; at a grid face the nodes' linear fit), or fitted nodal gradients (fit)
+  Model model = Model::Standard;    // keyword model; sets grad_p, reaction_points and drag_form
+  // grad p at the grains (pressure eos): the gradient the fluid feels at the nodes, -(internal
+  // force)/volume (at least half a cell), as the points see it (weak, standard), or the fitted
+  // nodal gradients (fit, yang2016)
   GradP grad_p = GradP::Weak;
-  // the grains' pressure reaction goes to the fluid through its points (points, default: the
-  // kernel the displaced fluid mass went through) or straight to the nodes (direct, the text's)
+  // the grains' pressure reaction goes to the fluid through its points (standard: the kernel the
+  // displaced fluid mass went through) or straight to the nodes (yang2016)
   bool reaction_points = true;
-  bool theta_transport = false;     // points carry theta (updated by div(theta u)) instead of re-interpolating it
   Face face[6];
   Gate gate;
   double damping = 0.0;
@@ -75,9 +77,9 @@ struct Options {
   bool projection = false;
   double pressure_tolerance = 1e-8;  // relative residual of the solve
   int pressure_max_iterations = 200;
-  bool surface_ghost = true;         // projection: ghost-fluid free surface (no: p = 0 at EMPTY nodes)
-  bool surface_given = false;        // free_surface given (else node with mesh walls)
-  bool projection_dtheta = true;     // couple: the d(theta)/dt source of the pressure equation
+  // projection: ghost-fluid free surface; with mesh walls p = 0 at the EMPTY nodes (the nodal fill
+  // that places the ghost surface lacks the mass behind a triangle)
+  bool surface_ghost = true;
   bool pressure_acceleration = false;  // pressure_output acceleration: points' p from the fluid's acceleration
   bool grain_pressure_acceleration = true;   // grain_pressure acceleration (couple only): grains feel its gradient
   double pressure_average = 0.0;     // time: time constant of the averaged nodal pressure f_ID[19] (0: none)

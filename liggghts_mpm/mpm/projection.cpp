@@ -450,7 +450,7 @@ void Projection::extend_for_points(const std::vector<double> &p, const std::vect
   if (grad_out) extend_to_padding(gb, *grad_out, 3);
 }
 
-void Projection::project(double *vel, const double *p2g, double mmin, const double *theta, bool dtheta, double h,
+void Projection::project(double *vel, const double *p2g, double mmin, const double *theta, double h,
                          Boundaries &bc, long step, const double *pvol, const IndexBox *work) {
   // sparse sweeps: every for_owned of this step visits the work box only
   work_ = work ? work->cut(grid_.patch()) : grid_.patch();
@@ -459,7 +459,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   have_prev_ = true;
   LocalGrid::WorkScope scope(grid_, work ? &work_ : nullptr);
   make_labels(p2g, mmin, theta, bc.walls());
-  const double *theta_prev = theta && dtheta && have_theta_last_ ? theta_last_.data() : nullptr;
+  const double *theta_prev = theta && have_theta_last_ ? theta_last_.data() : nullptr;
   // u* as it is; every wall condition comes after the projection: the wall's reaction is the
   // pressure, and a wall node's velocity zeroed before it (normal or, no-slip, tangential) would
   // be moved again by the correction (measured: the F1 column at rest, docs/projection.md)

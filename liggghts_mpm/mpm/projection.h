@@ -28,7 +28,7 @@ class Projection {
   // vel: the VelRec rows of the grid update, V_NEW = u* at the owned nodes (0 where the node
   // mass p2g M <= mmin: those become EMPTY nodes, p = 0). On return V_NEW holds the corrected,
   // wall-conditioned velocity at the owned nodes (not forwarded). theta: nodal fluid fraction
-  // (null: 1); dtheta: the d(theta)/dt source with theta of the last solve (none at the first).
+  // (null: 1), with the d(theta)/dt source from theta of the last solve (none at the first).
   // pvol: sum S V of the points per node (owned nodes, after the reverse sum), for the
   // volume correction (keyword volume_correction; null: none). Throws mpm::Error naming the
   // step if the solve does not converge.
@@ -36,7 +36,7 @@ class Projection {
   // node with fluid mass grown by kWorkMargin nodes; the sweeps then visit its nodes only and every
   // array keeps outside it the value the full sweep gives there (no fluid within reach: 0, EMPTY).
   // Not with theta (couple) or mesh walls. null: the whole patch.
-  void project(double *vel, const double *p2g, double mmin, const double *theta, bool dtheta, double h,
+  void project(double *vel, const double *p2g, double mmin, const double *theta, double h,
                Boundaries &bc, long step, const double *pvol = nullptr, const IndexBox *work = nullptr);
   // the nodes the work box must reach beyond the nodes with mass: the farthest any sweep reads or
   // writes from them (the surface's gradient and extrapolation 1, deep_inside 2) and one more

@@ -39,12 +39,6 @@ std::string FluidSolver::check_points() {
   if (anybad)
     throw Error("Fix mpm/fluid: the fix group contains atoms that are not material points of this fix "
                 "(use a group of the fill type only)");
-  if (opt.theta_transport && !opt.coupled)
-    throw Error("Fix mpm/fluid: keyword 'theta_transport yes' needs keyword 'couple' (there is no "
-                "fluid fraction to transport without grains)");
-  if (opt.theta_transport && !opt.musl)
-    throw Error("Fix mpm/fluid: keyword 'theta_transport yes' needs 'update musl' (the divergence of "
-                "theta u is taken in the MUSL remap)");
   if (!opt.coupled) return "";
   double dmax = 0.0, gd = 0.0;
   int overlap = 0, go = 0;
@@ -109,7 +103,7 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
       c.hi[d] = grid_.patch().hi[d];
     }
   }
-  g_.assign(grid_.size(), opt.musl, opt.coupled, opt.theta_transport);
+  g_.assign(grid_.size(), opt.musl, !opt.projection, opt.coupled, opt.grad_p == GradP::Fit);
   bc.walls_moved();  // the nodes' mesh-wall constraints are indexed by the patch
   // the sparse grid covers the fluid's own phases, also with couple and with the projection: the
   // coupling reads the fluid's arrays (zero outside the active blocks, as on the dense grid) and
@@ -119,7 +113,6 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
   // "Sparse grid")
   sparse_ = opt.sparse;
   if (sparse_) blocks_.setup(grid_);
-  th_prev_valid_ = false;
   if (opt.projection) {
     proj_.reset(new Projection(grid_, comm_, opt));
     if (last.valid) {
@@ -351,7 +344,7 @@ void FluidSolver::update_grid(double h) {
     IndexBox work;
     const bool sparse_proj = sparse_ && !opt.coupled && !bc.walls();
     if (sparse_proj) work = projection_work_box();
-    proj_->project(g_.vel.data(), g_.p2g.data(), mmin, opt.coupled ? g_.th.data() : nullptr, opt.projection_dtheta, h,
+    proj_->project(g_.vel.data(), g_.p2g.data(), mmin, opt.coupled ? g_.th.data() : nullptr, h,
                    bc, clock.step, vc ? pvol_.data() : nullptr, sparse_proj ? &work : nullptr);
   }
   grid_.forward(g_.vel.data(), VelRec::N);
@@ -439,44 +432,33 @@ void FluidSolver::update_stress(double h, bool theta_only) {
   }
   const int nlocal = pts.nlocal;
   const double *rmass = pts.rmass;
-  // theta_transport: the fluid volume theta V changes by h V div(theta u) (grid operators), so
-  // that flow through a fixed irregular bed keeps it; else theta stays, V changes by h V div u
-  const bool transport = opt.coupled && opt.theta_transport && state.theta_initialized && !theta_only;
-  if (opt.antilock) {
-    // the cell sums: after MUSL already taken in its gradient pass (musl_gradient), else here
-    if (theta_only || !cells_summed_) {
-      if (pcell_.size() < static_cast<std::size_t>(nlocal)) pcell_.resize(nlocal);
-      clear_nodes(g_.cell, CellRec::N);
-      for (int i = 0; i < nlocal; ++i) {
-        if (!is_point(i)) continue;
-        sum_cell(i, theta_only ? nullptr : velgrad(i), transport);
-      }
+  // anti-locking: the cell sums, after MUSL already taken in its gradient pass (musl_gradient),
+  // else here
+  if (theta_only || !cells_summed_) {
+    if (pcell_.size() < static_cast<std::size_t>(nlocal)) pcell_.resize(nlocal);
+    clear_nodes(g_.cell, CellRec::N);
+    for (int i = 0; i < nlocal; ++i) {
+      if (!is_point(i)) continue;
+      sum_cell(i, theta_only ? nullptr : velgrad(i));
     }
-    cells_summed_ = false;
-    grid_.reverse_sum(g_.cell.data(), CellRec::N);
-    grid_.forward(g_.cell.data(), CellRec::N);
   }
+  cells_summed_ = false;
+  grid_.reverse_sum(g_.cell.data(), CellRec::N);
+  grid_.forward(g_.cell.data(), CellRec::N);
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
     double *s = pts.state[i];
     // theta_only: velgrad belongs to the last step's atom order then and is not read
     const double *L = theta_only ? nullptr : velgrad(i);
-    double div = theta_only ? 0.0 : L[0] + L[4] + L[8];
-    double p;
-    double fgrow = transport ? 1.0 + h * divthu_[i] / s[C_THETA] : 1.0;  // growth of theta V
-    if (opt.antilock) {
-      const double *c = &g_.cell[CellRec::N * pcell_[i]];
-      div = c[CellRec::VDIV] / c[CellRec::V];
-      if (transport) fgrow = 1.0 + h * c[CellRec::VDIVTHU] / c[CellRec::THV];
-      const double rho_cell = transport ? c[CellRec::M] / (c[CellRec::THV] * fgrow)
-                                        : c[CellRec::M] / (c[CellRec::THV] * (1.0 + h * div));
-      p = opt.eos.pressure(rho_cell);
-    }
+    // the cell's mean dilatation and density (anti-locking): the point's own J and volume follow
+    // the cell's, its pressure is the cell's
+    const double *c = &g_.cell[CellRec::N * pcell_[i]];
+    const double div = c[CellRec::VDIV] / c[CellRec::V];
+    const double rho_cell = c[CellRec::M] / (c[CellRec::THV] * (1.0 + h * div));
+    double p = opt.eos.pressure(rho_cell);
     const double J = 1.0 + h * div;
     s[C_VOL] *= J;
-    if (transport) s[C_THETA] = std::min(1.0, std::max(opt.theta_min, s[C_THETA] * fgrow / J));
     s[C_RHO] = rmass[i] / (s[C_THETA] * s[C_VOL]);
-    if (!opt.antilock) p = opt.eos.pressure(s[C_RHO]);
     // Liquid cannot carry tension beyond its cavitation pressure: without the cut a stretched
     // surface layer would hold itself together (and to walls).
     p = std::max(p, opt.pmin);

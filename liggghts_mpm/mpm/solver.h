@@ -104,8 +104,7 @@ class FluidSolver {
   // pressure projection: the state of the last solve on the whole grid (collective), for the
   // restart file; before the grid is set up, the one read from a restart file (or none)
   ProjectionState projection_state();
-  // First run with grains: the fluid mass reduced to theta rho0 V once; later runs: the nodes'
-  // fraction of the grains' present positions (theta_transport).
+  // First run with grains: the fluid mass reduced to theta rho0 V once.
   void setup_coupling();
 
   // Time-step check of the current state (collective, throws mpm::Error): the number of fluid
@@ -181,9 +180,6 @@ class FluidSolver {
   // out_j = sum_p S_jp V_p sum_i S_ip q_i (3 per node, folded): a nodal field as the points see it
   template <int NS> void through_points(const double *q, std::vector<double> &out);
   void fold_to_mirror(std::vector<double> &a, int stride);
-  bool near_face(int i, int j, int k) const;
-  bool near_face_along(int d, int idx) const;
-  bool near_face(const int base[3], int ns) const;
   void smooth_node_volume(std::vector<double> &a, int stride = 1);
   template <class Fn> void for_nodes(const Stencil &ps, Fn &&fn) const;
   // sparse grid: the active blocks of the points' stencils, retired blocks cleared
@@ -211,8 +207,8 @@ class FluidSolver {
   // anti-locking: the node index of the cell that holds point i (clamped at non-periodic faces)
   std::size_t cell_node(int i) const;
   // anti-locking: point i's share of its cell's sums (CellRec) for the stress update, velocity
-  // gradient L (9, row-major) and, with transport, div(theta u); stores pcell_[i]
-  void sum_cell(int i, const double *L, bool transport);
+  // gradient L (9, row-major); stores pcell_[i]
+  void sum_cell(int i, const double *L);
   void smooth_solid_volume();
   double solid_node_volume(int i, int j, int k) const;
   void init_theta();
@@ -235,7 +231,6 @@ class FluidSolver {
   int grain_base_lo_[3] = {0, 0, 0}, grain_base_hi_[3] = {-1, -1, -1};
   IndexBox projection_work_box();
   bool grid_ready_ = false;
-  bool th_prev_valid_ = false;
   std::vector<Stencil> shapes_, grain_shapes_;
   std::vector<int> plist_;          // local indices of the material points (this sub-step)
   std::vector<double> vpic_;        // grid (PIC) velocity at the points, for the position update
@@ -246,7 +241,6 @@ class FluidSolver {
   const double *velgrad(int i) const {
     return grad_in_state_ ? pts.state[i] + C_AFF : &velgrad_[9 * static_cast<std::size_t>(i)];
   }
-  std::vector<double> divthu_;      // theta_transport: div(theta u) at the points (MUSL pass)
   // anti-locking (eos): the node index of each point's cell, and whether the MUSL gradient pass
   // has already summed the cells of this sub-step's stress update (sum_cell)
   std::vector<std::size_t> pcell_;
@@ -303,17 +297,14 @@ inline std::size_t FluidSolver::cell_node(int i) const {
 }
 
 // L == nullptr: the fluid fraction only (refresh_pressure), no divergence sums
-inline void FluidSolver::sum_cell(int i, const double *L, bool transport) {
+inline void FluidSolver::sum_cell(int i, const double *L) {
   const double *s = pts.state[i];
   const std::size_t n = cell_node(i);
   pcell_[i] = n;
   double *c = &g_.cell[CellRec::N * n];
   const double V = s[C_VOL];
   c[CellRec::V] += V;
-  if (L) {
-    c[CellRec::VDIV] += V * (L[0] + L[4] + L[8]);
-    if (transport) c[CellRec::VDIVTHU] += V * divthu_[i];
-  }
+  if (L) c[CellRec::VDIV] += V * (L[0] + L[4] + L[8]);
   c[CellRec::THV] += s[C_THETA] * V;
   c[CellRec::M] += pts.rmass[i];
 }

@@ -16,7 +16,7 @@ void FluidSolver::particles_to_grid() {
   // the boundary term of each point right after its own share, so that every node sums its
   // contributions in point order
   // (projection: the walls' reaction is the solve's pressure, not a traction of the points)
-  const bool traction = opt.wall_traction && opt.shape == ShapeKind::QuadraticBSpline && !opt.projection;
+  const bool traction = opt.shape == ShapeKind::QuadraticBSpline && !opt.projection;
   double *const g = g_.p2g.data();
   auto boundary_term = [&](int i, const Stencil &ps) {
     if (traction) bc.add_traction(ps, pts.x[i], pts.state[i][C_VOL], pts.state[i][C_P], g);
@@ -190,13 +190,9 @@ void FluidSolver::musl_gradient() {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   const double *const ga = g_.aux.data();
   const bool store_affine = opt.transfer != Transfer::Apic;
-  const bool transport = opt.coupled && opt.theta_transport;
-  const double *const gth = transport ? g_.th.data() : nullptr;
-  if (transport && divthu_.size() < static_cast<std::size_t>(pts.nlocal)) divthu_.resize(pts.nlocal);
   // anti-locking (eos): the cell sums of the stress update (update_stress) are taken here, in the
   // same point order, while the point's record is at hand (one pass over the points less)
-  const bool cells = opt.antilock && !opt.projection;
-  const bool cell_transport = transport && state.theta_initialized;
+  const bool cells = !opt.projection;
   if (cells) {
     if (pcell_.size() < static_cast<std::size_t>(pts.nlocal)) pcell_.resize(pts.nlocal);
     clear_nodes(g_.cell, CellRec::N);
@@ -204,15 +200,12 @@ void FluidSolver::musl_gradient() {
   for (const int i : plist_) {
     const Stencil &ps = shapes_[i];
     Row4 Lc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // Lc[e][d] = sum v_d dS/dx_e
-    double dtu = 0.0;  // divergence of theta u (theta_transport)
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double, double gx, double gy, double gz) {
       const Row4 u = row4(ga + AuxRec::N * n + AuxRec::U);
       Lc[0] += gx * u;
       Lc[1] += gy * u;
       Lc[2] += gz * u;
-      if (transport) dtu += gth[n] * (gx * u[0] + gy * u[1] + gz * u[2]);
     });
-    if (transport) divthu_[i] = dtu;
     double L[9];
     for (int d = 0; d < 3; ++d)
       for (int e = 0; e < 3; ++e) L[3 * d + e] = Lc[e][d];
@@ -220,7 +213,7 @@ void FluidSolver::musl_gradient() {
       std::copy(L, L + 9, pts.state[i] + C_AFF);
     else
       std::copy(L, L + 9, &velgrad_[9 * static_cast<std::size_t>(i)]);
-    if (cells) sum_cell(i, L, cell_transport);
+    if (cells) sum_cell(i, L);
   }
   cells_summed_ = cells;
   grad_in_state_ = store_affine;

@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
-"""Grains held in still water feel Archimedes' force (issue #13, acceptance 4): a random bed
+"""Grains held in still water feel Archimedes' force: a random bed
 (inputs/archimedes/in.bed, reduced), the fluid force on the grains against rho g sum V, a bound from
-the inputs alone. With `pressure eos` and the default coupling (grad_p weak: the fluid's own nodal
-gradient as its points see it, reaction points) within 2 % mid-depth and resting on the floor, at
+the inputs alone. With `pressure eos` and the standard model (the fluid's own nodal
+gradient as its points see it, the reaction through the points) within 2 % mid-depth and resting on the floor, at
 cells of 1.5 and 3 grain diameters (at 3 d the water is 3 cells deep: the bed lies within 1.5 cells
 of the floor and of the free surface), with and without theta_smooth (measured 0.9963-1.0008,
-docs/projection.md "Archimedes with eos"). The former default grad_p nodal must miss on the floor by
-more than 2 % (0.77 at cell 3 d), so that the case can tell the two apart.
+docs/projection.md "Archimedes with eos"). The dissertation's literal coupling (model yang2016) must
+miss on the floor by more than 2 %, so that the case can tell the two apart.
 
     test_archimedes.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR [--mpirun "..."]
 """
@@ -74,11 +74,11 @@ def case_bed_floor_c15_smooth(r):
 
 
 def case_bed_floor_c3(r):
-    """default coupling, the bed on the floor, cell 3 d, theta_smooth 0 / 0.004; and the former
-    default grad_p nodal there, which this case must tell apart"""
+    """default coupling, the bed on the floor, cell 3 d, theta_smooth 0 / 0.004; and the text's
+    coupling (model yang2016) there, which this case must tell apart"""
     rows(r, "floor_c3", "floor_c3_smooth")
-    qn = ratio(r, "floor_c3_nodal", floor=1, extra="grad_p nodal", **CELL3)
-    check(abs(qn - 1.0) > TOL, f"grad_p nodal on the floor at cell 3 d is off by more than {TOL:.0%} ({qn:.4f})")
+    qt = ratio(r, "floor_c3_yang2016", floor=1, extra="model yang2016", **CELL3)
+    check(abs(qt - 1.0) > TOL, f"model yang2016 on the floor at cell 3 d is off by more than {TOL:.0%} ({qt:.4f})")
 
 
 if __name__ == "__main__":

@@ -162,7 +162,7 @@ def case_bad_input(r):
     base = "cell 0.5 density 1000 fill col 2 2 2 type 1 pressure projection"
     cases = [
         (base + " bulk 2e9", "'pressure projection' does not use keyword(s) 'bulk'"),
-        (base + " eos tait 7 antilock no pmin 0", "'eos', 'antilock', 'pmin'"),
+        (base + " eos tait 7 pmin 0", "'eos', 'pmin'"),
         (base + " tolerance 0", "keyword 'tolerance' expects a relative residual > 0"),
         (base + " max_iterations 0", "keyword 'max_iterations' expects an integer >= 1"),
         (base + " pressure incompressible", "keyword 'pressure' expects 'projection' or 'eos'"),

@@ -95,21 +95,6 @@ def case_pressure_output(r):
     check(spread < 1e-6 and step < 1e-6, "the acceleration pressure is hydrostatic beside the mesh wall")
 
 
-def case_ghost_refused(r):
-    """free_surface ghost with mesh_wall is refused before any computation (not balanced at rest
-    beside a mesh wall yet: 3.5e-3 / 6.6e-2 m/s after 1 s beside a vertical / 30 degree wall)."""
-    d, p = r.run("projection_mesh/ghost", INPUT, {"extra": "free_surface ghost"}, expect_ok=False,
-                 extra_files=(STL,))
-    msg = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
-    check(p.returncode != 0 and "free_surface ghost" in msg and "mesh_wall" in msg and "free_surface node" in msg,
-          f"free_surface ghost with mesh_wall: an error naming both keywords and the remedy (got: {msg.strip()[:160]})")
-    check(not os.path.exists(os.path.join(d, "mesh_walls_projection.csv")) or
-          len(read_csv(os.path.join(d, "mesh_walls_projection.csv")).get("t", [])) == 0,
-          "no output rows written")
-    d, p, s = run(r, "node_explicit", extra="free_surface node", tend=0.1)
-    check(p.returncode == 0 and max(s["vmax"]) < 1e-4, "free_surface node with mesh_wall runs (at rest)")
-
-
 def case_piston(r):
     """A horizontal mesh floor rising at w = 0.1 m/s under a 0.6 m column (free surface above)."""
     w = 0.1

@@ -228,7 +228,7 @@ set type 2 diameter 0.002 density 2500
 group grains type 2
 group fluid type 1
 fix grav all gravity 9.81 vector 0 0 -1
-fix f fluid mpm/fluid cell 0.0025 density 1000 bulk 1e5 viscosity 1e-3 fill box 1 1 1 type 1 couple grains grad_p {gradp}
+fix f fluid mpm/fluid cell 0.0025 density 1000 bulk 1e5 viscosity 1e-3 fill box 1 1 1 type 1 couple grains model {model}
 fix nve grains nve/sphere
 timestep 1e-5
 dump d grains custom {steps} grains.dump id x y z vx vy vz f_dragforce[1] f_dragforce[2] f_dragforce[3]
@@ -244,23 +244,23 @@ def last_rows(path):
 
 
 def case_np2_cut(r):
-    """np 2 = np 1 to round-off for 'grad_p fit' and 'grad_p nodal' with grains on the cut. The
-    fit's need-flags were summed to the owner but not forwarded to the halo, so a rank skipped the
-    pressure moments of nodes only the other rank's grains read (4e-6 relative before)."""
+    """np 2 = np 1 to round-off for both models with grains on the cut. The text's fitted gradient
+    (model yang2016) needs flags forwarded to the halo, else a rank skips the pressure moments of
+    nodes only the other rank's grains read (4e-6 relative)."""
     steps = 20
-    for gp in ("fit", "nodal"):
+    for gp in ("yang2016", "standard"):
         res = []
         for np_ in (1, 2):
             d = r.fresh(f"np2_cut/{gp}_np{np_}")
             with open(os.path.join(d, "in.script"), "w") as f:
-                f.write(CUT.format(gradp=gp, steps=steps))
+                f.write(CUT.format(model=gp, steps=steps))
             p = r.execute(d, "in.script", np=np_, expect_ok=False, timeout=300)
-            check(p.returncode == 0, f"grad_p {gp} np {np_} runs")
+            check(p.returncode == 0, f"model {gp} np {np_} runs")
             res.append(last_rows(os.path.join(d, "grains.dump")) if p.returncode == 0 else None)
         if None in res:
             continue
         a, b = res
-        check(len(a) == len(b) == 5, f"grad_p {gp}: five grains in both runs")
+        check(len(a) == len(b) == 5, f"model {gp}: five grains in both runs")
         # scales: the box for positions, the largest velocity component, and for the fluid force
         # the buoyancy rho_f V g of a grain (4.1e-5 N): early in the run the force is a small
         # difference of pressure terms of that size, so its own size would measure cancellation
@@ -272,7 +272,7 @@ def case_np2_cut(r):
         fmax = max(abs(row[c]) for row in a for c in (7, 8, 9))
         print(f"  grad_p {gp}: largest difference np2 vs np1 (x, v, fluid force per grain, relative to box, |v|max, rho_f V g) {rel:.2e}; "
               f"largest fluid force {fmax:.3e} N")
-        check(fmax > 0.0 and rel < 1e-12, f"grad_p {gp}: np 2 = np 1 within 1e-12 relative ({rel:.2e})")
+        check(fmax > 0.0 and rel < 1e-12, f"model {gp}: np 2 = np 1 within 1e-12 relative ({rel:.2e})")
 
 
 def case_density_warning(r):

@@ -44,7 +44,7 @@ std::string error_of(const std::string &words) {
 const std::string kBase = "cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 ";
 
 TEST(Options, DefaultsAndValues) {
-  const mpm::Options o = parse(kBase + "viscosity 1e-3 cfl 0.3 transfer flip 0.95 update usl antilock no "
+  const mpm::Options o = parse(kBase + "viscosity 1e-3 cfl 0.3 transfer flip 0.95 update usl "
                                        "boundary zlo shear 1e-3 output 10 out points v p grid mass cfl 0.3");
   EXPECT_EQ(o.grid.ncell[0], 4);
   EXPECT_EQ(o.grid.pad, 1);
@@ -54,12 +54,34 @@ TEST(Options, DefaultsAndValues) {
   EXPECT_EQ(o.transfer, mpm::Transfer::Flip);
   EXPECT_DOUBLE_EQ(o.flip_alpha, 0.95);
   EXPECT_FALSE(o.musl);
-  EXPECT_FALSE(o.antilock);
+  EXPECT_EQ(o.model, mpm::Model::Standard);
+  EXPECT_EQ(o.grad_p, mpm::GradP::Weak);
+  EXPECT_TRUE(o.reaction_points);
+  EXPECT_EQ(o.drag_form, mpm::DragForm::Consistent);
   EXPECT_EQ(o.face[4].kind, mpm::BcKind::Shear);
   EXPECT_EQ(o.face[0].kind, mpm::BcKind::NoSlip);
   EXPECT_EQ(o.out_point_fields, (std::vector<std::string>{"v", "p"}));
   EXPECT_EQ(o.out_grid_fields, (std::vector<std::string>{"mass"}));  // 'cfl' ended the list
   EXPECT_DOUBLE_EQ(o.mass_threshold, 1e-5);
+}
+
+// model yang2016: the dissertation's coupling forms, all three, and only with its pressure model
+TEST(Options, ModelPresetSetsTheTextsForms) {
+  const mpm::Options o = parse(kBase + "viscosity 1e-3 model yang2016");
+  EXPECT_EQ(o.model, mpm::Model::Yang2016);
+  EXPECT_EQ(o.grad_p, mpm::GradP::Fit);
+  EXPECT_FALSE(o.reaction_points);
+  EXPECT_EQ(o.drag_form, mpm::DragForm::Literal);
+  EXPECT_EQ(error_of(kBase + "model text"), "Fix mpm/fluid: keyword 'model' expects 'standard' or 'yang2016', got 'text'");
+  EXPECT_NE(error_of("cell 0.5 density 1000 fill col 2 2 2 type 1 pressure projection model yang2016")
+                .find("'model yang2016' is the dissertation's weakly compressible model and needs 'pressure eos'"),
+            std::string::npos);
+  EXPECT_NE(error_of(kBase + "drag stokes literal").find("the text's literal form belongs to 'model yang2016'"),
+            std::string::npos);
+  // the forms are the model's, not keywords of their own
+  for (const char *retired : {"grad_p fit", "reaction direct", "antilock no", "wall_traction no", "theta_transport yes",
+                              "dtheta_source no", "free_surface node"})
+    EXPECT_NE(error_of(kBase + retired).find("unknown keyword"), std::string::npos) << retired;
 }
 
 TEST(Options, ErrorsNameKeywordExpectationAndValue) {

@@ -128,14 +128,14 @@ void check(const std::string &args, bool moving, bool periodic_y = false) {
 
 TEST(SparseGrid, BsplineFlipMuslEqualsDense) { check("shape bspline2 transfer flip", true); }
 TEST(SparseGrid, BsplineApicUslEqualsDense) { check("transfer apic update usl", false); }
-TEST(SparseGrid, LinearPicEqualsDense) { check("shape linear transfer pic antilock no", false); }
+TEST(SparseGrid, LinearPicEqualsDense) { check("shape linear transfer pic", false); }
 TEST(SparseGrid, GateAndFreeslipEqualDense) { check("gate x 0.6 lower never boundary all freeslip", true); }
 TEST(SparseGrid, PeriodicYEqualsDense) { check("transfer apic", false, true); }
 // pressure projection: the fluid's phases on the active blocks, the projection's sweeps on the work
 // box around the fluid (retired as the column collapses), the hypre solve on the FLUID nodes' box
 TEST(SparseGrid, ProjectionEqualsDense) { check("pressure projection", true); }
-TEST(SparseGrid, ProjectionNodeSurfaceAveragedEqualsDense) {
-  check("pressure projection free_surface node transfer apic pressure_average 0.01 pressure_output acceleration "
+TEST(SparseGrid, ProjectionAveragedEqualsDense) {
+  check("pressure projection transfer apic pressure_average 0.01 pressure_output acceleration "
         "volume_correction 10", false);
 }
 

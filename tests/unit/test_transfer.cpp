@@ -343,9 +343,8 @@ void check_coupling_scratch(const std::string &args) {
   }
 }
 
-TEST(CouplingScratch, NodalFitReactionPoints) { check_coupling_scratch("grad_p nodal"); }
-TEST(CouplingScratch, FitSmoothed) { check_coupling_scratch("grad_p fit theta_smooth 0.1"); }
-TEST(CouplingScratch, Weak) { check_coupling_scratch("grad_p weak"); }
+TEST(CouplingScratch, Yang2016Smoothed) { check_coupling_scratch("model yang2016 theta_smooth 0.1"); }
+TEST(CouplingScratch, Standard) { check_coupling_scratch(""); }
 
 }  // namespace
 
