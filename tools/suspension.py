@@ -150,10 +150,8 @@ INPUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "inputs",
 # model x options of the table in docs/suspension.md
 VARIANTS = [
     ("proj", {"pressure": "projection"}),
-    ("proj nodtheta", {"pressure": "projection", "extra": "dtheta_source no"}),
     ("eos", {"pressure": "eos"}),
     ("proj smooth", {"pressure": "projection", "extra": "theta_smooth 0.002"}),
-    ("proj nodtheta smooth", {"pressure": "projection", "extra": "dtheta_source no theta_smooth 0.002"}),
     ("eos smooth", {"pressure": "eos", "extra": "theta_smooth 0.002"}),
     # the grains' pressure force from the projection's multiplier (the default before 24 Nov 2026)
     ("proj smooth multiplier", {"pressure": "projection", "extra": "theta_smooth 0.002 grain_pressure multiplier"}),

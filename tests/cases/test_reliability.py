@@ -270,7 +270,7 @@ def case_np2_cut(r):
             scale = scales[1 + 3 * ((col - 1) // 3)]
             rel = max(rel, max(abs(x[col] - y[col]) for x, y in zip(a, b)) / scale)
         fmax = max(abs(row[c]) for row in a for c in (7, 8, 9))
-        print(f"  grad_p {gp}: largest difference np2 vs np1 (x, v, fluid force per grain, relative to box, |v|max, rho_f V g) {rel:.2e}; "
+        print(f"  model {gp}: largest difference np2 vs np1 (x, v, fluid force per grain, relative to box, |v|max, rho_f V g) {rel:.2e}; "
               f"largest fluid force {fmax:.3e} N")
         check(fmax > 0.0 and rel < 1e-12, f"model {gp}: np 2 = np 1 within 1e-12 relative ({rel:.2e})")
 
