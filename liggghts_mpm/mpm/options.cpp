@@ -325,8 +325,9 @@ void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
                 "needs 'pressure eos' (with 'bulk'); remove 'pressure projection' or the model");
   if (bad.empty()) return;
   if (o.projection)
-    throw Error("Fix mpm/fluid: keyword 'pressure projection' does not use keyword(s) " + bad +
-                " (they belong to the equation of state of 'pressure eos'); remove them");
+    throw Error("Fix mpm/fluid: the pressure model 'projection' (the default) does not use keyword(s) " + bad +
+                " (they belong to the equation of state of the weakly compressible model); add 'pressure eos' "
+                "to use that model, or remove them");
   throw Error("Fix mpm/fluid: keyword(s) " + bad + " belong to 'pressure projection' (the pressure solve); "
               "add 'pressure projection' or remove them");
 }
@@ -420,7 +421,7 @@ const std::vector<Keyword> kTable = {
      "six bounds xlo xhi ylo yhi zlo zhi", nullptr, 0, 0, false, false, nullptr, parse_grid, false},
     {"density", "real", "mass/volume", "> 0", "required", "a positive reference density",
      REAL(rho0), 0.0, kInf, true, true, nullptr, nullptr, false},
-    {"bulk", "real", "pressure", "> 0", "required", "a positive bulk modulus (pressure)",
+    {"bulk", "real", "pressure", "> 0", "required with pressure eos", "a positive bulk modulus (pressure)",
      REAL(bulk), 0.0, kInf, true, true, nullptr, nullptr, false},
     {"viscosity", "real", "pressure*time", ">= 0", "0", "a non-negative dynamic viscosity",
      REAL(viscosity), 0.0, kInf, false, true, nullptr, nullptr, false},
@@ -451,7 +452,7 @@ const std::vector<Keyword> kTable = {
      REAL(mass_threshold), 0.0, 1.0, false, true, nullptr, nullptr, false},
     {"sparse", "yes/no", "-", "", "yes", "'yes' or 'no'",
      nullptr, 0, 0, false, false, &Options::sparse, nullptr, false},
-    {"pressure", "eos | projection", "-", "", "eos",
+    {"pressure", "projection | eos", "-", "", "projection",
      "'eos' or 'projection'", nullptr, 0, 0, false, false, nullptr, parse_pressure, false},
     {"tolerance", "real", "-", "> 0", "1e-8", "a relative residual > 0 of the pressure solve",
      REAL(pressure_tolerance), 0.0, kInf, true, true, nullptr, nullptr, false},
@@ -549,7 +550,8 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
   }
   if (!given[0]) throw Error("Fix mpm/fluid: keyword 'cell' (cell size) is required");
   if (!given[1]) throw Error("Fix mpm/fluid: keyword 'density' (reference density) is required");
-  if (!given[2] && !o.projection) throw Error("Fix mpm/fluid: keyword 'bulk' (bulk modulus) is required");
+  if (!given[2] && !o.projection)
+    throw Error("Fix mpm/fluid: keyword 'pressure eos' needs keyword 'bulk' (the bulk modulus of its equation of state)");
   check_pressure_model(o, seen);
   if (o.coupled && !(o.viscosity > 0.0))
     throw Error("Fix mpm/fluid: keyword 'couple' needs keyword 'viscosity' > 0 (the drag laws scale with it)");

@@ -72,9 +72,9 @@ struct Options {
   int fluid_every = 1;              // the fluid advances every N-th time step, by N dt (keyword every)
   double mass_threshold = 1e-5;
   bool sparse = true;                // fluid grid phases only on the blocks the points reach (pressure eos)
-  // pressure model (keyword pressure): eos, the text's weakly compressible fluid, or projection,
-  // the incompressible fluid of a pressure Poisson solve (mpm/projection.h, docs/projection.md)
-  bool projection = false;
+  // pressure model (keyword pressure): projection (default), the incompressible fluid of a pressure
+  // Poisson solve (mpm/projection.h), or eos, the text's weakly compressible fluid
+  bool projection = true;
   double pressure_tolerance = 1e-8;  // relative residual of the solve
   int pressure_max_iterations = 200;
   // projection: ghost-fluid free surface; with mesh walls p = 0 at the EMPTY nodes (the nodal fill

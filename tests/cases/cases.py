@@ -246,15 +246,15 @@ def case_restart_roundtrip(r):
 
 def case_bad_input(r):
     """Bad fix arguments stop with an error naming the keyword and what was expected."""
-    base = ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1")
+    base = ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1")
     cases = [
-        ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 colour red", "unknown keyword 'colour'"),
+        ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1 colour red", "unknown keyword 'colour'"),
         ("cell 0.5 density 1000 bulk", "keyword 'bulk' expects"),
-        ("cell -0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1", "keyword 'cell' expects a positive cell size"),
-        ("cell 0.5 density 0 bulk 2e6 fill col 2 2 2 type 1", "keyword 'density' expects a positive reference density"),
-        ("cell 0.5 density 1000 bulk -1 fill col 2 2 2 type 1", "keyword 'bulk' expects a positive bulk modulus"),
-        ("cell 0.3 density 1000 bulk 2e6 fill col 2 2 2 type 1", "divides the grid extent"),
-        ("density 1000 bulk 2e6 fill col 2 2 2 type 1", "keyword 'cell' (cell size) is required"),
+        ("cell -0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1", "keyword 'cell' expects a positive cell size"),
+        ("cell 0.5 density 0 pressure eos bulk 2e6 fill col 2 2 2 type 1", "keyword 'density' expects a positive reference density"),
+        ("cell 0.5 density 1000 pressure eos bulk -1 fill col 2 2 2 type 1", "keyword 'bulk' expects a positive bulk modulus"),
+        ("cell 0.3 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1", "divides the grid extent"),
+        ("density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1", "keyword 'cell' (cell size) is required"),
         (base + " eos tait 0.5", "'eos tait' expects an exponent"),
         (base + " shape cubic", "keyword 'shape' expects 'linear' or 'bspline2'"),
         (base + " boundary xlo sticky", "keyword 'boundary' expects"),
@@ -264,7 +264,7 @@ def case_bad_input(r):
         (base + " transfer flip 2", "'transfer flip' expects a FLIP fraction"),
         (base + " grid 0 2 0 2 0 9", "bounds must lie inside the simulation box"),
         (base + " gate x 7 lower 0.1", "keyword 'gate' expects a position inside the grid"),
-        ("cell 0.5 density 1000 bulk 2e6 fill nowhere 2 2 2 type 1", "'fill' expects an existing region ID"),
+        ("cell 0.5 density 1000 pressure eos bulk 2e6 fill nowhere 2 2 2 type 1", "'fill' expects an existing region ID"),
         (base + " output 10 out points velocity", "'output points' expects point fields"),
         (base + " cfl 0", "keyword 'cfl' expects a CFL number in (0,1]"),
         (base + " mass_threshold 1", "keyword 'mass_threshold' expects a fraction of the point mass in [0,1)"),
@@ -672,7 +672,7 @@ create_atoms 2 single 0.01 0.01 0.01 units box
 set atom 1 diameter {d} density 2500
 group grains type 2
 group fluid type 1
-fix f fluid mpm/fluid cell 0.005 density 1000 bulk 1e5 fill box 1 1 1 type 1 {args}
+fix f fluid mpm/fluid cell 0.005 density 1000 pressure eos bulk 1e5 fill box 1 1 1 type 1 {args}
 run 0
 """
     cases = [

@@ -129,7 +129,7 @@ create_box 1 box
 region col block 0 1 0 1 0 1 units box
 neighbor 0.1 bin
 fix b all balance/mpm {args}
-fix f all mpm/fluid cell 0.25 density 1000 bulk 2e6 fill col 2 2 2 type 1
+fix f all mpm/fluid cell 0.25 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1
 run 0
 """
     bad = [

@@ -161,24 +161,25 @@ def case_bad_input(r):
     """Bad projection input stops with an error naming the keyword (and the step for a failed solve)."""
     base = "cell 0.5 density 1000 fill col 2 2 2 type 1 pressure projection"
     cases = [
-        (base + " bulk 2e9", "'pressure projection' does not use keyword(s) 'bulk'"),
+        (base + " bulk 2e9", "the pressure model 'projection' (the default) does not use keyword(s) 'bulk'"),
+        ("cell 0.5 density 1000 fill col 2 2 2 type 1 bulk 2e9", "add 'pressure eos' to use that model"),
         (base + " eos tait 7 pmin 0", "'eos', 'pmin'"),
         (base + " tolerance 0", "keyword 'tolerance' expects a relative residual > 0"),
         (base + " max_iterations 0", "keyword 'max_iterations' expects an integer >= 1"),
         (base + " pressure incompressible", "keyword 'pressure' expects 'projection' or 'eos'"),
-        ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 tolerance 1e-6",
+        ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1 tolerance 1e-6",
          "'tolerance' belong to 'pressure projection'"),
-        ("cell 0.5 density 1000 fill col 2 2 2 type 1", "keyword 'bulk' (bulk modulus) is required"),
+        ("cell 0.5 density 1000 fill col 2 2 2 type 1 pressure eos", "keyword 'pressure eos' needs keyword 'bulk'"),
         (base + " volume_correction -1", "keyword 'volume_correction' expects a rate (1/time) >= 0"),
-        ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 volume_correction 10",
+        ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1 volume_correction 10",
          "'volume_correction' belong to 'pressure projection'"),
         (base + " pressure_average -1", "keyword 'pressure_average' expects a time constant (time) >= 0"),
         (base + " pressure_output fast", "keyword 'pressure_output' expects 'multiplier' or 'acceleration', got 'fast'"),
-        ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 pressure_output acceleration pressure_average 1",
+        ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1 pressure_output acceleration pressure_average 1",
          "'pressure_output', 'pressure_average' belong to 'pressure projection'"),
         (base + " grain_pressure gradient", "keyword 'grain_pressure' expects 'multiplier' or 'acceleration', got 'gradient'"),
         (base + " grain_pressure multiplier", "keyword 'grain_pressure' needs keyword 'couple'"),
-        ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 grain_pressure acceleration",
+        ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1 grain_pressure acceleration",
          "'grain_pressure' belong to 'pressure projection'"),
     ]
     for i, (args, expect) in enumerate(cases):

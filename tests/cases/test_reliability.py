@@ -34,7 +34,7 @@ fix m5 all property/global coefficientFriction peratomtypepair 2 0.3 0.3 0.3 0.3
 pair_style gran model hooke/stiffness tangential history
 pair_coeff * *
 region col block 0 0.1 0 0.05 0 0.2 units box
-fix fluid all mpm/fluid cell 0.025 density 1000 bulk 2e5 viscosity 1e-3 boundary all freeslip &
+fix fluid all mpm/fluid cell 0.025 density 1000 pressure eos bulk 2e5 viscosity 1e-3 boundary all freeslip &
     fill col 2 2 2 type 1 front x {fixargs}
 fix grav all gravity 9.81 vector 0 0 -1
 timestep 2e-4
@@ -102,7 +102,7 @@ create_atoms 2 single 0.012 0.02 0.02 units box
 set type 2 diameter {d} density 2500
 group grains type 2
 group fluid type 1
-fix f fluid mpm/fluid cell 0.005 density 1000 bulk 1e5 viscosity 1e-3 fill box 1 1 1 type 1 couple grains {fixargs}
+fix f fluid mpm/fluid cell 0.005 density 1000 pressure eos bulk 1e5 viscosity 1e-3 fill box 1 1 1 type 1 couple grains {fixargs}
 fix nve grains nve/sphere
 timestep 1e-5
 run {steps}
@@ -169,7 +169,7 @@ label common
 atom_modify sort 0 0
 neighbor 0.02 bin
 neigh_modify delay 0 every 1 check yes
-fix fluid all mpm/fluid cell 0.1 density 1000 bulk 2e6 viscosity 0.01 boundary all freeslip &
+fix fluid all mpm/fluid cell 0.1 density 1000 pressure eos bulk 2e6 viscosity 0.01 boundary all freeslip &
     fill column 2 1 2 type 1 front x gate x 0.8 lower 0.1 output 125 col points p
 fix grav all gravity 9.81 vector 0.0 0.0 -1.0
 timestep 2e-4
@@ -228,7 +228,7 @@ set type 2 diameter 0.002 density 2500
 group grains type 2
 group fluid type 1
 fix grav all gravity 9.81 vector 0 0 -1
-fix f fluid mpm/fluid cell 0.0025 density 1000 bulk 1e5 viscosity 1e-3 fill box 1 1 1 type 1 couple grains model {model}
+fix f fluid mpm/fluid cell 0.0025 density 1000 pressure eos bulk 1e5 viscosity 1e-3 fill box 1 1 1 type 1 couple grains model {model}
 fix nve grains nve/sphere
 timestep 1e-5
 dump d grains custom {steps} grains.dump id x y z vx vy vz f_dragforce[1] f_dragforce[2] f_dragforce[3]
@@ -321,7 +321,7 @@ neighbor 0.001 bin
 neigh_modify delay 0 every 1 check yes
 group fluid type 1
 region box block 0 0.04 0 0.04 0 0.04 units box
-fix g fluid mpm/fluid cell 0.005 density 1000 bulk 1e5 viscosity 1e-3 fill box 1 1 1 type 1
+fix g fluid mpm/fluid cell 0.005 density 1000 pressure eos bulk 1e5 viscosity 1e-3 fill box 1 1 1 type 1
 run 1
 """
     with open(os.path.join(d, "in.b"), "w") as f:

@@ -41,7 +41,7 @@ std::string error_of(const std::string &words) {
   return "";
 }
 
-const std::string kBase = "cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 ";
+const std::string kBase = "cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1 ";
 
 TEST(Options, DefaultsAndValues) {
   const mpm::Options o = parse(kBase + "viscosity 1e-3 cfl 0.3 transfer flip 0.95 update usl "
@@ -91,7 +91,7 @@ TEST(Options, ErrorsNameKeywordExpectationAndValue) {
   EXPECT_NE(error_of(kBase + "couple nosuch").find("keyword 'couple' expects an existing group-ID"), std::string::npos);
   EXPECT_NE(error_of(kBase + "couple grains").find("needs keyword 'viscosity' > 0"), std::string::npos);
   EXPECT_NE(error_of(kBase + "fill col 2 2 2 type 3").find("'fill type' expects an existing atom type"), std::string::npos);
-  EXPECT_NE(error_of("cell 0.3 density 1000 bulk 2e6").find("divides the grid extent"), std::string::npos);
+  EXPECT_NE(error_of("cell 0.3 density 1000 pressure eos bulk 2e6").find("divides the grid extent"), std::string::npos);
   EXPECT_NE(error_of(kBase + "output 1 o points velocity").find("'output points' expects point fields"), std::string::npos);
   EXPECT_EQ(error_of(kBase + "theta_smooth 0"), "");
 }

@@ -31,7 +31,7 @@ struct Column {
 
   Column(const std::string &args, bool periodic_y) {
     const bool eos = args.find("projection") == std::string::npos;
-    std::istringstream is("f all mpm/fluid cell 0.05 density 1000 viscosity 1e-3 sparse " + args + (eos ? " bulk 1e5" : ""));
+    std::istringstream is("f all mpm/fluid cell 0.05 density 1000 viscosity 1e-3 sparse " + args + (eos ? " pressure eos bulk 1e5" : ""));
     for (std::string s; is >> s;) words.push_back(s);
     std::vector<char *> argv;
     for (auto &s : words) argv.push_back(&s[0]);

@@ -77,7 +77,7 @@ struct Scene : Host {
   explicit Scene(const std::string &args, int n = 40, bool periodic = false) {
     mpm::ParseEnv env;
     for (int d = 0; d < 3; ++d) env.periodic[d] = periodic;
-    parse("cell 0.1 density 1000 bulk 1e5 viscosity 1e-3 " + args, env);
+    parse("cell 0.1 density 1000 pressure eos bulk 1e5 viscosity 1e-3 " + args, env);
     std::mt19937_64 gen(7);
     std::uniform_real_distribution<double> pos(0.25, 0.75), val(-1.0, 1.0), pos1(0.5, 1.5);
     xs.resize(3 * n), vs.resize(3 * n), fs.resize(3 * n), rows.assign(n * mpm::NCOL, 0.0);
@@ -264,7 +264,7 @@ struct CoupledScene : Host {
   CoupledScene(const std::string &args, double grain_x) {
     mpm::ParseEnv env;
     env.group_exists = [](const char *g) { return std::string(g) == "beads"; };
-    parse("cell 0.1 density 1000 bulk 1e5 viscosity 1e-3 couple beads " + args, env);
+    parse("cell 0.1 density 1000 pressure eos bulk 1e5 viscosity 1e-3 couple beads " + args, env);
     std::mt19937_64 gen(11);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     for (int k = 0; k < 8; ++k)  // points 2 x 2 x 2 per cell in [0.2, 0.8] x [0.2, 0.8] x [0, 0.5]
