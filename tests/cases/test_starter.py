@@ -2,7 +2,8 @@
 """mpm_case.starter: the starter scene inputs/starter/in.pour_and_collapse at reduced size
 (-var quick 1: 300 beads poured, a water column of 36 points released onto them, a few seconds).
 
-Checks: the run ends normally; every thermo value is finite; the fluid mass f_fluid[1] is the same
+Checks: the run ends normally with the default model; the largest point pressure stays below
+5 (rho g h + rho U^2) of the column; every thermo value is finite; the fluid mass f_fluid[1] is the same
 in every thermo line of the coupled runs and lies between 0.5 and 1 x rho0 x the column volume (the
 points' mass is reduced by the beads inside the column); all beads are in the last dump, inside the
 box, with finite values; the HDF5 index lists the point files; tools/render_run.py (through
@@ -82,6 +83,12 @@ def main():
           f"fluid mass f_fluid[1] the same in all {len(masses)} lines of the coupled runs ({masses[0]!r} kg)")
     check(0.5 * m0 < masses[0] <= m0 * (1 + 1e-12), f"fluid mass {masses[0]:.6g} kg within 0.5..1 x rho0 x column volume {m0:.6g}")
     fh, fl = blocks[2]
+    # a bound from the inputs alone: the largest point pressure below 5 (rho g h + rho U^2), U the
+    # column's free-fall speed sqrt(2 g h)
+    g = 9.81
+    bound = 5.0 * (RHO * g * HWATER + RHO * 2.0 * g * HWATER)
+    pmax = max(row[h.index("fluid[10")] for h, rows in blocks[1:] for row in rows)
+    check(0.0 < pmax < bound, f"largest point pressure {pmax:.4g} Pa below 5 (rho g h + rho U^2) = {bound:.4g} Pa")
     front = [row[fh.index("fluid[4]")] for row in fl]
     check(front[-1] > front[0], f"the water front moves after the gate opens ({front[0]:.4f} -> {front[-1]:.4f} m)")
 
