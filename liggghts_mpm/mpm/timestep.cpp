@@ -19,9 +19,12 @@ double FluidSolver::stable_dt() {
   // maxima and the points' arrays in locals (registers, not reloaded per point).
   double v2max = 0.0, rho_max = eos.rho0, mrho_max = -eos.rho0, ratio_max = 0.0, mth_max = -1.0,
          mgrain_max = -HUGE_VAL;
+  // pressure eos, for the scene's pressure scale (pressure_warning): the largest point pressure,
+  // the largest |f/m| squared of the points' external force (gravity), the points' extent
+  double p_max = -HUGE_VAL, a2max = 0.0, ext[6] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   const int n = pts.nlocal, *mask = pts.mask, point_bit = pts.point_bit;
   double *const *vel = pts.v, *const *state = pts.state;
-  const bool coupled = opt.coupled;
+  const bool coupled = opt.coupled, eos_scale = !opt.projection;
   for (int i = 0; i < n; ++i) {
     if (mask[i] & point_bit) {
       const double *v = vel[i], *s = state[i];
@@ -29,6 +32,15 @@ double FluidSolver::stable_dt() {
       const double rho = s[C_RHO];
       rho_max = std::max(rho_max, rho);
       mrho_max = std::max(mrho_max, -rho);
+      if (eos_scale) {
+        p_max = std::max(p_max, s[C_P]);
+        const double *f = pts.f[i], *x = pts.x[i], m = pts.rmass[i];
+        a2max = std::max(a2max, (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) / (m * m));
+        for (int d = 0; d < 3; ++d) {
+          ext[2 * d] = std::max(ext[2 * d], x[d]);
+          ext[2 * d + 1] = std::max(ext[2 * d + 1], -x[d]);
+        }
+      }
       if (coupled) {
         const double th = s[C_THETA];
         if (th > 0.0 && th < 1.0) {
@@ -41,9 +53,17 @@ double FluidSolver::stable_dt() {
       mgrain_max = std::max(mgrain_max, -pts.rmass[i] / (4.0 / 3.0 * M_PI * r * r * r));
     }
   }
-  double loc[6] = {std::sqrt(v2max), rho_max, mrho_max, ratio_max, mth_max, mgrain_max};
-  double glob[6];
-  MPI_Allreduce(loc, glob, 6, MPI_DOUBLE, MPI_MAX, comm_);
+  double loc[14] = {std::sqrt(v2max), rho_max, mrho_max, ratio_max, mth_max, mgrain_max, p_max, a2max,
+                    ext[0], ext[1], ext[2], ext[3], ext[4], ext[5]};
+  double glob[14];
+  MPI_Allreduce(loc, glob, eos_scale ? 14 : 6, MPI_DOUBLE, MPI_MAX, comm_);
+  if (eos_scale) {
+    // rho0 (|a|max H + |v|max^2), H the points' largest extent: hydrostatic plus dynamic pressure
+    double extent = 0.0;
+    for (int d = 0; d < 3; ++d) extent = std::max(extent, glob[8 + 2 * d] + glob[9 + 2 * d]);
+    p_max_ = glob[6];
+    p_scale_ = eos.rho0 * (std::sqrt(glob[7]) * std::max(extent, 0.0) + glob[0] * glob[0]);
+  }
   // Sound speed: largest over the density range (Tait stiffens under compression, the linear
   // law under tension).
   // Projection: incompressible, no sound speed; the advective and viscous limits remain.
@@ -72,18 +92,31 @@ double FluidSolver::stable_dt() {
   return std::min(dt_ac, dt_visc);
 }
 
-// Once per run: the points' density (reduced in stable_dt) left [0.5, 2] rho0 under the equation
-// of state: the weakly compressible model is far from its range (a column hitting the floor fast).
+// Once per run, under the equation of state (both reduced in stable_dt): the points' density
+// deviates from rho0 by more than kDensityDeviation, or the largest point pressure exceeds
+// kPressureFactor times the scene's scale rho0 (|a| H + |v|max^2) (hydrostatic plus dynamic): the
+// weakly compressible fluid is out of its range (a soft bulk modulus, a fast impact, pressure noise
+// in a dense bed), and its pressures and densities are not those of water.
 std::string FluidSolver::density_warning() {
+  constexpr double kDensityDeviation = 0.03, kPressureFactor = 5.0;
   if (opt.projection || density_warned_) return "";
   const double r0 = opt.eos.rho0, lo = rho_range_[0] / r0, hi = rho_range_[1] / r0;
-  if (lo >= 0.5 && hi <= 2.0) return "";
+  const bool density = lo < 1.0 - kDensityDeviation || hi > 1.0 + kDensityDeviation;
+  const bool pressure = p_max_ > kPressureFactor * p_scale_ && p_scale_ > 0.0;
+  if (!density && !pressure) return "";
   density_warned_ = true;
   std::ostringstream os;
-  os.precision(6);
-  os << "WARNING: fix mpm/fluid: the points' density left [0.5, 2] rho0 at step " << clock.step << " (rho/rho0 from "
-     << lo << " to " << hi << "): the fluid is compressed or stretched far beyond a weakly compressible fluid; "
-     << "raise keyword 'bulk' (" << opt.eos.K << ") or lower the speeds (warned once per run)\n";
+  os.precision(4);
+  os << "WARNING: fix mpm/fluid (pressure eos): at step " << clock.step;
+  if (density)
+    os << " the points' density left rho0 by more than " << 100 * kDensityDeviation << " % (rho/rho0 from " << lo << " to "
+       << hi << ")" << (pressure ? " and" : "");
+  if (pressure)
+    os << " the largest point pressure " << p_max_ << " exceeds " << kPressureFactor
+       << " times the scene's scale rho0 (|a| H + |v|max^2) = " << p_scale_;
+  os << ": the weakly compressible fluid is outside its range. Remedies: a stiffer 'bulk' (" << opt.eos.K
+     << ") with a smaller timestep or 'subcycle yes', or the incompressible default 'pressure projection' "
+     << "(warned once per run)\n";
   return os.str();
 }
 
