@@ -57,6 +57,8 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   env.group_exists = [this](const char *name) { return group->find(name) >= 0; };
   env.mesh_wall = [this](int n, char **a, int i) { return parse_mesh_wall(n, a, i); };
   guarded([&] { solver.reset(new mpm::FluidSolver(mpm::parse_options(narg, arg, env), world)); });
+  if (comm->me == 0)
+    for (const std::string &w : solver->opt.warnings) error->warning(FLERR, w.c_str());
 
   restart_global = 1;
   restart_peratom = 1;

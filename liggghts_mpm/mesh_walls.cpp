@@ -30,7 +30,7 @@ constexpr int kPack = 21;  // doubles per packed triangle: 9 positions, 9 veloci
                            // global triangle ID, periodic image code
 
 std::string fix_msg(const std::string &id, const std::string &what) {
-  return "mesh wall: fix ID '" + id + "': " + what;
+  return "keyword 'mesh_wall': fix ID '" + id + "': " + what;
 }
 
 std::vector<WallSpec> checked(const std::vector<MeshWallSpec> &specs) {

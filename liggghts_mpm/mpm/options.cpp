@@ -604,6 +604,10 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
     if (!k)
       throw Error(std::string("Fix mpm/fluid: unknown keyword '") + kw +
                   "' (see docs/fix_mpm_fluid.md for the keywords)");
+    // a keyword given again replaces its value (boundary and mesh_wall: one face or mesh each)
+    if (std::find(seen.begin(), seen.end(), kw) != seen.end() && strcmp(kw, "boundary") != 0 &&
+        strcmp(kw, "mesh_wall") != 0)
+      o.warnings.push_back(std::string("Fix mpm/fluid: keyword '") + kw + "' given more than once; the last value is used");
     seen.push_back(kw);
     if (k->real) {
       a.need(1, kw, k->help);
@@ -647,6 +651,13 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
     std::ostringstream os;
     os << "Fix mpm/fluid: keyword 'height' expects a wall position inside the grid along " << "xyz"[o.wall_axis]
        << " [" << o.grid.origin[o.wall_axis] << ", " << o.grid.upper(o.wall_axis) << "], got " << o.wall_pos;
+    throw Error(os.str());
+  }
+  if (o.hydrostatic && !(o.hydro_surface > o.grid.origin[o.hydro_axis])) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: keyword 'hydrostatic' expects a surface above the grid's lower bound along "
+       << "xyz"[o.hydro_axis] << " (" << o.grid.origin[o.hydro_axis] << "; below it every initial pressure is 0), got "
+       << o.hydro_surface;
     throw Error(os.str());
   }
   const Gate &g = o.gate;

@@ -107,6 +107,8 @@ struct Options {
   int out_every = 0;
   std::string out_prefix;
   std::vector<std::string> out_point_fields, out_grid_fields;
+  // warnings of the parser (a keyword given twice), printed by the fix
+  std::vector<std::string> warnings;
 };
 
 // What the parser needs to know of the simulation around it (LIGGGHTS' box, groups, types).
