@@ -125,7 +125,7 @@ SPEC = {
 BAD_REAL = ["0", "-1", "nan", "inf", "-inf", "1e308", "-1e308", "1e-308", "1e400", "99999999999999999999",
             "0x10", "1,5", "abc", None]
 BAD_INT = ["0", "-1", "1.5", "nan", "2147483648", "9223372036854775808", "99999999999999999999", "1e3", "abc", None]
-BAD_WORD = ["maybe", "1", "YES", "x y", None]
+BAD_WORD = ["maybe", "1", "YES", "\"x y\"", None]
 # --quick: one bad value per argument, taken in turn from these lists (the keyword's and argument's
 # positions pick it), so that the sample still sees every kind of value
 QUICK_REAL = ["nan", "-1", "1e400", "inf", "abc", "1e-308", "0x10"]

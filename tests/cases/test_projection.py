@@ -164,7 +164,7 @@ def case_bad_input(r):
         (base + " bulk 2e9", "'pressure projection' does not use keyword(s) 'bulk'"),
         (base + " eos tait 7 antilock no pmin 0", "'eos', 'antilock', 'pmin'"),
         (base + " tolerance 0", "keyword 'tolerance' expects a relative residual > 0"),
-        (base + " max_iterations 0", "keyword 'max_iterations' expects an integer >= 1"),
+        (base + " max_iterations 0", "keyword 'max_iterations' expects an integer in [1, 1000000]"),
         (base + " pressure incompressible", "keyword 'pressure' expects 'projection' or 'eos'"),
         ("cell 0.5 density 1000 bulk 2e6 fill col 2 2 2 type 1 tolerance 1e-6",
          "'tolerance' belong to 'pressure projection'"),
