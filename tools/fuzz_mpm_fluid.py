@@ -243,7 +243,7 @@ def cases(quick):
                 continue
             bad, extreme = values_for(slot, quick, ikw + pos)
             for group, vals in (("bad", bad), ("extreme", extreme)):
-                if group == "bad" and (not quick or (pos == 0 and ikw % 3 == 0)) and (kw, pos) not in OPTIONAL:
+                if group == "bad" and (not quick or (pos == 0 and ikw % 4 == 0)) and (kw, pos) not in OPTIONAL:
                     vals = vals + [None] if None not in vals else vals
                 for v in vals:
                     if v is None and (kw, pos) in OPTIONAL:
@@ -262,7 +262,7 @@ def cases(quick):
                     label = f"{kw}/{pos}/{v if v is not None else 'missing'}"
                     out.append((label, script(ctx, extra), kw, group))
                     # the same through fix_modify for the keywords it changes
-                    if v is not None and kw in MODIFIABLE and group == "bad" and (not quick or (pos == 0 and ikw % 2 == 0)):
+                    if v is not None and kw in MODIFIABLE and group == "bad" and (not quick or (pos == 0 and ikw % 3 == 0)):
                         mod = "fix_modify fluid " + kw + " " + " ".join(example[:pos] + [v] + example[pos + 1:])
                         if kw == "gate":
                             mod = "fix_modify fluid gate " + v
@@ -273,7 +273,7 @@ def cases(quick):
             out.append((f"{kw}/repeated", script(ctx, one + " " + one), kw, "repeat"))
     for kw in ("tolerance", "cell", "pressure", "mesh_wall", "couple", "density", "colour"):
         out.append((f"fix_modify/{kw}/not_modifiable", script("eos", "", post=f"fix_modify fluid {kw} 1"), kw, "bad"))
-    for label, extra, ctx, kw in (CONFLICTS if not quick else CONFLICTS[::3]):
+    for label, extra, ctx, kw in (CONFLICTS if not quick else CONFLICTS[::4]):
         out.append((f"conflict/{label}", script(ctx, extra), kw, "bad"))
     # fix balance/mpm
     for ikw, (kw, slots) in enumerate(BAL_SPEC.items()):
