@@ -262,7 +262,7 @@ def cases(quick):
                     label = f"{kw}/{pos}/{v if v is not None else 'missing'}"
                     out.append((label, script(ctx, extra), kw, group))
                     # the same through fix_modify for the keywords it changes
-                    if v is not None and kw in MODIFIABLE and group == "bad" and (not quick or (pos == 0 and ikw % 3 == 0)):
+                    if v is not None and kw in MODIFIABLE and group == "bad" and (not quick or (pos == 0 and ikw % 4 == 0)):
                         mod = "fix_modify fluid " + kw + " " + " ".join(example[:pos] + [v] + example[pos + 1:])
                         if kw == "gate":
                             mod = "fix_modify fluid gate " + v
@@ -279,6 +279,8 @@ def cases(quick):
     for ikw, (kw, slots) in enumerate(BAL_SPEC.items()):
         example = [ex for _, ex in slots]
         for pos, (slot, _) in enumerate(slots):
+            if quick and pos > 0:
+                continue
             bad, extreme = values_for(slot, quick, ikw + pos)
             if (not quick or (pos == 0 and ikw % 2 == 0)) and None not in bad:
                 bad = bad + [None]
