@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <sstream>
+#include <string>
 #include <utility>
 
 #include "atom.h"
@@ -33,9 +34,15 @@ using mpm::parse_int;
 
 FixBalanceMpm::FixBalanceMpm(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg) {
   int iarg = 3;
+  std::vector<std::string> seen;
   while (iarg < narg) {
     const char *kw = arg[iarg];
     const char *v = iarg + 1 < narg ? arg[iarg + 1] : nullptr;
+    // a keyword given again replaces its value (weight: one group each)
+    if (strcmp(kw, "weight") != 0 && std::find(seen.begin(), seen.end(), kw) != seen.end() && comm->me == 0)
+      error->warning(FLERR, (std::string("Fix balance/mpm: keyword '") + kw +
+                             "' given more than once; the last value is used").c_str());
+    seen.push_back(kw);
     if (strcmp(kw, "dim") == 0) {
       dim_ = mpm::axis_of(v);
       if (dim_ < 0) bad_arg(kw, "x, y or z", v);
@@ -94,6 +101,21 @@ void FixBalanceMpm::bad_arg(const char *keyword, const char *expected, const cha
 }
 
 int FixBalanceMpm::setmask() { return FixConst::PRE_EXCHANGE; }
+
+// measured yes scales the weights by the work fix mpm/fluid measured: without one it would do nothing
+void FixBalanceMpm::init() {
+  if (measured_ && fluid_fixes().empty())
+    error->all(FLERR, "Fix balance/mpm: keyword 'measured yes' scales the weights by the work of fix mpm/fluid, "
+                      "and no fix mpm/fluid is defined; remove it or define the fluid fix");
+}
+
+// The keywords are set in the fix command only: fix_modify names the word it cannot change.
+int FixBalanceMpm::modify_param(int narg, char **arg) {
+  error->all(FLERR, (std::string("Fix balance/mpm: fix_modify cannot change keyword '") + arg[0] +
+                     "' (the keywords dim, every, weight, volume, thresh and measured are set in the fix command)")
+                        .c_str());
+  return 0;
+}
 
 
 double FixBalanceMpm::base_weight(int i) const {

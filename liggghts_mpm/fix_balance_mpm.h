@@ -22,7 +22,9 @@ class FixBalanceMpm : public Fix {
  public:
   FixBalanceMpm(class LAMMPS *, int, char **);
   int setmask() override;
+  void init() override;
   void setup_pre_exchange() override;
+  int modify_param(int, char **) override;
   void pre_exchange() override;
   double compute_vector(int) override;
 

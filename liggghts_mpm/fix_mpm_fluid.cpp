@@ -33,6 +33,7 @@
 
 #include "mpm/error.h"
 #include "fix_mpm_fluid_guarded.h"
+#include "restart_guard.h"
 
 using namespace LAMMPS_NS;
 using namespace FixConst;
@@ -56,6 +57,8 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   env.group_exists = [this](const char *name) { return group->find(name) >= 0; };
   env.mesh_wall = [this](int n, char **a, int i) { return parse_mesh_wall(n, a, i); };
   guarded([&] { solver.reset(new mpm::FluidSolver(mpm::parse_options(narg, arg, env), world)); });
+  if (comm->me == 0)
+    for (const std::string &w : solver->opt.warnings) error->warning(FLERR, w.c_str());
 
   restart_global = 1;
   restart_peratom = 1;
@@ -69,7 +72,7 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   peratom_flag = 1;
   size_peratom_cols = NCOL;
   peratom_freq = 1;
-  nevery = solver->opt.out_every > 0 ? solver->opt.out_every : 1;
+  nevery = 1;  // end_of_step every step: the output's own steps, and the restart files (restart_guard.h)
 
   grow_arrays(atom->nmax);
   atom->add_callback(0);
@@ -84,17 +87,15 @@ FixMpmFluid::~FixMpmFluid() {
 }
 
 int FixMpmFluid::setmask() {
-  int mask = PRE_FINAL_INTEGRATE;
-  if (solver->opt.out_every > 0) mask |= END_OF_STEP;
-  return mask;
+  return PRE_FINAL_INTEGRATE | END_OF_STEP;
 }
 
+// the screen of liggghts_mpm copies a line "ERROR on proc" into the log file (main.cpp); a rank
+// without screen and log file (ranks other than 0) writes to stderr
 void FixMpmFluid::fail_one(const std::string &msg) {
-  for (FILE *f : {screen, logfile})
-    if (f) {
-      fprintf(f, "ERROR on proc %d: %s\n", comm->me, msg.c_str());
-      fflush(f);
-    }
+  FILE *f = screen ? screen : logfile ? logfile : stderr;
+  fprintf(f, "ERROR on proc %d: %s\n", comm->me, msg.c_str());
+  fflush(f);
   MPI_Abort(world, 1);
   std::abort();
 }
@@ -197,7 +198,9 @@ void FixMpmFluid::refresh_walls() {
 void FixMpmFluid::setup(int) {
   mpm::FluidSolver &s = sync();
   s.setup_grid(domain->sublo, domain->subhi, neighbor->skin);
+  check_gate_side();
   if (!mesh_specs.empty()) {
+    const bool first = !mesh_walls;  // the sides given in the fix command are checked at the first setup
     try {
       std::vector<mpm::MeshWallSpec> sp = mesh_specs;  // sides found in an earlier run are kept
       if (mesh_walls) for (size_t k = 0; k < sp.size(); ++k) sp[k].side = mesh_walls->side(k);
@@ -211,7 +214,7 @@ void FixMpmFluid::setup(int) {
     std::vector<const double *> pts;
     for (int i = 0; i < atom->nlocal; ++i) if (is_point(i)) pts.push_back(atom->x[i]);
     try {
-      print(mesh_walls->infer_sides(pts.data(), (int)pts.size(), 1.0 * s.opt.grid.dx));
+      print(mesh_walls->infer_sides(pts.data(), (int)pts.size(), 1.0 * s.opt.grid.dx, first));
     } catch (const std::exception &e) {
       error->all(FLERR, (std::string("Fix mpm/fluid: ") + e.what()).c_str());
     }
@@ -232,6 +235,36 @@ void FixMpmFluid::setup(int) {
   mark_run_start();
 }
 
+/* The gate holds the fluid on one side and puts back the points that crossed it by less than a
+   cell. Points found at a setup farther than a cell on its other side would all be pressed against
+   it (the whole fluid, for a gate on the wrong side or at a grid face with the fluid beyond it):
+   an error naming the gate, the sides and how much fluid is where. */
+void FixMpmFluid::check_gate_side() {
+  const mpm::Options &o = solver->opt;
+  const mpm::Gate &g = o.gate;
+  if (!g.active) return;
+  double loc[4] = {0.0, 0.0, 0.0, 0.0}, glob[4];  // points and mass on the held side, beyond a cell on the other
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (!is_point(i)) continue;
+    const double beyond = g.fluid_below ? atom->x[i][g.dim] - g.pos : g.pos - atom->x[i][g.dim];
+    const int k = beyond <= 0.0 ? 0 : beyond > o.grid.dx ? 2 : -1;
+    if (k < 0) continue;
+    loc[k] += 1.0;
+    loc[k + 1] += atom->rmass[i];
+  }
+  MPI_Allreduce(loc, glob, 4, MPI_DOUBLE, MPI_SUM, world);
+  if (glob[2] == 0.0) return;
+  const char *held = g.fluid_below ? "lower" : "upper", *other = g.fluid_below ? "upper" : "lower";
+  std::ostringstream os;
+  os.precision(6);
+  os << "Fix mpm/fluid: keyword 'gate' (" << "xyz"[g.dim] << " " << g.pos << " " << held << ") holds the fluid on its "
+     << held << " side, but " << glob[2] << " material points (mass " << glob[3] << ") lie on its " << other
+     << " side farther than one cell (" << o.grid.dx << ") from it, against " << glob[0] << " points (mass " << glob[1]
+     << ") on the " << held << " side: the gate puts back only points within one cell, the others would be pressed "
+     << "against it; give '" << other << "' or move the gate";
+  error->all(FLERR, os.str().c_str());
+}
+
 // the counters at the start of a run ('run N pre no' skips setup(): post_run marks it as well)
 void FixMpmFluid::mark_run_start() {
   const mpm::FluidSolver &s = *solver;
@@ -248,6 +281,7 @@ void FixMpmFluid::mark_run_start() {
 /* Where the fix's time went in the run just finished (slowest rank), next
    to LIGGGHTS' "Loop time": the fluid's own work and the coupling. */
 void FixMpmFluid::post_run() {
+  mpm::periodic_restarts().settle(lmp);
   const mpm::FluidSolver &s = *solver;
   double t[4] = {s.time_fluid - run_time_start[0], s.time_couple - run_time_start[1],
                  s.time_pressure_solver() - run_time_start[2], s.time_output - run_time_start[5]},
@@ -288,6 +322,7 @@ void FixMpmFluid::post_run() {
 ------------------------------------------------------------------------- */
 
 void FixMpmFluid::pre_final_integrate() {
+  mpm::periodic_restarts().settle(lmp);
   mpm::FluidSolver &s = sync();
   if (!s.grid_ready()) {
     // a new grid patch inside a run (fix balance/mpm every N): as at the setup of a run, the
@@ -339,6 +374,9 @@ int FixMpmFluid::modify_param(int narg, char **arg) {
 void FixMpmFluid::end_of_step() {
   const int every = solver->opt.out_every;
   if (every > 0 && update->ntimestep % every == 0) guarded([&] { sync().write_output(); });
+  // restart files of the restart command due now: LIGGGHTS writes them after this, through FIFOs;
+  // settled (renamed into place or removed with an error) at the next step or the end of the run
+  mpm::periodic_restarts().arm(lmp);
 }
 
 /* ----------------------------------------------------------------------

@@ -78,6 +78,7 @@ class FixMpmFluid : public Fix {
   void fill_points();
   void check_fill_memory(class Region *region, const int lo[3], const int hi[3]);
   void refresh_walls();
+  void check_gate_side();
   mpm::FluidSolver &sync();  // the solver with views of the current atom arrays and clock
   template <class Fn> void guarded(Fn &&fn);  // runs fn, translating the solver's errors
   void print(const std::string &text) const;  // rank 0: to screen and log file

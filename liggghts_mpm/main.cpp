@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "input.h"
@@ -26,7 +27,48 @@ bool is_any(const char *arg, std::initializer_list<const char *> names) {
   return false;
 }
 
+// The screen as LIGGGHTS writes to it, passed through to the real screen; a line "ERROR on proc
+// N: ..." (LIGGGHTS' error->one, which writes to the screen only and then aborts) is copied into
+// the log file as well, so that every error of the run is in both.
+struct ScreenTee {
+  FILE *screen;
+  FILE **logfile;  // LAMMPS::logfile (may change with the 'log' command)
+  std::string line;
+};
+
+ssize_t tee_write(void *cookie, const char *buf, size_t size) {
+  auto *t = static_cast<ScreenTee *>(cookie);
+  const size_t n = std::fwrite(buf, 1, size, t->screen);
+  for (size_t k = 0; k < size; ++k) {
+    t->line.push_back(buf[k]);
+    if (buf[k] != '\n') continue;
+    if (t->line.rfind("ERROR on proc", 0) == 0 && *t->logfile) {
+      std::fputs(t->line.c_str(), *t->logfile);
+      std::fflush(*t->logfile);
+    }
+    t->line.clear();
+  }
+  return static_cast<ssize_t>(n);
+}
+
+int tee_close(void *cookie) {
+  auto *t = static_cast<ScreenTee *>(cookie);
+  const int rc = t->screen == stdout ? std::fflush(stdout) : std::fclose(t->screen);
+  delete t;
+  return rc;
+}
+
 }  // namespace
+
+// Every abort of this executable goes through here (the MPI profiling interface: libliggghts'
+// calls of MPI_Abort resolve to this definition, which ends in PMPI_Abort). LIGGGHTS prints an
+// error to the screen and log file and then aborts without flushing them: when the screen is a pipe
+// or a file (batch systems) or for the log file, the message stayed in the stdio buffers and was
+// lost. Flushing every output stream first brings it out.
+extern "C" int MPI_Abort(MPI_Comm comm, int errorcode) {
+  std::fflush(nullptr);
+  return PMPI_Abort(comm, errorcode);
+}
 
 int main(int argc, char **argv) {
   MPI_Init(&argc, &argv);
@@ -69,6 +111,16 @@ int main(int argc, char **argv) {
   }
   args.push_back(nullptr);
   auto *lmp = new LAMMPS_NS::LAMMPS(int(args.size()) - 1, args.data(), MPI_COMM_WORLD);
+  if (lmp->screen && lmp->logfile) {
+    cookie_io_functions_t io = {nullptr, tee_write, nullptr, tee_close};
+    auto *tee = new ScreenTee{lmp->screen, &lmp->logfile, std::string()};
+    if (FILE *f = fopencookie(tee, "w", io)) {
+      std::setvbuf(f, nullptr, _IOLBF, 0);
+      lmp->screen = f;
+    } else {
+      delete tee;
+    }
+  }
   mpm::register_styles(lmp);
   if (help) {
     if (lmp->universe->me == 0) mpm::print_help(lmp, LIGGGHTS_MPM_VERSION);

@@ -30,7 +30,7 @@ constexpr int kPack = 21;  // doubles per packed triangle: 9 positions, 9 veloci
                            // global triangle ID, periodic image code
 
 std::string fix_msg(const std::string &id, const std::string &what) {
-  return "mesh wall: fix ID '" + id + "': " + what;
+  return "keyword 'mesh_wall': fix ID '" + id + "': " + what;
 }
 
 std::vector<WallSpec> checked(const std::vector<MeshWallSpec> &specs) {
@@ -185,7 +185,7 @@ bool MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
 // ---------------------------------------------------------------------------------------------
 // Fluid side from the points
 
-std::string MeshWalls::infer_sides(const double *const *x, int n, double reach) {
+std::string MeshWalls::infer_sides(const double *const *x, int n, double reach, bool check_given) {
   const size_t nm = ids_.size();
   std::vector<long> votes(2 * nm, 0);  // [k][0] normal side, [k][1] opposite side
   geo_.side_votes(x, n, reach, votes.data());
@@ -193,8 +193,21 @@ std::string MeshWalls::infer_sides(const double *const *x, int n, double reach) 
   MPI_Allreduce(votes.data(), total.data(), static_cast<int>(2 * nm), MPI_LONG, MPI_SUM, lmp_->world);
   std::ostringstream log;
   for (size_t k = 0; k < nm; ++k) {
-    if (geo_.wall(static_cast<int>(k)).side != SIDE_AUTO) continue;
+    const int side = geo_.wall(static_cast<int>(k)).side;
     const long np = total[2 * k], no = total[2 * k + 1];
+    if (check_given && (side == SIDE_NORMAL || side == SIDE_OPPOSITE)) {
+      const long on = side == SIDE_NORMAL ? np : no, off = side == SIDE_NORMAL ? no : np;
+      if (off > on) {
+        std::ostringstream os;
+        os << "side " << (side == SIDE_NORMAL ? "normal" : "opposite") << " holds the fluid on the "
+           << (side == SIDE_NORMAL ? "side its normals point to" : "side against its normals") << ", but " << off
+           << " of the " << on + off << " material points within " << reach << " of its faces lie on the other side ("
+           << on << " on the given side): that fluid would be held behind the wall; give 'side "
+           << (side == SIDE_NORMAL ? "opposite" : "normal") << "' or 'side auto'";
+        throw std::runtime_error(fix_msg(ids_[k], os.str()));
+      }
+    }
+    if (side != SIDE_AUTO) continue;
     if (np == 0 && no == 0)
       throw std::runtime_error(fix_msg(ids_[k], "no fluid point lies within reach of a triangle face; "
                                                  "cannot infer the fluid side (give it explicitly)"));

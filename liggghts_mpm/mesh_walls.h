@@ -41,8 +41,10 @@ class MeshWalls {
   // Collective. For every mesh with side SIDE_AUTO: the points x[0..n-1] vote
   // (WallGeometry::side_votes); the majority over all ranks fixes the side. Throws if a mesh gets
   // no vote. Needs a refresh() whose patch covers the points. Returns a one-line summary per mesh
-  // (for the log).
-  std::string infer_sides(const double *const *x, int n, double reach);
+  // (for the log). check_given: also throws for a mesh whose side was given (normal or opposite)
+  // when more of the points within reach of its faces lie on its other side (the fluid there would
+  // be held behind the wall), naming the mesh, the side and the counts.
+  std::string infer_sides(const double *const *x, int n, double reach, bool check_given = false);
 
   // Sum over ranks of the local triangles of all meshes (collective); for logs and tests.
   long global_triangles() const;

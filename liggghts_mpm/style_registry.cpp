@@ -11,6 +11,7 @@
 
 #include "fix_balance_mpm.h"
 #include "fix_mpm_fluid.h"
+#include "restart_guard.h"
 
 using namespace LAMMPS_NS;
 
@@ -63,6 +64,7 @@ const FixStyle kFixStyles[] = {
 void mpm::register_styles(LAMMPS *lmp) {
   std::map<std::string, FixCreatorFn> &fixes = *(lmp->modify->*modify_fix_map());
   for (const FixStyle &s : kFixStyles) fixes[s.name] = s.create;
+  mpm::register_restart_command(lmp);  // write_restart: the file complete or absent
 }
 
 std::vector<std::string> mpm::fix_style_names() {

@@ -1,6 +1,7 @@
 #include "mpm/options.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <iterator>
 #include <cstdlib>
 #include <cstring>
@@ -199,8 +200,8 @@ void parse_pmin(Options &o, Args &a, const ParseEnv &) {
   a.need(1, "pmin", "the lowest (cavitation) pressure, a number or 'none'");
   if (strcmp(a.at(1), "none") == 0)
     o.pmin = -HUGE_VAL;
-  else if (!parse_double(a.at(1), o.pmin))
-    bad_arg("pmin", "the lowest (cavitation) pressure, a number or 'none'", a.at(1));
+  else if (!parse_double(a.at(1), o.pmin) || o.pmin > 0.0)
+    bad_arg("pmin", "the lowest (cavitation) pressure, a number <= 0 (no tension beyond it) or 'none'", a.at(1));
   a.iarg += 2;
 }
 
@@ -289,14 +290,17 @@ void parse_output(Options &o, Args &a, const ParseEnv &) {
     list->push_back(w);
     ++a.iarg;
   }
+  if (o.out_point_fields.empty() && o.out_grid_fields.empty())
+    bad_arg("output", "at least one field after 'points' (point fields or 'grid' and grid fields)", nullptr);
 }
 
 void parse_pressure(Options &o, Args &a, const ParseEnv &) { choice(a, "projection", "eos", o.projection); }
 
 void parse_max_iterations(Options &o, Args &a, const ParseEnv &) {
-  const char *what = "an integer >= 1 (iterations of the pressure solve)";
+  // hypre's PCG keeps two doubles per allowed iteration (its residual history): 1e6 is 16 MB
+  const char *what = "an integer in [1, 1000000] (iterations of the pressure solve)";
   a.need(1, "max_iterations", what);
-  if (!parse_int(a.at(1), o.pressure_max_iterations) || o.pressure_max_iterations < 1)
+  if (!parse_int(a.at(1), o.pressure_max_iterations, 1, 1000000))
     bad_arg("max_iterations", what, a.at(1));
   a.iarg += 2;
 }
@@ -330,6 +334,37 @@ void check_pressure_model(Options &o, const std::vector<std::string> &seen) {
                 "to use that model, or remove them");
   throw Error("Fix mpm/fluid: keyword(s) " + bad + " belong to 'pressure projection' (the pressure solve); "
               "add 'pressure projection' or remove them");
+}
+
+// Keywords that another choice makes inert: one row each (keyword, when it has no effect, why);
+// an error naming the keyword and the reason, from the fix command (the keywords given) and from
+// fix_modify (the keyword changed). Add a row for a new dependency.
+struct Inert {
+  const char *keyword;
+  bool (*inert)(const Options &);
+  const char *why;
+};
+bool no_grains(const Options &o) { return !o.coupled; }
+bool shear_without_viscosity(const Options &o) {
+  if (o.viscosity > 0.0) return false;
+  for (const Face &f : o.face)
+    if (f.kind == BcKind::Shear) return true;
+  return false;
+}
+const Inert kInert[] = {
+    {"drag", no_grains, "the drag acts between the fluid and the grains of keyword 'couple', which is not given"},
+    {"theta_min", no_grains, "the fluid fraction comes from the grains of keyword 'couple', which is not given"},
+    {"theta_smooth", no_grains, "the fluid fraction comes from the grains of keyword 'couple', which is not given"},
+    {"cell_check", no_grains, "it checks the grains of keyword 'couple', which is not given"},
+    {"boundary", shear_without_viscosity,
+     "a 'shear' face exerts the stress mu v_t / delta, which is 0 without keyword 'viscosity' > 0"},
+};
+
+void check_inert(const Options &o, const std::vector<std::string> &seen, const char *command) {
+  for (const Inert &r : kInert)
+    if (std::find(seen.begin(), seen.end(), r.keyword) != seen.end() && r.inert(o))
+      throw Error(std::string("Fix mpm/fluid: ") + command + "keyword '" + r.keyword + "' has no effect here: " + r.why +
+                  "; remove it");
 }
 
 // Grid: cubic cells fitted exactly into the bounds (the box, or keyword grid).
@@ -379,6 +414,18 @@ void check_derived(const Options &o) {
        << " smoothing passes per step with cell " << g.dx << " (at most 1e6); reduce it";
     throw Error(os.str());
   }
+  const double dt_visc = viscous_dt_limit(g.dx, o.rho0, o.viscosity, o.dimension);
+  if (!(dt_visc >= DBL_MIN) || std::isnan(dt_visc)) {
+    os << "Fix mpm/fluid: keywords 'viscosity' (" << o.viscosity << ") and 'density' (" << o.rho0
+       << ") give a viscous time step limit " << dt_visc << " that is not a positive normal number in double precision";
+    throw Error(os.str());
+  }
+  // the pressure solve forms 1/rho0 and dot products of its squares: both within double precision
+  if (o.projection && !(o.rho0 >= 1e-150 && o.rho0 <= 1e150)) {
+    os << "Fix mpm/fluid: keyword 'density' expects with 'pressure projection' a reference density in [1e-150, 1e150] "
+       << "(the pressure solve squares 1/rho0), got " << o.rho0;
+    throw Error(os.str());
+  }
   if (o.projection) return;  // no equation of state
   const Eos &e = o.eos;
   double rho_hi = e.rho0;
@@ -393,18 +440,20 @@ void check_derived(const Options &o) {
       throw Error(os.str());
     }
   }
+  // the sound speed up to 2 rho0, the density range the run watches (density warning)
+  if (!std::isfinite(e.sound_speed_sq(2.0 * e.rho0)) || !std::isfinite(e.pressure(2.0 * e.rho0))) {
+    os << "Fix mpm/fluid: keyword 'eos' (" << (e.kind == EosKind::Tait ? "tait, gamma " : "linear") ;
+    if (e.kind == EosKind::Tait) os << e.gamma;
+    os << ") with 'bulk' " << e.K << " gives at twice the reference density a pressure or sound speed that is not "
+       << "finite in double precision; use a smaller gamma";
+    throw Error(os.str());
+  }
   const double c2 = std::max(e.sound_speed_sq(e.rho0), e.sound_speed_sq(rho_hi));
   const double dt_ac = acoustic_dt_limit(o.cfl, g.dx, std::sqrt(c2), 0.0);
   if (!std::isfinite(c2) || !(c2 > 0.0) || !std::isfinite(dt_ac) || !(dt_ac > 0.0)) {
     os << "Fix mpm/fluid: keywords 'bulk' (" << e.K << ") and 'density' (" << e.rho0
        << ") give a sound speed squared " << c2 << " and an acoustic time step limit " << dt_ac
        << " that are not finite and positive in double precision; use values of physical size";
-    throw Error(os.str());
-  }
-  const double dt_visc = viscous_dt_limit(g.dx, e.rho0, o.viscosity, o.dimension);
-  if (!(dt_visc > 0.0) || std::isnan(dt_visc)) {
-    os << "Fix mpm/fluid: keywords 'viscosity' (" << o.viscosity << ") and 'density' (" << e.rho0
-       << ") give a viscous time step limit " << dt_visc << " that is not positive in double precision";
     throw Error(os.str());
   }
 }
@@ -456,7 +505,7 @@ const std::vector<Keyword> kTable = {
      "'eos' or 'projection'", nullptr, 0, 0, false, false, nullptr, parse_pressure, false},
     {"tolerance", "real", "-", "> 0", "1e-8", "a relative residual > 0 of the pressure solve",
      REAL(pressure_tolerance), 0.0, kInf, true, true, nullptr, nullptr, false},
-    {"max_iterations", "integer", "-", ">= 1", "200", "an integer >= 1 (iterations of the pressure solve)",
+    {"max_iterations", "integer", "-", "[1, 1000000]", "200", "an integer in [1, 1000000] (iterations of the pressure solve)",
      nullptr, 0, 0, false, false, nullptr, parse_max_iterations, false},
     {"volume_correction", "real", "1/time", ">= 0", "0", "a rate (1/time) >= 0 at which compressed points are pushed apart",
      REAL(volume_correction), 0.0, kInf, false, true, nullptr, nullptr, false},
@@ -532,6 +581,10 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
     if (!k)
       throw Error(std::string("Fix mpm/fluid: unknown keyword '") + kw +
                   "' (see docs/fix_mpm_fluid.md for the keywords)");
+    // a keyword given again replaces its value (boundary and mesh_wall: one face or mesh each)
+    if (std::find(seen.begin(), seen.end(), kw) != seen.end() && strcmp(kw, "boundary") != 0 &&
+        strcmp(kw, "mesh_wall") != 0)
+      o.warnings.push_back(std::string("Fix mpm/fluid: keyword '") + kw + "' given more than once; the last value is used");
     seen.push_back(kw);
     if (k->real) {
       a.need(1, kw, k->help);
@@ -575,15 +628,31 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
   fit_grid(o, env);
   if (!o.wall_pos_given) o.wall_pos = o.grid.origin[o.wall_axis];
   check_derived(o);
+  check_inert(o, seen, "");
+  if (o.wall_pos_given && !o.grid.periodic[o.wall_axis] &&
+      !(o.wall_pos >= o.grid.origin[o.wall_axis] && o.wall_pos <= o.grid.upper(o.wall_axis))) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: keyword 'height' expects a wall position inside the grid along " << "xyz"[o.wall_axis]
+       << " [" << o.grid.origin[o.wall_axis] << ", " << o.grid.upper(o.wall_axis) << "], got " << o.wall_pos;
+    throw Error(os.str());
+  }
+  if (o.hydrostatic && !(o.hydro_surface > o.grid.origin[o.hydro_axis])) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: keyword 'hydrostatic' expects a surface above the grid's lower bound along "
+       << "xyz"[o.hydro_axis] << " (" << o.grid.origin[o.hydro_axis] << "; below it every initial pressure is 0), got "
+       << o.hydro_surface;
+    throw Error(os.str());
+  }
   const Gate &g = o.gate;
   if (g.active && !o.grid.periodic[g.dim] && (g.pos <= o.grid.origin[g.dim] || g.pos >= o.grid.upper(g.dim)))
     throw Error("Fix mpm/fluid: keyword 'gate' expects a position inside the grid");
   return o;
 }
 
-int modify_option(Options &o, int narg, char **arg) {
-  const Keyword *k = find_keyword(arg[0]);
-  if (!k || !k->modifiable) return 0;
+namespace {
+
+// fix_modify of keyword k: its new value in o; returns the number of words used
+int modify_value(Options &o, const Keyword &k, int narg, char **arg) {
   if (strcmp(arg[0], "gate") == 0) {
     if (narg < 2 || strcmp(arg[1], "off") != 0) bad_arg("fix_modify gate", "'off'", narg < 2 ? nullptr : arg[1]);
     o.gate.active = false;
@@ -596,13 +665,36 @@ int modify_option(Options &o, int narg, char **arg) {
     parse_face(o, a);
     return a.iarg;
   }
-  if (narg < 2) bad_arg(arg[0], k->help, nullptr);
-  if (k->flag) {
-    if (!parse_yesno(arg[1], o.*(k->flag))) bad_arg(arg[0], k->help, arg[1]);
+  if (narg < 2) bad_arg(arg[0], k.help, nullptr);
+  if (k.flag) {
+    if (!parse_yesno(arg[1], o.*(k.flag))) bad_arg(arg[0], k.help, arg[1]);
   } else {
-    parse_real(o, *k, arg[1]);
+    parse_real(o, k, arg[1]);
   }
   return 2;
 }
+
+}  // namespace
+
+int modify_option(Options &o, int narg, char **arg) {
+  const Keyword *k = find_keyword(arg[0]);
+  if (!k || !k->modifiable) {
+    std::string can;
+    for (const Keyword &r : kTable)
+      if (r.modifiable) can += std::string(can.empty() ? "" : ", ") + r.name;
+    throw Error(std::string("Fix mpm/fluid: fix_modify ") + (k ? "cannot change keyword '" : "has no keyword '") +
+                arg[0] + (k ? "' (set it in the fix command)" : "'") + "; it changes " + can);
+  }
+  Options before = o;
+  const int used = modify_value(o, *k, narg, arg);
+  try {
+    check_inert(o, {arg[0]}, "fix_modify ");
+  } catch (...) {
+    o = before;
+    throw;
+  }
+  return used;
+}
+
 
 }  // namespace mpm

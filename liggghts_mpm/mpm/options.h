@@ -109,6 +109,8 @@ struct Options {
   int out_every = 0;
   std::string out_prefix;
   std::vector<std::string> out_point_fields, out_grid_fields;
+  // warnings of the parser (a keyword given twice), printed by the fix
+  std::vector<std::string> warnings;
 };
 
 // What the parser needs to know of the simulation around it (LIGGGHTS' box, groups, types).
@@ -159,7 +161,9 @@ extern const char *const kGridFields[2];
 
 // fix ID group mpm/fluid keyword value ...: arg[3..narg). Throws mpm::Error.
 Options parse_options(int narg, char **arg, const ParseEnv &env);
-// fix_modify keyword value ...: returns the number of words used, 0 if not a keyword of the fix.
+// fix_modify keyword value ...: returns the number of words used. Throws mpm::Error for a word
+// fix_modify cannot change (naming it and the keywords it can), a bad value, or a value that another
+// choice makes inert (o unchanged then).
 int modify_option(Options &o, int narg, char **arg);
 
 }  // namespace mpm

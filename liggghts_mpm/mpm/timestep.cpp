@@ -165,9 +165,16 @@ std::string FluidSolver::check_timestep(bool at_setup) {
     os << "advective limit cfl*dx/|v|max = " << dt_adv << " (cfl = " << cfl << ", dx = " << dx << ", |v|max = " << vmax_
        << "), viscous limit dx^2 rho/(2 dim eta) = " << dt_visc << "; "
        << (dt_adv <= dt_visc ? "advective" : "viscous") << " limit applies";
+    // six significant digits (std::to_string printed 0.000000 for a step below 1e-6)
+    auto sig6 = [](double x) {
+      std::ostringstream t;
+      t.precision(6);
+      t << x;
+      return t.str();
+    };
     if (dt > dt_sub)
-      throw Error("Fix mpm/fluid: " + std::string(what) + std::to_string(dt) + " exceeds the largest stable time step of " +
-                  "'pressure projection' (" + os.str() + "); reduce the timestep to " + std::to_string(dt_sub / every) +
+      throw Error("Fix mpm/fluid: " + std::string(what) + sig6(dt) + " exceeds the largest stable time step of " +
+                  "'pressure projection' (" + os.str() + "); reduce the timestep to " + sig6(dt_sub / every) +
                   " or use keyword 'subcycle yes'" + (at_setup ? "" : " (limit reached during the run)"));
     state.nsub = 1;
     return "fix mpm/fluid: pressure projection, no sound speed: " + os.str() + "\n";
@@ -192,13 +199,16 @@ std::string FluidSolver::check_timestep(bool at_setup) {
        << " or use keyword 'subcycle yes'" << (at_setup ? "" : " (limit reached during the run)");
     throw Error(os.str());
   }
-  const int nsub = static_cast<int>(std::ceil(dt / dt_sub));
-  if (nsub > opt.max_subcycle) {
+  // in floating point: the count may exceed every integer type (cfl 1e-12 needs more than 2^31)
+  const double nsub_needed = std::ceil(dt / dt_sub);
+  if (!(nsub_needed <= opt.max_subcycle)) {
     std::ostringstream os;
-    os << "Fix mpm/fluid: 'subcycle yes' would need " << nsub << " sub-steps per timestep (more than "
+    os.precision(6);
+    os << "Fix mpm/fluid: 'subcycle yes' would need " << nsub_needed << " sub-steps per timestep (more than "
        << opt.max_subcycle << "); reduce the timestep to at most " << opt.max_subcycle * dt_sub;
     throw Error(os.str());
   }
+  const int nsub = static_cast<int>(nsub_needed);
   if (at_setup && nsub != state.nsub) {
     std::ostringstream os;
     os << "fix mpm/fluid: sub-cycling with " << nsub << " fluid sub-steps of " << dt / nsub

@@ -639,7 +639,7 @@ void WallGeometry::side_votes(const double *const *x, int n, double reach, long 
     std::vector<int> vote(nm, 0);
     for (int c = 0; c < ncand; ++c) {
       const Tri &t = tris_[cand ? (*cand)[c] : c];
-      if (walls_[t.mesh].side != SIDE_AUTO) continue;
+      if (walls_[t.mesh].side == SIDE_BOTH) continue;
       Hit h;
       closest_point(t, xi, h);
       if (!h.face || h.dist2 > best[t.mesh]) continue;

@@ -142,7 +142,8 @@ class WallGeometry {
   // is zeroed. Returns true if x was changed.
   bool push_back(double x[3], double v[3], double reach, const double *x_old = nullptr) const;
 
-  // Side votes of the n points x[i] for every wall with side SIDE_AUTO: each point votes with the
+  // Side votes of the n points x[i] for every one-sided wall (side SIDE_AUTO, SIDE_NORMAL or
+  // SIDE_OPPOSITE; not SIDE_BOTH): each point votes with the
   // sign of its normal distance to the closest triangle face within 'reach'. Adds to
   // votes[2 k] (normal side) and votes[2 k + 1] (opposite side), k < walls().
   void side_votes(const double *const *x, int n, double reach, long *votes) const;

@@ -165,7 +165,7 @@ def case_bad_input(r):
         ("cell 0.5 density 1000 fill col 2 2 2 type 1 bulk 2e9", "add 'pressure eos' to use that model"),
         (base + " eos tait 7 pmin 0", "'eos', 'pmin'"),
         (base + " tolerance 0", "keyword 'tolerance' expects a relative residual > 0"),
-        (base + " max_iterations 0", "keyword 'max_iterations' expects an integer >= 1"),
+        (base + " max_iterations 0", "keyword 'max_iterations' expects an integer in [1, 1000000]"),
         (base + " pressure incompressible", "keyword 'pressure' expects 'projection' or 'eos'"),
         ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1 tolerance 1e-6",
          "'tolerance' belong to 'pressure projection'"),

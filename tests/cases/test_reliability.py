@@ -7,6 +7,7 @@ case that must now either run correctly or stop with a message naming the keywor
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 
@@ -389,6 +390,236 @@ def case_coupled_restart(r):
     diff = max(abs(x - y) for ra, rb in zip(a, b) for x, y in zip(ra, rb))
     print(f"  largest difference of grain x, v, fluid force at step 200: {diff:.3e}")
     check(len(a) == len(b) == 5 and a == b, f"split run = uninterrupted run bit for bit (largest difference {diff:.3e})")
+
+
+def errors_of(p):
+    """The ERROR lines of a run's screen."""
+    return [ln for ln in p.stdout.splitlines() if "ERROR" in ln]
+
+
+def case_gate_side(r):
+    """A gate at or within round-off of a grid face with the fluid beyond it deleted every point
+    (exit 0), a gate whose held side is nearly empty pressed the fluid into a sliver: fluid found
+    farther than a cell on the gate's other side at setup is an error naming the gate, the sides
+    and the amounts. A gate with the fluid on its held side runs as before."""
+    for args, side in (("gate x 1e-300 lower never", "upper"), ("gate x 0.39999999999 upper never", "lower"),
+                       ("gate x 0.01 lower never", "upper")):
+        p, msg = r.run_script("gate_side/" + args.split()[2], COLUMN.format(pre="", fixargs=args, steps=50))
+        check(p.returncode != 0 and "keyword 'gate'" in msg and f"on its {side} side" in msg and "points (mass" in msg,
+              f"{args}: error naming the gate, the side and the fluid there (got: {msg.strip()[:220]})")
+        check("RESULT" not in p.stdout, f"{args}: no step run")
+    d = r.fresh("gate_side/ok")
+    p = execute_text(r, d, COLUMN.format(pre="", fixargs="gate x 0.2 lower never", steps=50))
+    res = result(p)
+    check(p.returncode == 0 and res is not None and res[1] == 512 and res[0] <= 0.2 + 1e-9,
+          f"gate x 0.2 lower (fluid at x < 0.1): runs, 512 points, front {res[0] if res else None} <= 0.2")
+
+
+def case_subcycle_overflow(r):
+    """'subcycle yes' with more than 2^31 sub-steps needed (cfl 1e-12) wrapped the count to
+    -2147483648 and froze the fluid (exit 0): the count is computed in floating point and refused
+    beyond the limit with the usual error."""
+    for args, label in (("subcycle yes cfl 1e-12", "eos"), ("pressure projection subcycle yes cfl 1e-15", "projection")):
+        text = COLUMN.format(pre="", fixargs=args, steps=5)
+        if "projection" in args:
+            text = text.replace("bulk 2e5", "")
+        p, msg = r.run_script("subcycle_overflow/" + label, text)
+        m = re.search(r"would need (\S+) sub-steps", msg)
+        check(p.returncode != 0 and m is not None and float(m.group(1)) > 2.0 ** 31,
+              f"{label}, {args}: error with the sub-step count > 2^31 (got: {msg.strip()[:200]})")
+
+
+# sets RLIMIT_FSIZE of the liggghts_mpm process that runs it through 'shell' (its ancestor)
+LIMIT_PY = """import os, resource, sys
+pid = os.getppid()
+while pid > 1:
+    with open(f"/proc/{pid}/comm") as f:
+        if f.read().strip() == "liggghts_mpm":
+            break
+    with open(f"/proc/{pid}/stat") as f:
+        pid = int(f.read().rsplit(")", 1)[1].split()[1])
+n = int(sys.argv[1])
+resource.prlimit(pid, resource.RLIMIT_FSIZE, (n, n))
+"""
+
+
+def case_restart_complete(r):
+    """On a full disk LIGGGHTS left truncated restart files and exit 0. Restart files are now
+    complete or absent: past a file-size limit (set after start-up, the same write failure as a
+    full disk: EFBIG instead of ENOSPC) the write_restart command and the restart command stop
+    with an error naming the file, in the screen and the log, and leave no file; without the limit
+    the same files are written and read back."""
+    base = COLUMN.format(pre="", fixargs="", steps=10)
+    runs = {"command": base + "write_restart w.bin\n",
+            "periodic": base.replace("run 10", "restart 5 r.*\nrestart 3 a.rst b.rst\nrun 10")}
+    for label, text in runs.items():
+        d = r.fresh(f"restart_complete/{label}_ok")
+        p = execute_text(r, d, text)
+        names = ["w.bin"] if label == "command" else ["r.5", "r.10", "a.rst", "b.rst"]
+        check(p.returncode == 0 and all(os.path.exists(os.path.join(d, n)) for n in names),
+              f"{label}: no limit: {names} written (exit {p.returncode})")
+        check(sorted(os.listdir(d)) == sorted(names + ["in.script", "log.liggghts", "output.txt"]),
+              f"{label}: no other file left ({sorted(os.listdir(d))})")
+        back = """atom_style sphere
+atom_modify map array sort 0 0
+read_restart {}
+print "ATOMS $(atoms)"
+""".format(names[0])
+        with open(os.path.join(d, "in.back"), "w") as f:
+            f.write(back)
+        pb = r.execute(d, "in.back", expect_ok=False, timeout=60)
+        check("ATOMS 512" in pb.stdout, f"{label}: {names[0]} read back with its 512 points")
+        d = r.fresh(f"restart_complete/{label}_limit")
+        with open(os.path.join(d, "limit.py"), "w") as f:
+            f.write(LIMIT_PY)
+        limited = text.replace("run 10", f"shell {sys.executable} limit.py 100000\nrun 10")
+        p = execute_text(r, d, limited)
+        log = open(os.path.join(d, "log.liggghts"), errors="replace").read()
+        err = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
+        first = names[0] if label == "command" else "a.rst"
+        check(p.returncode != 0 and f"restart file '{first}' could not be written completely" in err
+              and "File too large" in err, f"{label}: limit 100000 bytes: error naming the file and the cause ({err.strip()[:200]})")
+        check(err.strip() != "" and err.strip() in log, f"{label}: the error is in the log file too")
+        left = [n for n in os.listdir(d) if n not in ("in.script", "log.liggghts", "output.txt", "limit.py")]
+        check(left == [], f"{label}: limit: no restart file, partial copy or FIFO left ({left})")
+
+
+def case_mesh_wall_side(r):
+    """A mesh wall whose given side is opposite to the fluid froze it (kinetic energy 3e-28, exit
+    0): at setup, more points near its faces on the other side than on the given one is an error
+    naming the wall, the side and the counts. The right side runs."""
+    data = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data")
+    for fside, ok in (("normal", False), ("opposite", True)):
+        d = r.fresh(f"mesh_wall_side/{fside}")
+        for f in ("in.mesh_walls_box", "box.stl"):
+            shutil.copy(os.path.join(data, f), d)
+        p = r.execute(d, "in.mesh_walls_box", {"fside": fside, "steps": 20}, expect_ok=False, timeout=120)
+        err = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
+        if ok:
+            check(p.returncode == 0, f"side {fside} (box.stl normals point out, fluid inside): runs")
+        else:
+            check(p.returncode != 0 and "fix ID 'walls'" in err and "side normal" in err and "on the other side" in err,
+                  f"side {fside}: error naming the wall, the side and the counts ({err.strip()[:240]})")
+            m = re.search(r"but (\d+) of the (\d+) material points", err)
+            check(m is not None and int(m.group(1)) == int(m.group(2)) > 0,
+                  f"side {fside}: all points near the faces are on the other side ({m.groups() if m else None})")
+
+
+PROJ = COLUMN.replace("bulk 2e5 ", "")
+
+
+def case_max_iterations(r):
+    """max_iterations 2147483647 ended in MPI_ABORT without an ERROR line (hypre sizes its residual
+    history by it) and 1000000000 ran no step in 20 s: refused above 1000000 with the range; the
+    largest accepted value runs."""
+    for v in ("2147483647", "1000000000", "1000001"):
+        p, msg = r.run_script(f"max_iterations/{v}", PROJ.format(pre="", fixargs=f"pressure projection max_iterations {v}", steps=5))
+        check(p.returncode != 0 and "keyword 'max_iterations' expects an integer in [1, 1000000]" in msg and v in msg,
+              f"max_iterations {v}: refused with the range (got: {msg.strip()[:160]})")
+    d = r.fresh("max_iterations/1000000")
+    p = execute_text(r, d, PROJ.format(pre="", fixargs="pressure projection max_iterations 1000000", steps=5))
+    check(p.returncode == 0 and result(p) is not None, "max_iterations 1000000: runs")
+
+
+def case_lost_messages(r):
+    """A LIGGGHTS core error printed only the MPI_ABORT banner when the screen was a pipe or a
+    file, and the log stayed empty: every error reaches both (screen to a pipe and to a file;
+    an error of LIGGGHTS' error->one, of error->all and of the fix)."""
+    scripts = {
+        "core_one": "atom_style sphere\nregion box block 0 1 0 1 0 1 units box\ncreate_box 1 box\n"
+                    "create_atoms 1 random 10 -5 NULL\n",
+        "core_all": "atom_style sphere\nbogus_command 1\n",
+        "fix": COLUMN.format(pre="", fixargs="cfl 2", steps=1),
+    }
+    needles = {"core_one": "random seed", "core_all": "bogus_command", "fix": "keyword 'cfl'"}
+    for name, text in scripts.items():
+        for mode in ("pipe", "file"):
+            d = r.fresh(f"lost_messages/{name}_{mode}")
+            with open(os.path.join(d, "in.script"), "w") as f:
+                f.write(text)
+            cmd = [r.exe, "-in", "in.script", "-echo", "none"]
+            if mode == "pipe":
+                screen = subprocess.run(cmd, cwd=d, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                        timeout=60).stdout.decode(errors="replace")
+            else:
+                with open(os.path.join(d, "screen.txt"), "w") as f:
+                    subprocess.run(cmd, cwd=d, stdout=f, stderr=subprocess.STDOUT, timeout=60)
+                screen = open(os.path.join(d, "screen.txt"), errors="replace").read()
+            logp = os.path.join(d, "log.liggghts")
+            log = open(logp, errors="replace").read() if os.path.exists(logp) else ""
+            s_err = [ln for ln in screen.splitlines() if "ERROR" in ln and needles[name] in ln]
+            l_err = [ln for ln in log.splitlines() if "ERROR" in ln and needles[name] in ln]
+            check(len(s_err) == 1 and len(l_err) == 1,
+                  f"{name}, screen to a {mode}: the error once in the screen ({len(s_err)}) and once in the log ({len(l_err)})")
+
+
+GRAINS_PROJ = GRAINS.replace("bulk 1e5 ", "")
+
+
+def case_late_errors(r):
+    """Values that failed late (inside hypre at step 1, 'fluid state is not finite', 'reduce the
+    timestep') or with a bare 'Illegal fix_modify command': refused at the command, naming the
+    keyword and its range, before any step."""
+    cases = [
+        ("density_projection", PROJ.format(pre="", fixargs="pressure projection", steps=5).replace("density 1000", "density 1e308"),
+         ("keyword 'density'", "[1e-150, 1e150]")),
+        ("viscosity_couple", GRAINS_PROJ.format(fixargs="pressure projection", d="0.002", steps=5).replace("viscosity 1e-3", "viscosity 1e308"),
+         ("'viscosity'", "normal number")),
+        ("pmin", COLUMN.format(pre="", fixargs="pmin 1e300", steps=5), ("keyword 'pmin'", "<= 0")),
+        ("tait", COLUMN.format(pre="", fixargs="eos tait 1e300", steps=5), ("keyword 'eos'", "twice the reference density")),
+    ]
+    for word in ("tolerance 1e-3", "cell 0.05", "pressure projection", "mesh_wall w freeslip", "couple all", "colour red"):
+        kw = word.split()[0]
+        text = COLUMN.format(pre="", fixargs="", steps=5).replace("run 5", f"fix_modify fluid {word}\nrun 5")
+        cases.append(("fix_modify_" + kw, text, (f"'{kw}'", "fix_modify", "it changes", "damping", "cfl")))
+    for name, text, needles in cases:
+        p, msg = r.run_script("late_errors/" + name, text)
+        check(p.returncode != 0 and all(n in msg for n in needles), f"{name}: refused naming {needles} (got: {msg.strip()[:200]})")
+        check(not re.search(r"^\s+Step\s", p.stdout, re.M), f"{name}: before any step")
+
+
+def case_inert_keywords(r):
+    """Keywords that another choice makes inert, or values that make them do nothing, were
+    accepted silently: each is an error naming the keyword and why, in the fix command and
+    through fix_modify. The same keywords where they act are accepted."""
+    base = COLUMN.format(pre="", fixargs="{x}", steps=2)
+    cases = [
+        ("height", base.replace("{x}", "height z x -1"), ("keyword 'height'", "inside the grid")),
+        ("output", base.replace("{x}", "output 10 name points"), ("keyword 'output'", "at least one field")),
+        ("drag", base.replace("{x}", "drag stokes"), ("keyword 'drag'", "'couple'")),
+        ("theta_smooth", base.replace("{x}", "theta_smooth 0.01"), ("keyword 'theta_smooth'", "'couple'")),
+        ("theta_min", base.replace("{x}", "theta_min 0.5"), ("keyword 'theta_min'", "'couple'")),
+        ("cell_check", base.replace("{x}", "cell_check no"), ("keyword 'cell_check'", "'couple'")),
+        ("shear", base.replace("{x}", "boundary xlo shear 0.001").replace("viscosity 1e-3 ", ""),
+         ("keyword 'boundary'", "viscosity")),
+        ("fix_modify_cell_check", base.replace("{x}", "").replace("run 2", "fix_modify fluid cell_check yes\nrun 2"),
+         ("fix_modify keyword 'cell_check'", "'couple'")),
+    ]
+    for name, text, needles in cases:
+        p, msg = r.run_script("inert/" + name, text)
+        check(p.returncode != 0 and all(n in msg for n in needles), f"{name}: error naming {needles} (got: {msg.strip()[:200]})")
+    ok = GRAINS.format(fixargs="drag stokes theta_smooth 0.005 theta_min 0.4 cell_check yes output 2 o points v",
+                       d="0.002", steps=2) + "fix_modify f cell_check no\nrun 2\n"
+    d = r.fresh("inert/coupled_ok")
+    p = execute_text(r, d, ok)
+    check(p.returncode == 0, f"with couple: drag, theta_smooth, theta_min, cell_check, fix_modify cell_check accepted (exit {p.returncode})")
+
+
+def case_fuzz_quick(r):
+    """The reduced form of tools/fuzz_mpm_fluid.py: a sample of bad values for every keyword of
+    fix mpm/fluid and fix balance/mpm (and through fix_modify): no crash, no hang, no silent
+    acceptance, every error naming the keyword."""
+    tool = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools", "fuzz_mpm_fluid.py")
+    d = r.fresh("fuzz_quick")
+    p = subprocess.run([sys.executable, tool, "--exe", r.exe, "--work", d, "--quick"], stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, text=True, errors="replace", timeout=600)
+    print(p.stdout[-3000:])
+    m = re.search(r"cases (\d+) named (\d+) unnamed (\d+) crashes (\d+) hangs (\d+) silent (\d+)", p.stdout)
+    check(m is not None and int(m.group(1)) > 100, f"fuzz: summary line with more than 100 cases ({m.group(0) if m else None})")
+    if m:
+        n, named, unnamed, crash, hang, silent = map(int, m.groups())
+        check(crash == 0 and hang == 0 and silent == 0 and unnamed == 0 and named == n,
+              f"fuzz: every case an error naming its keyword ({m.group(0)})")
 
 
 if __name__ == "__main__":

@@ -93,7 +93,8 @@ TEST(Options, ErrorsNameKeywordExpectationAndValue) {
   EXPECT_NE(error_of(kBase + "fill col 2 2 2 type 3").find("'fill type' expects an existing atom type"), std::string::npos);
   EXPECT_NE(error_of("cell 0.3 density 1000 pressure eos bulk 2e6").find("divides the grid extent"), std::string::npos);
   EXPECT_NE(error_of(kBase + "output 1 o points velocity").find("'output points' expects point fields"), std::string::npos);
-  EXPECT_EQ(error_of(kBase + "theta_smooth 0"), "");
+  // 0 is inside the range (theta_smooth acts with couple only: InertKeywordsRefused)
+  EXPECT_EQ(error_of(kBase + "viscosity 1e-3 couple grains theta_smooth 0"), "");
 }
 
 TEST(Options, FixModifyTakesTheModifiableRowsOnly) {
@@ -102,9 +103,25 @@ TEST(Options, FixModifyTakesTheModifiableRowsOnly) {
   std::vector<char *> a = {&w[0][0], &w[1][0]};
   EXPECT_EQ(mpm::modify_option(o, 2, a.data()), 2);
   EXPECT_DOUBLE_EQ(o.damping, 5.0);
-  w = {"viscosity", "1"};
+  // a keyword fix_modify cannot change, or no keyword: an error naming the word and what it changes
+  for (const char *word : {"viscosity", "tolerance", "colour"}) {
+    w = {word, "1"};
+    a = {&w[0][0], &w[1][0]};
+    try {
+      mpm::modify_option(o, 2, a.data());
+      ADD_FAILURE() << word << " accepted";
+    } catch (const mpm::Error &e) {
+      const std::string m = e.what();
+      EXPECT_NE(m.find(std::string("'") + word + "'"), std::string::npos) << m;
+      EXPECT_NE(m.find("it changes"), std::string::npos) << m;
+      EXPECT_NE(m.find("damping"), std::string::npos) << m;
+    }
+  }
+  // a value another choice makes inert: refused, the option unchanged
+  w = {"cell_check", "no"};
   a = {&w[0][0], &w[1][0]};
-  EXPECT_EQ(mpm::modify_option(o, 2, a.data()), 0);
+  EXPECT_THROW(mpm::modify_option(o, 2, a.data()), mpm::Error);
+  EXPECT_TRUE(o.cell_check);
   w = {"subcycle", "maybe"};
   a = {&w[0][0], &w[1][0]};
   EXPECT_THROW(mpm::modify_option(o, 2, a.data()), mpm::Error);
@@ -112,6 +129,51 @@ TEST(Options, FixModifyTakesTheModifiableRowsOnly) {
   std::vector<char *> ab = {&b[0][0], &b[1][0], &b[2][0], &b[3][0]};
   EXPECT_EQ(mpm::modify_option(o, 4, ab.data()), 4);
   EXPECT_EQ(o.face[5].kind, mpm::BcKind::Partial);
+}
+
+// Ranges whose violation failed late (inside hypre, at step 1, as "reduce the timestep") or did
+// nothing: refused by the parser, naming the keyword and the range.
+TEST(Options, RangesRefusedAtTheCommand) {
+  const std::string proj = "cell 0.5 density 1000 pressure projection fill col 2 2 2 type 1 ";
+  EXPECT_NE(error_of(proj + "max_iterations 2147483647").find("'max_iterations' expects an integer in [1, 1000000]"),
+            std::string::npos);
+  EXPECT_EQ(error_of(proj + "max_iterations 1000000"), "");
+  std::string p = proj;
+  p.replace(p.find("density 1000"), 12, "density 1e308");
+  EXPECT_NE(error_of(p).find("'density' expects with 'pressure projection' a reference density in [1e-150, 1e150]"),
+            std::string::npos);
+  EXPECT_NE(error_of(kBase + "pmin 1e300").find("'pmin' expects"), std::string::npos);
+  EXPECT_EQ(error_of(kBase + "pmin 0"), "");
+  EXPECT_EQ(error_of(kBase + "pmin -1e5"), "");
+  EXPECT_NE(error_of(kBase + "eos tait 1e300").find("keyword 'eos' (tait"), std::string::npos);
+  EXPECT_EQ(error_of(kBase + "eos tait 7"), "");
+  EXPECT_NE(error_of(kBase + "viscosity 1e308").find("'viscosity'"), std::string::npos);
+  EXPECT_NE(error_of(proj + "viscosity 1e308").find("'viscosity'"), std::string::npos);
+  EXPECT_NE(error_of(kBase + "height z x -1").find("'height' expects a wall position inside the grid"), std::string::npos);
+  EXPECT_EQ(error_of(kBase + "height z x 1"), "");
+  EXPECT_NE(error_of(kBase + "output 10 o points").find("'output' expects at least one field"), std::string::npos);
+  EXPECT_NE(error_of(kBase + "hydrostatic z -1 9.81").find("'hydrostatic' expects a surface above"), std::string::npos);
+}
+
+// The table of keywords another choice makes inert: each an error naming the keyword and why;
+// accepted where they act.
+TEST(Options, InertKeywordsRefused) {
+  for (const char *kw : {"drag stokes", "theta_smooth 0.1", "theta_min 0.5", "cell_check no"}) {
+    const std::string name = std::string(kw).substr(0, std::string(kw).find(' '));
+    const std::string e = error_of(kBase + kw);
+    EXPECT_NE(e.find("keyword '" + name + "' has no effect here"), std::string::npos) << e;
+    EXPECT_NE(e.find("'couple'"), std::string::npos) << e;
+    EXPECT_EQ(error_of(kBase + "viscosity 1e-3 couple grains " + kw), "") << kw;
+  }
+  EXPECT_NE(error_of(kBase + "boundary xlo shear 1e-3").find("keyword 'boundary' has no effect"), std::string::npos);
+  EXPECT_EQ(error_of(kBase + "viscosity 1e-3 boundary xlo shear 1e-3"), "");
+}
+
+TEST(Options, RepeatedKeywordWarned) {
+  const mpm::Options o = parse(kBase + "cfl 0.3 cfl 0.4 boundary xlo freeslip boundary xhi freeslip");
+  ASSERT_EQ(o.warnings.size(), 1u);
+  EXPECT_NE(o.warnings[0].find("keyword 'cfl' given more than once"), std::string::npos);
+  EXPECT_DOUBLE_EQ(o.cfl, 0.4);
 }
 
 TEST(Options, EveryRowIsComplete) {
