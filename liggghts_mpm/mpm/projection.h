@@ -105,6 +105,10 @@ class Projection {
   void extrapolate_above_surface(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
                                  bool with_p);
   void extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const;
+  // with grains: the padding nodes behind the box walls take the gradient of their mirror node
+  // inside (the node their share of the grains' volume is folded to, FluidSolver::fluid_fraction),
+  // so that a grain reads there the gradient of the node whose fluid fraction it changed
+  void mirror_to_padding(const std::vector<double> &a, std::vector<double> &out) const;
   // sparse sweeps: the nodes of the last work box that are not in this one get the arrays' values
   // of a node without fluid within reach
   void retire(const IndexBox &work);
