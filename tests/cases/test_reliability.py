@@ -209,7 +209,7 @@ print "RESULT ${xf} ${ke}"
 
 
 # Grains on the cut between two ranks (np 2 splits the 0.04 m box at x = 0.02), free in a fluid
-# under gravity; {gradp}: the coupling option; per-grain position, velocity and fluid force dumped.
+# under gravity; {model}: the coupling model; per-grain position, velocity and fluid force dumped.
 CUT = """atom_style sphere
 atom_modify map array sort 0 0
 boundary f f f
@@ -369,15 +369,15 @@ def case_coupled_restart(r):
     tmpl = CUT.replace("fix grav all gravity", "variable mode index 0\nfix grav all gravity")
     head, tail = tmpl.split("fix grav all gravity", 1)
     body = "fix grav all gravity" + tail.replace("run {steps}", "")
-    full = head.replace("variable mode index 0\n", "") + body.format(gradp="fit", steps=100) + "run 200\n"
+    full = head.replace("variable mode index 0\n", "") + body.format(model="yang2016", steps=100) + "run 200\n"
     d0 = r.fresh("coupled_restart/full")
     p0 = execute_text(r, d0, full)
-    first = head.replace("variable mode index 0\n", "") + body.format(gradp="fit", steps=100) + "run 100\nwrite_restart r.bin\n"
+    first = head.replace("variable mode index 0\n", "") + body.format(model="yang2016", steps=100) + "run 100\nwrite_restart r.bin\n"
     d1 = r.fresh("coupled_restart/split")
     pa = execute_text(r, d1, first)
     second = ("atom_style sphere\natom_modify map array sort 0 0\nnewton off\ncommunicate single vel yes\n"
               "read_restart r.bin\nneighbor 0.001 bin\nneigh_modify delay 0 every 1 check yes\n"
-              "group grains type 2\ngroup fluid type 1\n" + body.format(gradp="fit", steps=100)
+              "group grains type 2\ngroup fluid type 1\n" + body.format(model="yang2016", steps=100)
               .replace("fill box 1 1 1 type 1 ", "").replace("grains.dump", "grains2.dump") + "run 100\n")
     with open(os.path.join(d1, "in.b"), "w") as f:
         f.write(second)
