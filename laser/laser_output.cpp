@@ -352,6 +352,9 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["status"] = r.status;
   j["message"] = r.message;
   j["notes"] = r.notes;
+  j["causes"] = r.causes;
+  j["warnings"] = r.warnings;
+  j["T_peak_over_T_critical"] = num(r.T_over_Tc);
   j["t_melt_center_s"] = r.t_melt_center >= 0 ? num(r.t_melt_center) : ordered_json(nullptr);
   j["depth_center_m"] = num(r.depth_center);
   j["volume_removed_m3"] = num(r.volume_removed);
@@ -375,6 +378,13 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["volume_vaporized_m3"] = num(r.volume_vaporized);
   j["volume_removed_by_flow_m3"] = num(r.volume_flow);
   j["volume_melted_m3"] = num(r.volume_melted);
+  j["melt_balance"] = {{"melted_m3", num(r.volume_melted)},
+                       {"vaporized_m3", num(r.volume_vaporized)},
+                       {"expelled_over_rim_m3", num(r.volume_expelled)},
+                       {"still_molten_m3", num(r.volume_molten)},
+                       {"vaporization_cut_m3", num(r.vaporization_cut)},
+                       {"relative_residual", num(r.melt_balance)},
+                       {"flow_substeps_max", r.flow_substeps_max}};
   j["u_peak_max_m_per_s"] = num(r.u_peak_max);
   j["A_last"] = num(r.A_last);
   j["xi_melt_edge"] = num(r.xi_melt_edge);
@@ -395,6 +405,7 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
                {"model", to_string(cfg.model)},     {"m", num(cfg.m)},             {"xi_p", num(cfg.xi_p)},
                {"Pr", num(cfg.mat.Pr)},             {"solid", to_string(cfg.solid)},
                {"melt_energy", to_string(cfg.melt_energy)},
+               {"melt_flow", to_string(cfg.melt_flow)},
                {"melt_update", cfg.implicit_melt ? "implicit" : "explicit"},
                {"dxi", num(cfg.dxi)},               {"material", cfg.material}};
   const Groups& G = r.groups;
@@ -420,6 +431,7 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["energy_check"] = {{"H_J_per_kg", num(pc.H)},
                        {"T_s_center_K", num(pc.Ts)},
                        {"removed_rhoH_over_beam", num(pc.removed_over_beam)},
+                       {"melted_and_vaporized_over_beam", num(pc.melt_vap_over_beam)},
                        {"worst_node_demand_over_absorbed", num(pc.worst_node_ratio)},
                        {"worst_node_xi", num(pc.worst_node_xi)},
                        {"centre_velocity_over_bound", num(pc.centre_velocity_ratio)},

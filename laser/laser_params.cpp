@@ -40,6 +40,7 @@ const char* to_string(SolidModel m) {
   return "?";
 }
 const char* to_string(MeltEnergy m) { return m == MeltEnergy::Advected ? "advected" : "text"; }
+const char* to_string(MeltFlow m) { return m == MeltFlow::Conservative ? "conservative" : "text"; }
 
 std::vector<std::string> material_presets() { return {"superalloy"}; }
 
@@ -293,6 +294,12 @@ const std::vector<Param>& params() {
         "pays c_pl (T_s - T_m)), text = the dissertation's linear conduction layer",
         [](Config& c, const std::string& v) { c.melt_energy = v == "text" ? MeltEnergy::Text : MeltEnergy::Advected; },
         [](const Config& c) { return std::string(to_string(c.melt_energy)); }));
+    t.push_back(choice(
+        "melt-flow", "model", {"conservative", "text"},
+        "surface-normal melt velocity in (4-13): conservative = divergence of the layer's volume flux "
+        "(melt is conserved; includes -u(g) dg/dxi), text = v(xi, g) of (4-22) as printed",
+        [](Config& c, const std::string& v) { c.melt_flow = v == "text" ? MeltFlow::Text : MeltFlow::Conservative; },
+        [](const Config& c) { return std::string(to_string(c.melt_flow)); }));
     t.push_back(real("shift", "model", "tau_m", 0, 10, true,
                      "backward shift of the Stefan solution for --solid shifted (3-36: 3 tau_0 = 3/(4 pi))",
                      &Config::shift));
@@ -351,6 +358,9 @@ const std::vector<Param>& params() {
     t.push_back(matreal("k-solid", "W/(m K)", 1e-2, 1e4, "thermal conductivity of the solid k_s", &Material::ks));
     t.push_back(matreal("cp-liquid", "J/(kg K)", 1, 1e5, "specific heat of the melt c_pl", &Material::cpl));
     t.push_back(matreal("cp-solid", "J/(kg K)", 1, 1e5, "specific heat of the solid c_ps", &Material::cps));
+    t.push_back(matreal("T-critical", "K", 0, 1e5,
+                        "critical temperature T_c: a warning above 0.8 T_c, status diverged above T_c",
+                        &Material::Tc));
     t.push_back(matreal("pr", "-", 1e-6, 1e7, "Prandtl number of the melt nu/alpha_l", &Material::Pr));
     return t;
   }();
@@ -529,6 +539,8 @@ void validate(Config& c) {
   const Material& m = c.mat;
   if (!(m.Tm > m.Ti))
     throw UsageError("--T-initial: must be below --T-melt (" + fmt(m.Tm) + " K), got " + fmt(m.Ti) + " K");
+  if (!(m.Tc > m.Tsat0))
+    throw UsageError("--T-critical: must be above --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tc) + " K");
   if (!(m.Tsat0 > m.Tm))
     throw UsageError("--T-melt: must be below --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tm) + " K");
   if (c.dtau > 0.0) c.dt = c.dtau * c.R * c.R / (m.kl / (m.rho * m.cpl));

@@ -23,10 +23,15 @@ enum class SolidModel { Exact, Shifted, Stefan };
 // the vaporizing surface (exponential profile; the vaporized mass carries
 // c_pl (T_s - T_m)); Text = the linear conduction layer of the dissertation.
 enum class MeltEnergy { Advected, Text };
+// Surface-normal velocity of the melt flow in (4-13): Conservative = the
+// divergence of the layer's volume flux (includes -u(g) dg/dxi, the melt is
+// conserved), Text = v(xi, g) of (4-22)/(4-13) as printed.
+enum class MeltFlow { Conservative, Text };
 
 const char* to_string(FlowModel m);
 const char* to_string(SolidModel m);
 const char* to_string(MeltEnergy m);
+const char* to_string(MeltFlow m);
 
 struct Config {
   Material mat;
@@ -38,6 +43,7 @@ struct Config {
   double xi_p = 1.0;
   SolidModel solid = SolidModel::Exact;
   MeltEnergy melt_energy = MeltEnergy::Advected;
+  MeltFlow melt_flow = MeltFlow::Conservative;
   double shift = 3.0 / (4.0 * kPi);  // (3-36): shift of the Stefan solution in tau_m
   bool curvature = true;
   bool moving_origin = true;
