@@ -145,7 +145,10 @@ INSTANTIATE_TEST_SUITE_P(
                 {"--dt", "shorter than the pulse"}},
         BadCase{"repeated_option", "--intensity 5e10 --intensity 6e10", "", {"--intensity"}},
         BadCase{"unknown_option", "--no-such-option 3", "", {"--no-such-option"}},
-        BadCase{"stray_argument", "stray", "", {"stray"}}),
+        BadCase{"stray_argument", "stray", "", {"stray"}},
+        BadCase{"melt_flow_unknown", "--melt-flow upwind", "", {"--melt-flow", "conservative, text", "upwind"}},
+        BadCase{"T_critical_below_sat", "--T-critical 3000", "", {"--T-critical", "--T-sat0", "3000 K"}},
+        BadCase{"T_critical_negative", "--T-critical -5", "", {"--T-critical", "K", "-5"}}),
     [](const ::testing::TestParamInfo<BadCase>& info) { return info.param.what; });
 
 TEST(LaserCli, VersionAndHelp) {
