@@ -25,7 +25,11 @@ struct Node {
 
 constexpr int kUnstableFlips = 3;
 constexpr long kMaxFlowSubsteps = 100000;
-constexpr double kTcWarnFraction = 0.8;     // warning above this fraction of T_c
+constexpr double kTcWarnFraction = 0.8;
+// rho (h_m V_melted + h_v V_vaporized) above this multiple of the beam energy is
+// not a solution at all (diverged); between 1 and this it is a failed check
+// (the text's melt layer reaches 1.12 at 7.5e10 W/m2)
+constexpr double kAbsurdEnergy = 2.0;     // warning above this fraction of T_c
 constexpr double kMeltBalanceTol = 1e-3;    // melt volume balance (text flow: 1e-4 at Pr = 0.142)
 constexpr double kSafeguardFraction = 1e-4; // of the node steps
 
@@ -672,12 +676,13 @@ void Drill::assess() {
                             "doubtful there");
   const PhysicalCheck& pc = res_.check;
   const bool finished = res_.status == "ok" || res_.status == "no_flow_solution" || res_.status == "truncated";
-  if (finished && (!std::isfinite(res_.volume_removed) || pc.melt_vap_over_beam > 1.0)) {
+  const std::string bound_text = "melting and vaporizing the computed volumes needs " +
+                                 fmt(pc.melt_vap_over_beam, 4) +
+                                 " times the beam energy (rho (h_m V_melted + h_v V_vaporized) / E_beam must stay below 1)";
+  if (finished && (!std::isfinite(res_.volume_removed) || !(pc.melt_vap_over_beam <= kAbsurdEnergy))) {
     res_.status = "diverged";
     res_.causes.insert(res_.causes.begin(), "energy bound of the whole melt");
-    res_.message = "melting and vaporizing the computed volumes needs " + fmt(pc.melt_vap_over_beam, 4) +
-                   " times the beam energy (rho (h_m V_melted + h_v V_vaporized) / E_beam must stay below 1)" +
-                   (res_.message.empty() ? "" : "; " + res_.message);
+    res_.message = bound_text + (res_.message.empty() ? "" : "; " + res_.message);
     return;
   }
   if (res_.status != "ok") return;
@@ -687,6 +692,7 @@ void Drill::assess() {
     why.push_back(name + ": " + text);
   };
   const double node_steps = double(res_.steps) * res_.nodes;
+  if (pc.melt_vap_over_beam >= 1.0) cause("energy bound of the whole melt", bound_text);
   if (pc.worst_node_ratio >= 1.0)
     cause("column energy bound", "the column at xi = " + fmt(pc.worst_node_xi, 4) + " melted and vaporized " +
                                      fmt(pc.worst_node_ratio, 4) + " times the energy it absorbed");
