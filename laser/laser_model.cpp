@@ -24,6 +24,12 @@ struct Node {
 };
 
 constexpr int kUnstableFlips = 3;
+// The model sees the absorbed intensity only (energies, bounds and groups).
+Config absorbed(Config c) {
+  c.I0 = c.absorbed_I0();
+  c.absorptivity = 1.0;
+  return c;
+}
 constexpr long kMaxFlowSubsteps = 100000;
 constexpr double kTcWarnFraction = 0.8;
 // rho (h_m V_melted + h_v V_vaporized) above this multiple of the beam energy is
@@ -36,7 +42,7 @@ constexpr double kSafeguardFraction = 1e-4; // of the node steps
 class Drill {
  public:
   Drill(const Config& c, FrameSink* sink)
-      : cfg_(c), G_(make_groups(c.mat, c.I0, c.R)), sink_(sink),
+      : cfg_(absorbed(c)), G_(make_groups(c.mat, c.absorbed_I0(), c.R)), sink_(sink),
         advected_(c.melt_energy == MeltEnergy::Advected) {}
   Result run();
 
@@ -151,9 +157,9 @@ bool Drill::solve_melt_flow(double ta, double tb) {
   for (int i = 1; i < N; ++i) {
     if (!nodes_[i].molten) continue;
     const bool lm = nodes_[i - 1].molten, rm = (i + 1 < N) && nodes_[i + 1].molten;
-    const double pl = nodes_[i - 1].itf.p_star, pc = nodes_[i].itf.p_star;
+    const double pl = cfg_.recoil * nodes_[i - 1].itf.p_star, pc = cfg_.recoil * nodes_[i].itf.p_star;
     if (rm) {
-      const double pr = nodes_[i + 1].itf.p_star;
+      const double pr = cfg_.recoil * nodes_[i + 1].itf.p_star;
       dpdx[i] = lm ? (pr - pl) / (2 * cfg_.dxi) : (pr - pc) / cfg_.dxi;
     } else if (lm) {
       dpdx[i] = (pc - pl) / cfg_.dxi;
@@ -301,11 +307,11 @@ void Drill::solve_boundary_layer(int& last_bl) {
   last_bl = 0;
   const int N = static_cast<int>(nodes_.size());
   if (N < 3 || !nodes_[0].molten || !nodes_[1].molten) return;
-  const double Pr = cfg_.mat.Pr, h = cfg_.dxi, pc = nodes_[0].itf.p_star;
+  const double Pr = cfg_.mat.Pr, h = cfg_.dxi, pc = cfg_.recoil * nodes_[0].itf.p_star;
   std::vector<double> U(N, 0.0);
   int end = 1;
   while (end < N && nodes_[end].molten) ++end;
-  for (int i = 0; i < end; ++i) U[i] = std::sqrt(std::max(0.0, 2.0 * (pc - nodes_[i].itf.p_star)));
+  for (int i = 0; i < end; ++i) U[i] = std::sqrt(std::max(0.0, 2.0 * (pc - cfg_.recoil * nodes_[i].itf.p_star)));
   auto Ux = [&](double x, double& u, double& du) {
     const double s = x / h;
     int i = std::min(static_cast<int>(s), end - 2);
@@ -782,6 +788,7 @@ Result Drill::run() {
     res_.steps = static_cast<int>(step + 1);
     res_.A_last = A_;
     res_.u_peak_max = std::max(res_.u_peak_max, u_peak_ * G_.v_scale);
+    if (!state_admissible(tb)) break;  // the interface re-solved by the step (implicit update)
     for (const auto& n : nodes_) {
       if (!n.molten) continue;
       res_.T_peak = std::max(res_.T_peak, n.itf.phi * cfg_.mat.Tsat0);
@@ -792,6 +799,7 @@ Result Drill::run() {
       if (!std::isfinite(n.S2) || !std::isfinite(n.g) || !std::isfinite(n.S1) ||
           !std::isfinite(n.b2) || !std::isfinite(n.itf.phi)) {
         res_.status = "diverged";
+        res_.causes.push_back("non-finite state");
         res_.message = "non-finite state at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb * G_.t_scale, 4) +
                        " s (model " + to_string(cfg_.model) + "; S2 " + fmt(n.S2, 4) + ", g " + fmt(n.g, 4) +
                        ", S1 " + fmt(n.S1, 4) + ", phi " + fmt(n.itf.phi, 4) + ", b2 " + fmt(n.b2, 4) + ")";
@@ -884,7 +892,7 @@ double advected_step_limit(const Config& cfg, const Groups& G) {
 }  // namespace
 
 double explicit_step_limit(const Config& cfg) {
-  const Groups G = make_groups(cfg.mat, cfg.I0, cfg.R);
+  const Groups G = make_groups(cfg.mat, cfg.absorbed_I0(), cfg.R);
   if (cfg.melt_energy == MeltEnergy::Advected) return advected_step_limit(cfg, G);
   const double L0 = 1.0 / (G.Ste * G.Nc) - G.theta_i;
   // surface state for a conduction gradient q into the melt: vapour term = 1 - k' q

@@ -266,6 +266,15 @@ const std::vector<Param>& params() {
     // [laser]
     t.push_back(real("intensity", "laser", "W/m2", 1e6, 1e13, false,
                      "laser intensity at the beam centre, I0 in (3-21)", &Config::I0));
+    t.push_back(real("absorptivity", "laser", "-", 0, 1, true,
+                     "absorbed fraction of the beam (the text absorbs all: 1); the model runs with absorptivity x I0",
+                     &Config::absorptivity));
+    t.push_back(choice(
+        "recoil", "model", {"full", "knight"},
+        "recoil pressure driving the melt flow: full = p_sat(T_s) as in the text, knight = 0.54 p_sat "
+        "(Anisimov/Knight, evaporation through a Knudsen layer)",
+        [](Config& c, const std::string& v) { c.recoil = v == "knight" ? 0.54 : 1.0; },
+        [](const Config& c) { return std::string(c.recoil == 1.0 ? "full" : "knight"); }));
     t.push_back(real("pulse", "laser", "s", 1e-9, 1e-2, false, "pulse length t_p", &Config::tp));
     t.push_back(real("radius", "laser", "m", 1e-6, 1e-2, false, "beam radius R in (3-21)", &Config::R));
     // [model]

@@ -38,12 +38,18 @@ struct Config {
   double I0 = 7.5e10;     // W/m2
   double tp = 700e-6;     // s
   double R = 0.254e-3;    // m
+  double absorbed_I0() const { return I0 * absorptivity; }  // W/m2 the surface takes
   FlowModel model = FlowModel::RisingFall;
   double m = 2.0;
   double xi_p = 1.0;
   SolidModel solid = SolidModel::Exact;
   MeltEnergy melt_energy = MeltEnergy::Advected;
   MeltFlow melt_flow = MeltFlow::Conservative;
+  // Recoil pressure that drives the melt flow, as a fraction of p_sat(T_s): 1 =
+  // the text (full saturation pressure), 0.54 = Anisimov (1968) / Knight (1979)
+  // for strong evaporation with a Knudsen layer.
+  double recoil = 1.0;
+  double absorptivity = 1.0;  // absorbed fraction of the beam (the text: 1)
   double shift = 3.0 / (4.0 * kPi);  // (3-36): shift of the Stefan solution in tau_m
   bool curvature = true;
   bool moving_origin = true;

@@ -22,7 +22,7 @@ constexpr double kStableFraction = 0.25;
 
 TimeStepPolicy::TimeStepPolicy(const Config& cfg) {
   dt_stable_ = cfg.implicit_melt ? 0.0 : explicit_step_limit(cfg);
-  const Groups G = make_groups(cfg.mat, cfg.I0, cfg.R);
+  const Groups G = make_groups(cfg.mat, cfg.absorbed_I0(), cfg.R);
   const double t_melt = melt_onset_tau(G, 0.0) * G.t_scale;
   if (cfg.dt > 0.0) {
     dt_ = cfg.dt;

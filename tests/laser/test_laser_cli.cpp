@@ -148,6 +148,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"stray_argument", "stray", "", {"stray"}},
         BadCase{"melt_flow_unknown", "--melt-flow upwind", "", {"--melt-flow", "conservative, text", "upwind"}},
         BadCase{"T_critical_below_sat", "--T-critical 3000", "", {"--T-critical", "--T-sat0", "3000 K"}},
+        BadCase{"absorptivity_above_one", "--absorptivity 1.2", "", {"--absorptivity", "(0, 1]", "1.2"}},
+        BadCase{"absorptivity_zero", "--absorptivity 0", "", {"--absorptivity", "(0, 1]"}},
+        BadCase{"recoil_unknown", "--recoil half", "", {"--recoil", "full, knight", "half"}},
         BadCase{"T_critical_negative", "--T-critical -5", "", {"--T-critical", "K", "-5"}}),
     [](const ::testing::TestParamInfo<BadCase>& info) { return info.param.what; });
 

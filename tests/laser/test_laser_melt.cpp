@@ -178,3 +178,43 @@ TEST(LaserStatus, AbsurdStateIsDivergedWithNonZeroExit) {
   EXPECT_EQ(csv.find("inf"), std::string::npos);
   fs::remove_all(dir);
 }
+
+// --absorptivity a runs the model with a I0: identical to the run at the
+// absorbed intensity (same step), and the summary keeps the beam's I0.
+TEST(LaserOptions, AbsorptivityScalesTheIntensity) {
+  Config a;
+  a.quiet = true;
+  a.tp = 100e-6;
+  a.I0 = 1e11;
+  a.absorptivity = 0.75;
+  validate(a);
+  a.dt = TimeStepPolicy(a).dt();
+  Config b = a;
+  b.I0 = 7.5e10;
+  b.absorptivity = 1.0;
+  EXPECT_EQ(TimeStepPolicy(b).dt(), a.dt);
+  const Result ra = run_simulation(a), rb = run_simulation(b);
+  ASSERT_EQ(ra.status, "ok") << ra.message;
+  EXPECT_EQ(ra.depth_center, rb.depth_center);
+  EXPECT_EQ(ra.volume_removed, rb.volume_removed);
+  EXPECT_NEAR(ra.energy.laser_exact / rb.energy.laser_exact, 1.0, 1e-15);
+}
+
+// --recoil knight drives the flow with 0.54 p_sat: no effect without a flow;
+// with the flow the least-squares coefficient A changes. Measured: at
+// Pr = 1420 A drops from 3.42e5 to 3.12e5, at Pr = 142 it stays 8034 (the
+// root the rule of (4-19) selects there is nearly independent of the pressure,
+// docs/laser_model.md 2.6), so the test holds the Pr = 1420 case.
+TEST(LaserOptions, RecoilKnightEntersTheFlowOnly) {
+  Config c = short_case(1420.0, MeltFlow::Conservative);
+  c.model = FlowModel::Conduction;
+  Config k = c;
+  k.recoil = 0.54;
+  EXPECT_EQ(run_simulation(c).volume_removed, run_simulation(k).volume_removed);
+  c.model = k.model = FlowModel::RisingFall;
+  const Result rf = run_simulation(c), rk = run_simulation(k);
+  std::printf("[ RECOIL ] Pr = 1420, 50 us: A full %.6g, knight %.6g; expelled %.4e / %.4e m3\n", rf.A_last,
+              rk.A_last, rf.volume_expelled, rk.volume_expelled);
+  EXPECT_LT(rk.A_last, 0.95 * rf.A_last);
+  EXPECT_GT(rk.A_last, 0.0);
+}
