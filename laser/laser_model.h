@@ -85,6 +85,7 @@ struct StepReport {
   double volume_error = 0;
   int runs = 0;
   long steps_total = 0;
+  double stable_limit = 0;  // s, a-priori explicit limit of (4-14) (0: implicit update or none)
   std::string reason;
 };
 

@@ -395,7 +395,11 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["dt_s"] = num(r.dt);
   j["dtau"] = num(r.dtau);
   j["tau_p"] = num(r.tau_p);
-  j["max_stable_dt_s"] = num(r.max_stable_dt);
+  // the a-priori limit the automatic step takes a quarter of (null for the
+  // implicit update), and 2/lambda at its largest along the run (thin layers
+  // right after onset; the run-time check fires only when g also oscillates)
+  j["max_stable_dt_s"] = r.step.stable_limit > 0 ? num(r.step.stable_limit) : nlohmann::ordered_json(nullptr);
+  j["min_2_over_lambda_seen_s"] = num(r.max_stable_dt);
   j["melt_thickness_clamps"] = r.melt_clamps;
   j["melt_rate_clamps"] = r.melt_rate_clamps;
   j["curvature_clamps"] = r.curvature_clamps;

@@ -124,6 +124,7 @@ Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) cons
   s.volume_error = ev;
   s.runs = runs;
   s.steps_total = steps;
+  s.stable_limit = dt_stable_;
   s.reason = reason_ + (dt < dt_ ? ", refined to meet --tol" : "");
   if (std::max(ed, ev) > cfg.tol && (fine.status == "ok" || fine.status == "inaccurate")) {
     const std::string m = "estimated error of the time step: depth " + fmt(ed, 4) + ", volume " + fmt(ev, 4) +

@@ -218,3 +218,32 @@ TEST(LaserOptions, RecoilKnightEntersTheFlowOnly) {
   EXPECT_LT(rk.A_last, 0.95 * rf.A_last);
   EXPECT_GT(rk.A_last, 0.0);
 }
+
+// summary.json max_stable_dt_s is the limit whose quarter the automatic step
+// takes (as the docs say); the implicit update has none (null).
+TEST(LaserStatus, MaxStableStepAgreesWithTheAutomaticStep) {
+  const fs::path dir = fs::temp_directory_path() / ("laser_stable_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const std::string upd : {"explicit", "implicit"}) {
+    const fs::path out = dir / upd;
+    // Table 5.1 (700 us): the automatic step is set by the stability limit
+    const std::string cmd = std::string(LASER_DRILL_EXE) + (upd == "explicit" ? "" : " --pulse 100e-6") +
+                            " --melt-update " + upd +
+                            " --quiet --out " + out.string() + " >/dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const std::string j = slurp(out / "summary.json");
+    const auto num_after = [&](const std::string& key) {
+      const size_t k = j.find("\"" + key + "\": ");
+      EXPECT_NE(k, std::string::npos) << key;
+      return j.substr(k + key.size() + 4, 24);
+    };
+    if (upd == "explicit") {
+      const double lim = std::stod(num_after("max_stable_dt_s")), dt = std::stod(num_after("dt_s"));
+      EXPECT_NEAR(dt, 0.25 * lim, 1e-12 * lim) << j.substr(0, 300);
+    } else {
+      EXPECT_EQ(num_after("max_stable_dt_s").rfind("null", 0), 0u);
+    }
+  }
+  fs::remove_all(dir);
+}
