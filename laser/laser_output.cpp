@@ -1,6 +1,7 @@
 #include "laser_output.h"
 
 #include <fcntl.h>
+#include <csignal>
 #include <hdf5.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -206,6 +207,46 @@ bool is_ours(const std::string& name) {
 
 }  // namespace
 
+namespace {
+// Killed by SIGINT/SIGTERM/SIGHUP: the staged files, the lock and a folder the
+// run created (if empty) are removed by the handler (unlink/rmdir only, which
+// are async-signal-safe), then the signal ends the process as usual.
+constexpr int kMaxCleanup = 16;
+char g_cleanup[kMaxCleanup][4096];
+volatile std::sig_atomic_t g_ncleanup = 0;
+char g_created_dir[4096];
+volatile std::sig_atomic_t g_dir_created = 0;
+
+extern "C" void cleanup_on_signal(int sig) {
+  for (int i = 0; i < g_ncleanup; ++i) ::unlink(g_cleanup[i]);
+  if (g_dir_created) ::rmdir(g_created_dir);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+void arm_cleanup(const fs::path& dir, bool created, const std::vector<std::string>& names) {
+  int n = 0;
+  const auto add = [&](const fs::path& p) {
+    if (n < kMaxCleanup && p.string().size() < sizeof g_cleanup[0])
+      std::snprintf(g_cleanup[n++], sizeof g_cleanup[0], "%s", p.c_str());
+  };
+  for (const auto& name : names) add(dir / (name + kPartSuffix));
+  add(dir / kLockName);
+  g_ncleanup = n;
+  g_dir_created = 0;
+  if (created && dir.string().size() < sizeof g_created_dir) {
+    std::snprintf(g_created_dir, sizeof g_created_dir, "%s", dir.c_str());
+    g_dir_created = 1;
+  }
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, cleanup_on_signal);
+}
+
+void disarm_cleanup() {
+  g_ncleanup = 0;
+  g_dir_created = 0;
+}
+}  // namespace
+
 const std::vector<std::string>& OutputDir::output_names() {
   static const std::vector<std::string> n = {"summary.json", "final_profile.csv", "centre.csv", "profiles.h5",
                                              "conduction_table.csv"};
@@ -275,6 +316,7 @@ OutputDir::OutputDir(const std::string& dir, bool overwrite) : dir_(dir) {
       throw UsageError("--out: cannot lock '" + lock.string() + "': " + why);
     }
   }
+  arm_cleanup(d, created_, output_names());
   if (overwrite)
     for (const auto& e : fs::directory_iterator(d, ec)) {
       const std::string name = e.path().filename().string();
@@ -283,6 +325,7 @@ OutputDir::OutputDir(const std::string& dir, bool overwrite) : dir_(dir) {
 }
 
 OutputDir::~OutputDir() {
+  disarm_cleanup();
   std::error_code ec;
   for (const auto& s : staged_) fs::remove(s, ec);
   const fs::path d(dir_);

@@ -11,7 +11,11 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
+#include <chrono>
+#include <thread>
 
 #include "laser_model.h"
 #include "laser_timestep.h"
@@ -246,4 +250,34 @@ TEST(LaserStatus, MaxStableStepAgreesWithTheAutomaticStep) {
     }
   }
   fs::remove_all(dir);
+}
+
+// Killed while running (SIGTERM, SIGINT), laser_drill leaves no .part file and
+// no lock behind, and removes the folder it created.
+TEST(LaserOutput, KilledRunLeavesNothingBehind) {
+  for (int sig : {SIGTERM, SIGINT}) {
+    const fs::path dir = fs::temp_directory_path() / ("laser_kill_" + std::to_string(::getpid()) + "_" +
+                                                      std::to_string(sig));
+    fs::remove_all(dir);
+    const std::string out = dir.string();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      ::execl(LASER_DRILL_EXE, LASER_DRILL_EXE, "--pr", "142", "--dt", "1e-7", "--melt-update", "implicit", "--quiet",
+              "--out", out.c_str(), static_cast<char*>(nullptr));
+      std::_Exit(127);
+    }
+    ASSERT_GT(pid, 0);
+    bool staged = false;
+    for (int k = 0; k < 200 && !staged; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      staged = fs::exists(dir / "profiles.h5.part");
+    }
+    EXPECT_TRUE(staged) << "the run did not start writing";
+    ::kill(pid, sig);
+    int st = 0;
+    ::waitpid(pid, &st, 0);
+    EXPECT_TRUE(WIFSIGNALED(st) && WTERMSIG(st) == sig);
+    EXPECT_FALSE(fs::exists(dir)) << "left behind in " << out;
+    fs::remove_all(dir);
+  }
 }
