@@ -1,6 +1,7 @@
 #include "laser_model.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -770,6 +771,7 @@ Result Drill::run() {
   int next_frame = 1;
   record(0.0, true);
   long next_progress = nsteps / 10;
+  auto last_progress = std::chrono::steady_clock::now();
   double tau = 0.0;
   for (long step = 0; step < nsteps; ++step) {
     const double ta = tau;
@@ -814,11 +816,15 @@ Result Drill::run() {
     const bool frame = tb >= tau_p * next_frame / (nframes - 1) - 1e-12 * tau_p;
     if (frame) ++next_frame;
     if (frame || step % centre_every == 0 || step == nsteps - 1) record(tb, frame);
-    if (!cfg_.quiet && nsteps >= 1000 && next_progress > 0 && step + 1 >= next_progress) {
+    // progress every 10 % of the pulse, and at least every 10 s of wall time
+    const bool slow = !cfg_.quiet && (step & 63) == 0 &&
+                      std::chrono::steady_clock::now() - last_progress > std::chrono::seconds(10);
+    if (slow || (!cfg_.quiet && nsteps >= 1000 && next_progress > 0 && step + 1 >= next_progress)) {
+      last_progress = std::chrono::steady_clock::now();
       std::fprintf(stderr, "laser_drill: t = %.1f us (%3.0f %%), centre depth %.2f um, T %.0f K\n",
                    tb * G_.t_scale * 1e6, 100.0 * (step + 1) / nsteps,
                    (nodes_[0].S2 - nodes_[0].g) * cfg_.R * 1e6, res_.centre.back().T);
-      next_progress += nsteps / 10;
+      if (!slow) next_progress += nsteps / 10;
     }
   }
   if (res_.frames_written == 0 || (res_.status != "diverged" && res_.final_frame.t < tau * G_.t_scale))

@@ -151,6 +151,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"absorptivity_above_one", "--absorptivity 1.2", "", {"--absorptivity", "(0, 1]", "1.2"}},
         BadCase{"absorptivity_zero", "--absorptivity 0", "", {"--absorptivity", "(0, 1]"}},
         BadCase{"recoil_unknown", "--recoil half", "", {"--recoil", "full, knight", "half"}},
+        BadCase{"cannot_finish_1e13", "--intensity 1e13", "", {"--intensity 1e+13 W/m2", "--pulse", "node steps"}},
+        BadCase{"cannot_finish_fine_grid", "--intensity 5e12 --dxi 0.001", "", {"--dxi", "cannot finish", "node steps"}},
         BadCase{"T_critical_negative", "--T-critical -5", "", {"--T-critical", "K", "-5"}}),
     [](const ::testing::TestParamInfo<BadCase>& info) { return info.param.what; });
 
