@@ -1,6 +1,7 @@
 // laser_drill: single-pulse laser drilling model (Yang 2016, Part I).
 // Exit status: 0 finished run (status in summary.json), 2 bad input (nothing
-// written), 1 write failure or internal error (no summary.json).
+// written), 1 write failure or internal error (no summary.json), 3 status
+// diverged (summary.json written: a non-finite or physically absurd state).
 #include <chrono>
 #include <cstdlib>
 #include <cstdio>
@@ -52,12 +53,19 @@ int main(int argc, char** argv) {
     out->write_tables(cfg, r);
     out->commit(summary_json(cfg, r, wall));
     out.reset();
+    char est[96];
+    if (r.status == "diverged")  // no error estimate of a state that is not a solution
+      std::snprintf(est, sizeof est, "no error estimate: diverged");
+    else
+      std::snprintf(est, sizeof est, "est. error depth %.1e, volume %.1e", r.step.depth_error, r.step.volume_error);
     std::printf("status %s; depth %.4g m; volume %.4g m3; rate %.4g m3/s; T_peak %.1f K; "
-                "p_peak %.4g Pa; dt %.3g s (est. error depth %.1e, volume %.1e); wall %.3f s\n",
-                r.status.c_str(), r.depth_center, r.volume_removed, r.removal_rate, r.T_peak, r.p_peak, r.dt,
-                r.step.depth_error, r.step.volume_error, wall);
+                "p_peak %.4g Pa; dt %.3g s (%s); wall %.3f s\n",
+                r.status.c_str(), r.depth_center, r.volume_removed, r.removal_rate, r.T_peak, r.p_peak, r.dt, est,
+                wall);
     std::fflush(stdout);
+    for (const auto& w : r.warnings) std::fprintf(stderr, "laser_drill: warning: %s\n", w.c_str());
     if (!r.message.empty()) std::fprintf(stderr, "laser_drill: %s: %s\n", r.status.c_str(), r.message.c_str());
+    if (r.status == "diverged") return 3;
   } catch (const WriteError& e) {
     std::cerr << "laser_drill: error: " << e.what() << "\n";
     out.reset();  // removes the staged files and the lock

@@ -77,6 +77,10 @@ struct Material {
   double cpl = 625.0;       // J/(kg K)
   double cps = 380.0;       // J/(kg K)
   double Pr = 0.142;        // -
+  // Critical temperature: the vapour model (3-15)/(3-17) and the sharp melt-vapour
+  // interface lose meaning as T_s approaches it. Not in the text; estimates for
+  // nickel, the base of the super alloy, range 7800-9500 K: 8500 K is taken.
+  double Tc = 8500.0;       // K
 };
 
 struct Groups {

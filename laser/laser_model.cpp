@@ -1,10 +1,12 @@
 #include "laser_model.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <sstream>
+#include <cstdlib>
 
 namespace laser {
 
@@ -14,18 +16,34 @@ struct Node {
   double xi = 0, tau_m = 0, area = 0;  // area in m2
   bool molten = false;
   double S1 = 0, S2 = 0, g = 0, b2 = 0, S1flow = 0;
+  double V_in = 0;  // gross melt thickness carried into the column by the flow
   InterfaceState itf;
   double dS1 = 0, dS2 = 0, v = 0, f = 0;  // rates of the last step, f: u = f zeta
+  double v_kin = 0;  // conservative flow: -(1/xi) d(xi Q)/dxi at the start of the step (used in (4-27))
   double last_dg = 0;  // dg/dtau of the last step
   int flips = 0;       // consecutive sign changes of dg/dtau with lambda dtau > 2
 };
 
 constexpr int kUnstableFlips = 3;
+// The model sees the absorbed intensity only (energies, bounds and groups).
+Config absorbed(Config c) {
+  c.I0 = c.absorbed_I0();
+  c.absorptivity = 1.0;
+  return c;
+}
+constexpr long kMaxFlowSubsteps = 100000;
+constexpr double kTcWarnFraction = 0.8;
+// rho (h_m V_melted + h_v V_vaporized) above this multiple of the beam energy is
+// not a solution at all (diverged); between 1 and this it is a failed check
+// (the text's melt layer reaches 1.12 at 7.5e10 W/m2)
+constexpr double kAbsurdEnergy = 2.0;     // warning above this fraction of T_c
+constexpr double kMeltBalanceTol = 1e-3;    // melt volume balance (text flow: 1e-4 at Pr = 0.142)
+constexpr double kSafeguardFraction = 1e-4; // of the node steps
 
 class Drill {
  public:
   Drill(const Config& c, FrameSink* sink)
-      : cfg_(c), G_(make_groups(c.mat, c.I0, c.R)), sink_(sink),
+      : cfg_(absorbed(c)), G_(make_groups(c.mat, c.absorbed_I0(), c.R)), sink_(sink),
         advected_(c.melt_energy == MeltEnergy::Advected) {}
   Result run();
 
@@ -33,7 +51,8 @@ class Drill {
   void setup();
   void melt_onset(double tb);
   void solve_interfaces();
-  bool solve_melt_flow();
+  bool solve_melt_flow(double ta, double tb);
+  bool conservative_flow(const FlowProfile& profile, int first, double ta, double tb);
   void solve_boundary_layer(int& last_bl);
   double solid_gradient_mean(const Node& n, double ta, double tb) const;
   // phases of advance_interfaces, per node
@@ -51,6 +70,8 @@ class Drill {
   void record(double tau, bool frame);
   void emit(Frame&& f);
   void physical_check();
+  bool state_admissible(double tb);
+  void assess();
   double node_ta(const Node& n, double ta) const { return std::max(ta, n.tau_m); }
 
   Config cfg_;
@@ -65,6 +86,7 @@ class Drill {
   double dtau_ = 0;
   std::string flow_failure_;
   std::string first_clamp_;
+  long flow_substeps_ = 0;
   int idx_x1_ = 0;
 };
 
@@ -116,9 +138,9 @@ void Drill::solve_interfaces() {
 
 // Least squares coefficient A of (4-18)/(4-19) for the integral profiles and
 // the vertical surface velocity v(xi, g) that enters (4-13).
-bool Drill::solve_melt_flow() {
+bool Drill::solve_melt_flow(double ta, double tb) {
   const int N = static_cast<int>(nodes_.size());
-  for (auto& n : nodes_) { n.v = 0.0; n.f = 0.0; }
+  for (auto& n : nodes_) { n.v = 0.0; n.f = 0.0; n.v_kin = 0.0; }
   A_ = 0.0;
   u_peak_ = 0.0;
   if (cfg_.model == FlowModel::Conduction) return true;
@@ -136,9 +158,9 @@ bool Drill::solve_melt_flow() {
   for (int i = 1; i < N; ++i) {
     if (!nodes_[i].molten) continue;
     const bool lm = nodes_[i - 1].molten, rm = (i + 1 < N) && nodes_[i + 1].molten;
-    const double pl = nodes_[i - 1].itf.p_star, pc = nodes_[i].itf.p_star;
+    const double pl = cfg_.recoil * nodes_[i - 1].itf.p_star, pc = cfg_.recoil * nodes_[i].itf.p_star;
     if (rm) {
-      const double pr = nodes_[i + 1].itf.p_star;
+      const double pr = cfg_.recoil * nodes_[i + 1].itf.p_star;
       dpdx[i] = lm ? (pr - pl) / (2 * cfg_.dxi) : (pr - pc) / cfg_.dxi;
     } else if (lm) {
       dpdx[i] = (pc - pl) / cfg_.dxi;
@@ -166,6 +188,7 @@ bool Drill::solve_melt_flow() {
     return false;
   }
   A_ = root.A;
+  if (cfg_.melt_flow == MeltFlow::Conservative) return conservative_flow(profile, first, ta, tb);
   // The rising-fall v has the finite limit -A g^2 on the axis; the rising v
   // ~ xi^(1/m - 1) is singular there and the centre stays pure conduction.
   const int first_v = (!rising && first == 1) ? 0 : first;
@@ -177,6 +200,104 @@ bool Drill::solve_melt_flow() {
     n.v = flow_surface_velocity(profile, A_, x, g);
     u_peak_ = std::max(u_peak_, std::fabs(n.f * g));
   }
+  // Diagnostic only: the volume the profile carries out of the melt zone
+  // (face flux pi xi f g^2 at the outer melt edge), booked as in the
+  // conservative form so that the melt balance can be compared.
+  const double R2 = cfg_.R * cfg_.R;
+  for (int k = 0; k < N; ++k) {
+    const Node& n = nodes_[k];
+    if (!n.molten || !(n.g > 0.0) || (k + 1 < N && nodes_[k + 1].molten)) continue;
+    const double xf = (k + 0.5) * cfg_.dxi, c = kPi * xf * flow_shape(profile, A_, xf);
+    if (c > 0.0) res_.volume_expelled += c * n.g * n.g * (tb - ta) * R2 * cfg_.R;
+  }
+  return true;
+}
+
+// Flux-conservative surface velocity (docs/laser_model.md, 2.6): the layer's
+// volume flux per unit circumference Q = int_0^g u dzeta = f g^2/2 (u = f zeta)
+// crosses the cell faces xi_(k+1/2) = (k + 1/2) d(xi), which bound exactly the
+// node areas; dg/dtau = -(1/xi) d(xi Q)/dxi = v(xi, g) - u(xi, g) dg/dxi. The
+// face value of g is taken upwind; the flux is advanced over the step in
+// sub-steps that move at most half of a cell's melt (so g stays >= 0 and no
+// clamp is needed), with A and f fixed at this step's values. Melt that
+// crosses a face into a node that is not molten, or the outer end of the grid,
+// is expelled over the rim. Each node gets v = (its change of g)/(its part of
+// the step), which (4-13) and (4-27) then use.
+bool Drill::conservative_flow(const FlowProfile& profile, int first, double ta, double tb) {
+  const int N = static_cast<int>(nodes_.size());
+  const double h = cfg_.dxi, dtau = tb - ta, R2 = cfg_.R * cfg_.R;
+  const int first_c = first == 1 ? 0 : first;  // the integral profiles reach the axis
+  std::vector<char> active(N, 0);
+  std::vector<double> gs(N, 0.0), a(N, 0.0), c(N, 0.0), vin(N, 0.0);
+  for (int i = 0; i < N; ++i) {
+    Node& n = nodes_[i];
+    a[i] = n.area / R2;
+    if (i >= first_c && n.molten) {
+      active[i] = 1;
+      gs[i] = std::max(n.g, 0.0);
+      if (n.xi > 0.0) {
+        n.f = flow_shape(profile, A_, n.xi);
+        u_peak_ = std::max(u_peak_, std::fabs(n.f * n.g));
+      }
+    }
+    // face between node i and i + 1: volume rate c_i g_up^2 (outwards > 0)
+    const double xf = (i + 0.5) * h;
+    c[i] = kPi * xf * flow_shape(profile, A_, xf);
+  }
+  for (int k = first_c; k < N; ++k) {  // rates at the start of the step, for (4-27)
+    const int up = c[k] >= 0.0 ? k : k + 1, dn = c[k] >= 0.0 ? k + 1 : k;
+    if (up >= N || !active[up]) continue;
+    const double q = std::fabs(c[k]) * gs[up] * gs[up];
+    nodes_[up].v_kin -= q / a[up];
+    if (dn < N && active[dn]) nodes_[dn].v_kin += q / a[dn];
+  }
+  double t = 0.0, expelled = 0.0;
+  long sub = 0;
+  std::vector<double> out(N), g0(N);
+  while (t < dtau) {
+    std::fill(out.begin(), out.end(), 0.0);
+    double worst = 0.0;
+    for (int k = first_c; k < N; ++k) {
+      const int up = c[k] >= 0.0 ? k : k + 1;
+      if (up >= N || !active[up]) continue;
+      out[up] += std::fabs(c[k]) * gs[up];  // outflow rate / (g a) summed below
+    }
+    for (int i = first_c; i < N; ++i)
+      if (active[i] && a[i] > 0.0) worst = std::max(worst, out[i] / a[i]);
+    const double dts = worst > 0.0 ? std::min(dtau - t, 0.5 / worst) : dtau - t;
+    // every face flux from the state at the start of the sub-step
+    std::copy(gs.begin(), gs.end(), g0.begin());
+    for (int k = first_c; k < N; ++k) {
+      const int up = c[k] >= 0.0 ? k : k + 1, dn = c[k] >= 0.0 ? k + 1 : k;
+      if (up >= N || !active[up]) continue;
+      const double vol = std::fabs(c[k]) * g0[up] * g0[up] * dts;
+      if (!(vol > 0.0)) continue;
+      gs[up] -= vol / a[up];
+      if (dn < N && active[dn]) {
+        gs[dn] += vol / a[dn];
+        vin[dn] += vol / a[dn];
+      } else {
+        expelled += vol;
+      }
+    }
+    t = (dts == dtau - t) ? dtau : t + dts;
+    if (++sub > kMaxFlowSubsteps) {
+      flow_failure_ = "melt flow faster than the grid can carry: more than " + std::to_string(kMaxFlowSubsteps) +
+                      " flux sub-steps in one time step (A = " + fmt(A_, 4) + "; Courant number u dt/dr about " +
+                      fmt(worst * dtau, 4) + ")";
+      return false;
+    }
+  }
+  flow_substeps_ = std::max(flow_substeps_, sub);
+  res_.volume_expelled += expelled * R2 * cfg_.R;
+  for (int i = 0; i < N; ++i) {
+    if (!active[i]) continue;
+    Node& n = nodes_[i];
+    const double dtn = tb - node_ta(n, ta);
+    if (!(dtn > 0.0)) continue;
+    n.v = (gs[i] - std::max(n.g, 0.0)) / dtn;
+    n.V_in += vin[i];
+  }
   return true;
 }
 
@@ -187,11 +308,11 @@ void Drill::solve_boundary_layer(int& last_bl) {
   last_bl = 0;
   const int N = static_cast<int>(nodes_.size());
   if (N < 3 || !nodes_[0].molten || !nodes_[1].molten) return;
-  const double Pr = cfg_.mat.Pr, h = cfg_.dxi, pc = nodes_[0].itf.p_star;
+  const double Pr = cfg_.mat.Pr, h = cfg_.dxi, pc = cfg_.recoil * nodes_[0].itf.p_star;
   std::vector<double> U(N, 0.0);
   int end = 1;
   while (end < N && nodes_[end].molten) ++end;
-  for (int i = 0; i < end; ++i) U[i] = std::sqrt(std::max(0.0, 2.0 * (pc - nodes_[i].itf.p_star)));
+  for (int i = 0; i < end; ++i) U[i] = std::sqrt(std::max(0.0, 2.0 * (pc - cfg_.recoil * nodes_[i].itf.p_star)));
   auto Ux = [&](double x, double& u, double& du) {
     const double s = x / h;
     int i = std::min(static_cast<int>(s), end - 2);
@@ -385,9 +506,16 @@ void Drill::move_fronts(Node& n, const Rates& r, double dtn) {
   n.S2 += r.dS2 * dtn;
   n.S1 += r.dS1 * dtn;
   n.S1flow += -n.v * dtn;
+  if (cfg_.melt_flow == MeltFlow::Text && n.v > 0.0) n.V_in += n.v * dtn;
   n.g += (r.dS2 - r.dS1 + n.v) * dtn;
   if (n.g < 0.0) {
     ++res_.melt_clamps;
+    if (cfg_.melt_flow == MeltFlow::Conservative) {
+      // vaporization cannot take more melt than there is: the recession of
+      // this step is cut to the melt available (booked, the volume is kept)
+      n.S1 += n.g;
+      res_.vaporization_cut += -n.g * cfg_.R * n.area;
+    }
     n.g = 0.0;
   }
 }
@@ -432,8 +560,14 @@ void Drill::melt_temperature() {
       continue;
     }
     const double g = n.g, th = n.itf.theta_sat, f = n.f, x = n.xi;
+    if (!(th > 0.0)) {  // a layer at T_m throughout (beyond the vaporizing zone): b2 = 0 exactly
+      n.b2 = 0.0;
+      fJ_up = 0.0;
+      continue;
+    }
     const double sgn = outward ? 1.0 : -1.0;  // d/dxi by the upwind difference
-    const double num = sgn * (f * th * g * g / 3.0 - fJ_up) / h + f / x * th * g * g / 3.0 + n.v * th;
+    const double vs = cfg_.melt_flow == MeltFlow::Conservative ? n.v_kin : n.v;  // surface velocity of (4-27)
+    const double num = sgn * (f * th * g * g / 3.0 - fJ_up) / h + f / x * th * g * g / 3.0 + vs * th;
     const double den = 2.0 * g + f * std::pow(g, 4) / 12.0 * (sgn / h + 1.0 / x);
     n.b2 = num / den;
     // Safeguard: keep the profile (4-25) monotone in [0, g], |b2 g^2| <= theta_sat.
@@ -495,24 +629,31 @@ void Drill::physical_check() {
   pc.Ts = res_.T_center;
   pc.H = H(std::max(pc.Ts, m.Tm));
   pc.H0 = H(m.Tsat0);
-  const double melt_heat = m.cps * (m.Tm - m.Ti) + m.hls;  // J/kg of melt still in place
-  double beam = 0, demand = 0, demand0 = 0;
+  const double melt_heat = m.cps * (m.Tm - m.Ti) + m.hls;  // J/kg to melt the solid in place
+  // sensible heat per kg that melt carried into a column can bring at most
+  const double inflow_heat = m.cpl * (std::max(res_.T_peak, m.Tm) - m.Tm);
+  double beam = 0, demand = 0, demand0 = 0, need_all = 0;
   pc.worst_node_ratio = 0;
   const double t_end = res_.t_end;
   for (const auto& n : nodes_) {
     const double absorbed = cfg_.I0 * gaussian_beam(n.xi) * t_end;  // J/m2
     beam += absorbed * n.area;
-    const double removed = (n.S2 - n.g) * R, melt = n.g * R;
+    const double removed = (n.S2 - n.g) * R;
     if (!n.molten) continue;
-    const double Ts = n.itf.phi * m.Tsat0;
-    const double need = m.rho * (H(Ts) * removed + melt_heat * melt);
+    const double Ts = std::max(n.itf.phi * m.Tsat0, m.Tm);
+    // the column melted S2 in place and vaporized S1 (paying c_pl (T_s - T_m)
+    // + h_lv); melt the flow brought in may have carried heat with it
+    const double need = m.rho * (melt_heat * n.S2 + (H(Ts) - melt_heat) * n.S1) * R;
+    const double avail = absorbed + m.rho * inflow_heat * n.V_in * R;
+    need_all += need * n.area;
     demand += m.rho * pc.H * removed * n.area;
     demand0 += m.rho * pc.H0 * removed * n.area;
-    const double ratio = need / absorbed;
-    if (ratio > pc.worst_node_ratio) { pc.worst_node_ratio = ratio; pc.worst_node_xi = n.xi; }
+    const double ratio = need / avail;
+    if (!(ratio <= pc.worst_node_ratio)) { pc.worst_node_ratio = ratio; pc.worst_node_xi = n.xi; }
   }
   pc.removed_over_beam = beam > 0 ? demand / beam : 0.0;
   pc.removed_over_beam_H0 = beam > 0 ? demand0 / beam : 0.0;
+  pc.melt_vap_over_beam = beam > 0 ? need_all / beam : 0.0;
   // net centre recession over the last 10 % of the pulse
   const auto& c = res_.centre;
   if (c.size() >= 2 && res_.t_melt_center >= 0) {
@@ -523,7 +664,96 @@ void Drill::physical_check() {
   }
   pc.centre_bound = cfg_.I0 / (m.rho * pc.H);
   pc.centre_velocity_ratio = pc.centre_velocity / pc.centre_bound;
-  pc.holds = pc.removed_over_beam < 1.0 && pc.worst_node_ratio < 1.0 && pc.centre_velocity_ratio < 1.0;
+  // I0/(rho H) bounds the recession by vaporization only; a flow that expels
+  // melt can remove the centre for rho (c_ps (T_m - T_i) + h_ls) per volume, and
+  // the centre column's energy bound (worst_node_ratio) covers that case
+  const bool no_flow = cfg_.model == FlowModel::Conduction;
+  pc.holds = pc.melt_vap_over_beam < 1.0 && pc.worst_node_ratio < 1.0 && (!no_flow || pc.centre_velocity_ratio < 1.0);
+}
+
+// Status from the physics checks: every check that fails is named (the most
+// serious first) in Result::causes and the message; the counts count.
+void Drill::assess() {
+  const Material& m = cfg_.mat;
+  res_.T_over_Tc = res_.T_peak / m.Tc;
+  if (res_.T_peak > kTcWarnFraction * m.Tc)
+    res_.warnings.push_back("surface temperature " + fmt(res_.T_peak, 5) + " K above " + fmt(kTcWarnFraction, 2) +
+                            " of the critical temperature " + fmt(m.Tc, 5) +
+                            " K: the Clausius-Clapeyron vapour (3-15) and the sharp melt-vapour interface are "
+                            "doubtful there");
+  const PhysicalCheck& pc = res_.check;
+  const bool finished = res_.status == "ok" || res_.status == "no_flow_solution" || res_.status == "truncated";
+  const std::string bound_text = "melting and vaporizing the computed volumes needs " +
+                                 fmt(pc.melt_vap_over_beam, 4) +
+                                 " times the beam energy (rho (h_m V_melted + h_v V_vaporized) / E_beam must stay below 1)";
+  if (finished && (!std::isfinite(res_.volume_removed) || !(pc.melt_vap_over_beam <= kAbsurdEnergy))) {
+    res_.status = "diverged";
+    res_.causes.insert(res_.causes.begin(), "energy bound of the whole melt");
+    res_.message = bound_text + (res_.message.empty() ? "" : "; " + res_.message);
+    return;
+  }
+  if (res_.status != "ok") return;
+  std::vector<std::string> why;
+  auto cause = [&](const std::string& name, const std::string& text) {
+    res_.causes.push_back(name);
+    why.push_back(name + ": " + text);
+  };
+  const double node_steps = double(res_.steps) * res_.nodes;
+  if (pc.melt_vap_over_beam >= 1.0) cause("energy bound of the whole melt", bound_text);
+  if (pc.worst_node_ratio >= 1.0)
+    cause("column energy bound", "the column at xi = " + fmt(pc.worst_node_xi, 4) + " melted and vaporized " +
+                                     fmt(pc.worst_node_ratio, 4) + " times the energy it absorbed");
+  if (cfg_.model == FlowModel::Conduction && pc.centre_velocity_ratio >= 1.0)
+    cause("centre recession bound", "net centre recession " + fmt(pc.centre_velocity_ratio, 4) +
+                                        " times I0/(rho H) over the last 10 % of the pulse");
+  if (std::fabs(res_.melt_balance) > kMeltBalanceTol)
+    cause("melt volume balance", "melted - vaporized - expelled over the rim - still molten = " +
+                                     fmt(res_.melt_balance, 4) + " of the melted volume" +
+                                     (cfg_.melt_flow == MeltFlow::Text ? " (the text's surface velocity (4-22) does "
+                                                                         "not conserve the melt; --melt-flow conservative)"
+                                                                       : ""));
+  if (res_.b2_clamps > kSafeguardFraction * node_steps)
+    cause("b2 limiter", "|b2| g^2 <= theta_sat of (4-25) enforced " + std::to_string(res_.b2_clamps) +
+                            " times (" + fmt(res_.b2_clamps / node_steps, 3) + " of the node steps)");
+  if (res_.curvature_clamps > kSafeguardFraction * node_steps)
+    cause("curvature clamp", "|a d| >= 2 in (3-37) clamped " + std::to_string(res_.curvature_clamps) + " times (" +
+                                 first_clamp_ + ")");
+  if (cfg_.melt_flow == MeltFlow::Text && res_.melt_clamps > kSafeguardFraction * node_steps)
+    cause("melt thickness clamp", "g < 0 set to 0 " + std::to_string(res_.melt_clamps) + " times");
+  if (res_.volume_melted > 0 && res_.vaporization_cut > kMeltBalanceTol * res_.volume_melted)
+    cause("vaporization cut", "recession cut to the melt available " + std::to_string(res_.melt_clamps) +
+                                  " times, " + fmt(res_.vaporization_cut / res_.volume_melted, 3) +
+                                  " of the melted volume (the step is too long for the thin layer)");
+  const double imb = (res_.energy.sum() - res_.energy.laser_exact) / res_.energy.laser_exact;
+  if (std::fabs(imb) > 0.01) cause("energy bookkeeping", "imbalance " + fmt(imb, 4) + " (> 1e-2)");
+  if (!why.empty()) {
+    res_.status = "inaccurate";
+    std::string msg;
+    for (const auto& w : why) msg += (msg.empty() ? "" : "; ") + w;
+    res_.message = msg;
+  } else if (res_.curvature_clamps > 0) {
+    res_.message = "curvature |a d| >= 2 clamped " + std::to_string(res_.curvature_clamps) + " times (of " +
+                   fmt(node_steps, 4) + " node steps; " + first_clamp_ + ")";
+  }
+}
+
+// A surface state beyond the model's range stops the run as diverged: a
+// non-finite temperature or pressure, or a temperature above the critical one.
+bool Drill::state_admissible(double tb) {
+  const Material& m = cfg_.mat;
+  for (const auto& n : nodes_) {
+    if (!n.molten) continue;
+    const double T = n.itf.phi * m.Tsat0;
+    if (std::isfinite(T) && std::isfinite(n.itf.p_pa) && T <= m.Tc) continue;
+    res_.status = "diverged";
+    res_.causes.push_back(std::isfinite(T) && std::isfinite(n.itf.p_pa) ? "surface temperature above the critical temperature"
+                                                                       : "non-finite surface state");
+    res_.message = "surface state beyond the model at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb * G_.t_scale, 4) +
+                   " s: T_s = " + fmt(T, 5) + " K (critical temperature --T-critical " + fmt(m.Tc, 5) +
+                   " K), p = " + fmt(n.itf.p_pa, 4) + " Pa (melt thickness g = " + fmt(n.g * cfg_.R, 4) + " m)";
+    return false;
+  }
+  return true;
 }
 
 Result Drill::run() {
@@ -541,13 +771,15 @@ Result Drill::run() {
   int next_frame = 1;
   record(0.0, true);
   long next_progress = nsteps / 10;
+  auto last_progress = std::chrono::steady_clock::now();
   double tau = 0.0;
   for (long step = 0; step < nsteps; ++step) {
     const double ta = tau;
     const double tb = (step == nsteps - 1) ? tau_p : std::min(tau_p, (step + 1) * dtau_);
     melt_onset(tb);
     solve_interfaces();
-    if (!solve_melt_flow()) {
+    if (!state_admissible(tb)) break;
+    if (!solve_melt_flow(ta, tb)) {
       res_.status = "no_flow_solution";
       res_.message = flow_failure_ + " at t = " + fmt(ta * G_.t_scale, 4) + " s";
       break;
@@ -558,6 +790,7 @@ Result Drill::run() {
     res_.steps = static_cast<int>(step + 1);
     res_.A_last = A_;
     res_.u_peak_max = std::max(res_.u_peak_max, u_peak_ * G_.v_scale);
+    if (!state_admissible(tb)) break;  // the interface re-solved by the step (implicit update)
     for (const auto& n : nodes_) {
       if (!n.molten) continue;
       res_.T_peak = std::max(res_.T_peak, n.itf.phi * cfg_.mat.Tsat0);
@@ -568,6 +801,7 @@ Result Drill::run() {
       if (!std::isfinite(n.S2) || !std::isfinite(n.g) || !std::isfinite(n.S1) ||
           !std::isfinite(n.b2) || !std::isfinite(n.itf.phi)) {
         res_.status = "diverged";
+        res_.causes.push_back("non-finite state");
         res_.message = "non-finite state at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb * G_.t_scale, 4) +
                        " s (model " + to_string(cfg_.model) + "; S2 " + fmt(n.S2, 4) + ", g " + fmt(n.g, 4) +
                        ", S1 " + fmt(n.S1, 4) + ", phi " + fmt(n.itf.phi, 4) + ", b2 " + fmt(n.b2, 4) + ")";
@@ -582,14 +816,19 @@ Result Drill::run() {
     const bool frame = tb >= tau_p * next_frame / (nframes - 1) - 1e-12 * tau_p;
     if (frame) ++next_frame;
     if (frame || step % centre_every == 0 || step == nsteps - 1) record(tb, frame);
-    if (!cfg_.quiet && nsteps >= 1000 && next_progress > 0 && step + 1 >= next_progress) {
+    // progress every 10 % of the pulse, and at least every 10 s of wall time
+    const bool slow = !cfg_.quiet && (step & 63) == 0 &&
+                      std::chrono::steady_clock::now() - last_progress > std::chrono::seconds(10);
+    if (slow || (!cfg_.quiet && nsteps >= 1000 && next_progress > 0 && step + 1 >= next_progress)) {
+      last_progress = std::chrono::steady_clock::now();
       std::fprintf(stderr, "laser_drill: t = %.1f us (%3.0f %%), centre depth %.2f um, T %.0f K\n",
                    tb * G_.t_scale * 1e6, 100.0 * (step + 1) / nsteps,
                    (nodes_[0].S2 - nodes_[0].g) * cfg_.R * 1e6, res_.centre.back().T);
-      next_progress += nsteps / 10;
+      if (!slow) next_progress += nsteps / 10;
     }
   }
-  if (res_.frames_written == 0 || res_.final_frame.t < tau * G_.t_scale) record(tau, true);
+  if (res_.frames_written == 0 || (res_.status != "diverged" && res_.final_frame.t < tau * G_.t_scale))
+    record(tau, true);
   if (sink_) sink_->finish();
   res_.t_end = tau * G_.t_scale;
   res_.dt = cfg_.dt;
@@ -610,7 +849,12 @@ Result Drill::run() {
     res_.volume_vaporized += n.S1 * R * n.area;
     res_.volume_flow += n.S1flow * R * n.area;
     res_.volume_melted += n.S2 * R * n.area;
+    res_.volume_molten += n.g * R * n.area;
   }
+  res_.flow_substeps_max = flow_substeps_;
+  if (res_.volume_melted > 0.0)
+    res_.melt_balance = (res_.volume_melted - res_.volume_vaporized - res_.volume_expelled - res_.volume_molten) /
+                        res_.volume_melted;
   res_.removal_rate = res_.t_end > 0 ? res_.volume_removed / res_.t_end : 0.0;
   physical_check();
   if (res_.status == "ok" && c.tau_m >= tau_p) {
@@ -625,21 +869,7 @@ Result Drill::run() {
                    "; melting would reach xi = " + fmt(res_.xi_melt_edge, 4) +
                    "): removed volume and energy are cut at --xi-max";
   }
-  if (res_.status == "ok") {
-    // A finished run whose safeguards fired is reported, not passed off as ok.
-    const double imb = (res_.energy.sum() - res_.energy.laser_exact) / res_.energy.laser_exact;
-    const double node_steps = double(res_.steps) * res_.nodes;
-    if (std::fabs(imb) > 0.01 || res_.curvature_clamps > 1e-4 * node_steps) {
-      res_.status = "inaccurate";
-      res_.message = "energy imbalance " + fmt(imb, 4) + ", curvature |a d| >= 2 clamped " +
-                     std::to_string(res_.curvature_clamps) + " times (" + first_clamp_ + "), b2 limiter hit " +
-                     std::to_string(res_.b2_clamps) + " times, melt thickness clamped at 0 " +
-                     std::to_string(res_.melt_clamps) + " times";
-    } else if (res_.curvature_clamps > 0) {
-      res_.message = "curvature |a d| >= 2 clamped " + std::to_string(res_.curvature_clamps) + " times (of " +
-                     fmt(node_steps, 4) + " node steps; " + first_clamp_ + ")";
-    }
-  }
+  assess();
   return res_;
 }
 
@@ -668,7 +898,7 @@ double advected_step_limit(const Config& cfg, const Groups& G) {
 }  // namespace
 
 double explicit_step_limit(const Config& cfg) {
-  const Groups G = make_groups(cfg.mat, cfg.I0, cfg.R);
+  const Groups G = make_groups(cfg.mat, cfg.absorbed_I0(), cfg.R);
   if (cfg.melt_energy == MeltEnergy::Advected) return advected_step_limit(cfg, G);
   const double L0 = 1.0 / (G.Ste * G.Nc) - G.theta_i;
   // surface state for a conduction gradient q into the melt: vapour term = 1 - k' q

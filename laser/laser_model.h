@@ -68,7 +68,8 @@ struct PhysicalCheck {
   double H0 = 0;                    // J/kg with T_sat0
   double removed_over_beam = 0;     // rho H V_removed / beam energy on the grid
   double removed_over_beam_H0 = 0;  // the same with H0
-  double worst_node_ratio = 0;      // max over nodes of demand / absorbed
+  double melt_vap_over_beam = 0;    // rho (h_m V_melted + h_v V_vaporized) / beam energy (global bound)
+  double worst_node_ratio = 0;      // max over nodes of demand / (absorbed + heat the inflowing melt can bring)
   double worst_node_xi = 0;
   double centre_velocity = 0;       // m/s, net recession over the last 10 % of the pulse
   double centre_bound = 0;          // m/s, I0 / (rho H)
@@ -84,6 +85,7 @@ struct StepReport {
   double volume_error = 0;
   int runs = 0;
   long steps_total = 0;
+  double stable_limit = 0;  // s, a-priori explicit limit of (4-14) (0: implicit update or none)
   std::string reason;
 };
 
@@ -97,6 +99,11 @@ struct Result {
   double t_melt_center = -1;
   double depth_center = 0, S2_center = 0, g_center = 0;
   double volume_removed = 0, volume_vaporized = 0, volume_flow = 0, volume_melted = 0;
+  double volume_expelled = 0;    // m3, melt carried over the rim by the flow (conservative flow)
+  double volume_molten = 0;      // m3, melt still in place at the end
+  double vaporization_cut = 0;   // m3, recession cut to the melt available (conservative flow)
+  double melt_balance = 0;       // (melted - vaporized - expelled - molten) / melted
+  long flow_substeps_max = 0;    // most flux sub-steps in one step (conservative flow)
   double removal_rate = 0;
   double T_peak = 0, p_peak = 0, u_peak_max = 0, A_last = 0;
   double T_center = 0;     // K, centre surface temperature at the end
@@ -110,6 +117,9 @@ struct Result {
   PhysicalCheck check;
   StepReport step;
   std::vector<std::string> notes;  // e.g. the --frames clip
+  std::vector<std::string> causes; // named checks that made the status inaccurate/diverged
+  std::vector<std::string> warnings;  // physics range (critical temperature)
+  double T_over_Tc = 0;            // T_peak / T_critical
   std::vector<double> xi, tau_m_s;
   std::vector<Frame> frames;       // kept only when run without a FrameSink
   Frame final_frame;

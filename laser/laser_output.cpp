@@ -1,6 +1,7 @@
 #include "laser_output.h"
 
 #include <fcntl.h>
+#include <csignal>
 #include <hdf5.h>
 #include <sys/file.h>
 #include <unistd.h>
@@ -206,6 +207,46 @@ bool is_ours(const std::string& name) {
 
 }  // namespace
 
+namespace {
+// Killed by SIGINT/SIGTERM/SIGHUP: the staged files, the lock and a folder the
+// run created (if empty) are removed by the handler (unlink/rmdir only, which
+// are async-signal-safe), then the signal ends the process as usual.
+constexpr int kMaxCleanup = 16;
+char g_cleanup[kMaxCleanup][4096];
+volatile std::sig_atomic_t g_ncleanup = 0;
+char g_created_dir[4096];
+volatile std::sig_atomic_t g_dir_created = 0;
+
+extern "C" void cleanup_on_signal(int sig) {
+  for (int i = 0; i < g_ncleanup; ++i) ::unlink(g_cleanup[i]);
+  if (g_dir_created) ::rmdir(g_created_dir);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+void arm_cleanup(const fs::path& dir, bool created, const std::vector<std::string>& names) {
+  int n = 0;
+  const auto add = [&](const fs::path& p) {
+    if (n < kMaxCleanup && p.string().size() < sizeof g_cleanup[0])
+      std::snprintf(g_cleanup[n++], sizeof g_cleanup[0], "%s", p.c_str());
+  };
+  for (const auto& name : names) add(dir / (name + kPartSuffix));
+  add(dir / kLockName);
+  g_ncleanup = n;
+  g_dir_created = 0;
+  if (created && dir.string().size() < sizeof g_created_dir) {
+    std::snprintf(g_created_dir, sizeof g_created_dir, "%s", dir.c_str());
+    g_dir_created = 1;
+  }
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) std::signal(sig, cleanup_on_signal);
+}
+
+void disarm_cleanup() {
+  g_ncleanup = 0;
+  g_dir_created = 0;
+}
+}  // namespace
+
 const std::vector<std::string>& OutputDir::output_names() {
   static const std::vector<std::string> n = {"summary.json", "final_profile.csv", "centre.csv", "profiles.h5",
                                              "conduction_table.csv"};
@@ -275,6 +316,7 @@ OutputDir::OutputDir(const std::string& dir, bool overwrite) : dir_(dir) {
       throw UsageError("--out: cannot lock '" + lock.string() + "': " + why);
     }
   }
+  arm_cleanup(d, created_, output_names());
   if (overwrite)
     for (const auto& e : fs::directory_iterator(d, ec)) {
       const std::string name = e.path().filename().string();
@@ -283,6 +325,7 @@ OutputDir::OutputDir(const std::string& dir, bool overwrite) : dir_(dir) {
 }
 
 OutputDir::~OutputDir() {
+  disarm_cleanup();
   std::error_code ec;
   for (const auto& s : staged_) fs::remove(s, ec);
   const fs::path d(dir_);
@@ -352,6 +395,9 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["status"] = r.status;
   j["message"] = r.message;
   j["notes"] = r.notes;
+  j["causes"] = r.causes;
+  j["warnings"] = r.warnings;
+  j["T_peak_over_T_critical"] = num(r.T_over_Tc);
   j["t_melt_center_s"] = r.t_melt_center >= 0 ? num(r.t_melt_center) : ordered_json(nullptr);
   j["depth_center_m"] = num(r.depth_center);
   j["volume_removed_m3"] = num(r.volume_removed);
@@ -375,6 +421,13 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["volume_vaporized_m3"] = num(r.volume_vaporized);
   j["volume_removed_by_flow_m3"] = num(r.volume_flow);
   j["volume_melted_m3"] = num(r.volume_melted);
+  j["melt_balance"] = {{"melted_m3", num(r.volume_melted)},
+                       {"vaporized_m3", num(r.volume_vaporized)},
+                       {"expelled_over_rim_m3", num(r.volume_expelled)},
+                       {"still_molten_m3", num(r.volume_molten)},
+                       {"vaporization_cut_m3", num(r.vaporization_cut)},
+                       {"relative_residual", num(r.melt_balance)},
+                       {"flow_substeps_max", r.flow_substeps_max}};
   j["u_peak_max_m_per_s"] = num(r.u_peak_max);
   j["A_last"] = num(r.A_last);
   j["xi_melt_edge"] = num(r.xi_melt_edge);
@@ -385,7 +438,11 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["dt_s"] = num(r.dt);
   j["dtau"] = num(r.dtau);
   j["tau_p"] = num(r.tau_p);
-  j["max_stable_dt_s"] = num(r.max_stable_dt);
+  // the a-priori limit the automatic step takes a quarter of (null for the
+  // implicit update), and 2/lambda at its largest along the run (thin layers
+  // right after onset; the run-time check fires only when g also oscillates)
+  j["max_stable_dt_s"] = r.step.stable_limit > 0 ? num(r.step.stable_limit) : nlohmann::ordered_json(nullptr);
+  j["min_2_over_lambda_seen_s"] = num(r.max_stable_dt);
   j["melt_thickness_clamps"] = r.melt_clamps;
   j["melt_rate_clamps"] = r.melt_rate_clamps;
   j["curvature_clamps"] = r.curvature_clamps;
@@ -395,6 +452,9 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
                {"model", to_string(cfg.model)},     {"m", num(cfg.m)},             {"xi_p", num(cfg.xi_p)},
                {"Pr", num(cfg.mat.Pr)},             {"solid", to_string(cfg.solid)},
                {"melt_energy", to_string(cfg.melt_energy)},
+               {"melt_flow", to_string(cfg.melt_flow)},
+               {"recoil_fraction_of_p_sat", num(cfg.recoil)},
+               {"absorptivity", num(cfg.absorptivity)},
                {"melt_update", cfg.implicit_melt ? "implicit" : "explicit"},
                {"dxi", num(cfg.dxi)},               {"material", cfg.material}};
   const Groups& G = r.groups;
@@ -420,6 +480,7 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["energy_check"] = {{"H_J_per_kg", num(pc.H)},
                        {"T_s_center_K", num(pc.Ts)},
                        {"removed_rhoH_over_beam", num(pc.removed_over_beam)},
+                       {"melted_and_vaporized_over_beam", num(pc.melt_vap_over_beam)},
                        {"worst_node_demand_over_absorbed", num(pc.worst_node_ratio)},
                        {"worst_node_xi", num(pc.worst_node_xi)},
                        {"centre_velocity_over_bound", num(pc.centre_velocity_ratio)},

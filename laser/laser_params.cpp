@@ -40,6 +40,7 @@ const char* to_string(SolidModel m) {
   return "?";
 }
 const char* to_string(MeltEnergy m) { return m == MeltEnergy::Advected ? "advected" : "text"; }
+const char* to_string(MeltFlow m) { return m == MeltFlow::Conservative ? "conservative" : "text"; }
 
 std::vector<std::string> material_presets() { return {"superalloy"}; }
 
@@ -265,6 +266,15 @@ const std::vector<Param>& params() {
     // [laser]
     t.push_back(real("intensity", "laser", "W/m2", 1e6, 1e13, false,
                      "laser intensity at the beam centre, I0 in (3-21)", &Config::I0));
+    t.push_back(real("absorptivity", "laser", "-", 0, 1, true,
+                     "absorbed fraction of the beam (the text absorbs all: 1); the model runs with absorptivity x I0",
+                     &Config::absorptivity));
+    t.push_back(choice(
+        "recoil", "model", {"full", "knight"},
+        "recoil pressure driving the melt flow: full = p_sat(T_s) as in the text, knight = 0.54 p_sat "
+        "(Anisimov/Knight, evaporation through a Knudsen layer)",
+        [](Config& c, const std::string& v) { c.recoil = v == "knight" ? 0.54 : 1.0; },
+        [](const Config& c) { return std::string(c.recoil == 1.0 ? "full" : "knight"); }));
     t.push_back(real("pulse", "laser", "s", 1e-9, 1e-2, false, "pulse length t_p", &Config::tp));
     t.push_back(real("radius", "laser", "m", 1e-6, 1e-2, false, "beam radius R in (3-21)", &Config::R));
     // [model]
@@ -293,6 +303,12 @@ const std::vector<Param>& params() {
         "pays c_pl (T_s - T_m)), text = the dissertation's linear conduction layer",
         [](Config& c, const std::string& v) { c.melt_energy = v == "text" ? MeltEnergy::Text : MeltEnergy::Advected; },
         [](const Config& c) { return std::string(to_string(c.melt_energy)); }));
+    t.push_back(choice(
+        "melt-flow", "model", {"conservative", "text"},
+        "surface-normal melt velocity in (4-13): conservative = divergence of the layer's volume flux "
+        "(melt is conserved; includes -u(g) dg/dxi), text = v(xi, g) of (4-22) as printed",
+        [](Config& c, const std::string& v) { c.melt_flow = v == "text" ? MeltFlow::Text : MeltFlow::Conservative; },
+        [](const Config& c) { return std::string(to_string(c.melt_flow)); }));
     t.push_back(real("shift", "model", "tau_m", 0, 10, true,
                      "backward shift of the Stefan solution for --solid shifted (3-36: 3 tau_0 = 3/(4 pi))",
                      &Config::shift));
@@ -351,6 +367,9 @@ const std::vector<Param>& params() {
     t.push_back(matreal("k-solid", "W/(m K)", 1e-2, 1e4, "thermal conductivity of the solid k_s", &Material::ks));
     t.push_back(matreal("cp-liquid", "J/(kg K)", 1, 1e5, "specific heat of the melt c_pl", &Material::cpl));
     t.push_back(matreal("cp-solid", "J/(kg K)", 1, 1e5, "specific heat of the solid c_ps", &Material::cps));
+    t.push_back(matreal("T-critical", "K", 0, 1e5,
+                        "critical temperature T_c: a warning above 0.8 T_c, status diverged above T_c",
+                        &Material::Tc));
     t.push_back(matreal("pr", "-", 1e-6, 1e7, "Prandtl number of the melt nu/alpha_l", &Material::Pr));
     return t;
   }();
@@ -529,6 +548,8 @@ void validate(Config& c) {
   const Material& m = c.mat;
   if (!(m.Tm > m.Ti))
     throw UsageError("--T-initial: must be below --T-melt (" + fmt(m.Tm) + " K), got " + fmt(m.Ti) + " K");
+  if (!(m.Tc > m.Tsat0))
+    throw UsageError("--T-critical: must be above --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tc) + " K");
   if (!(m.Tsat0 > m.Tm))
     throw UsageError("--T-melt: must be below --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tm) + " K");
   if (c.dtau > 0.0) c.dt = c.dtau * c.R * c.R / (m.kl / (m.rho * m.cpl));

@@ -23,21 +23,33 @@ enum class SolidModel { Exact, Shifted, Stefan };
 // the vaporizing surface (exponential profile; the vaporized mass carries
 // c_pl (T_s - T_m)); Text = the linear conduction layer of the dissertation.
 enum class MeltEnergy { Advected, Text };
+// Surface-normal velocity of the melt flow in (4-13): Conservative = the
+// divergence of the layer's volume flux (includes -u(g) dg/dxi, the melt is
+// conserved), Text = v(xi, g) of (4-22)/(4-13) as printed.
+enum class MeltFlow { Conservative, Text };
 
 const char* to_string(FlowModel m);
 const char* to_string(SolidModel m);
 const char* to_string(MeltEnergy m);
+const char* to_string(MeltFlow m);
 
 struct Config {
   Material mat;
   double I0 = 7.5e10;     // W/m2
   double tp = 700e-6;     // s
   double R = 0.254e-3;    // m
+  double absorbed_I0() const { return I0 * absorptivity; }  // W/m2 the surface takes
   FlowModel model = FlowModel::RisingFall;
   double m = 2.0;
   double xi_p = 1.0;
   SolidModel solid = SolidModel::Exact;
   MeltEnergy melt_energy = MeltEnergy::Advected;
+  MeltFlow melt_flow = MeltFlow::Conservative;
+  // Recoil pressure that drives the melt flow, as a fraction of p_sat(T_s): 1 =
+  // the text (full saturation pressure), 0.54 = Anisimov (1968) / Knight (1979)
+  // for strong evaporation with a Knudsen layer.
+  double recoil = 1.0;
+  double absorptivity = 1.0;  // absorbed fraction of the beam (the text: 1)
   double shift = 3.0 / (4.0 * kPi);  // (3-36): shift of the Stefan solution in tau_m
   bool curvature = true;
   bool moving_origin = true;

@@ -22,7 +22,7 @@ constexpr double kStableFraction = 0.25;
 
 TimeStepPolicy::TimeStepPolicy(const Config& cfg) {
   dt_stable_ = cfg.implicit_melt ? 0.0 : explicit_step_limit(cfg);
-  const Groups G = make_groups(cfg.mat, cfg.I0, cfg.R);
+  const Groups G = make_groups(cfg.mat, cfg.absorbed_I0(), cfg.R);
   const double t_melt = melt_onset_tau(G, 0.0) * G.t_scale;
   if (cfg.dt > 0.0) {
     dt_ = cfg.dt;
@@ -39,6 +39,7 @@ TimeStepPolicy::TimeStepPolicy(const Config& cfg) {
       throw UsageError(reason_ + ": " + fmt(cfg.tp / dt_, 4) + " steps of " + fmt(dt_, 4) + " s over the pulse " +
                        fmt(cfg.tp, 4) + " s; at most " + fmt(kMaxSteps / 3, 4) + " allowed (valid range [" +
                        fmt(3 * cfg.tp / kMaxSteps, 4) + ", " + fmt(cfg.tp, 4) + ") s)");
+    check_work(cfg);
     return;
   }
   automatic_ = true;
@@ -52,6 +53,28 @@ TimeStepPolicy::TimeStepPolicy(const Config& cfg) {
     dt_ = kStableFraction * dt_stable_;
     reason_ = "explicit limit (4-14) x " + fmt(kStableFraction, 4);
   }
+  check_work(cfg);
+}
+
+// Refuses a case whose reported run alone would exceed the step or node-step
+// budget (grid size estimated as in the model's setup).
+void TimeStepPolicy::check_work(const Config& cfg) const {
+  const Groups G = make_groups(cfg.mat, cfg.absorbed_I0(), cfg.R);
+  const double tau_p = cfg.tp / G.t_scale, tau_m0 = melt_onset_tau(G, 0.0);
+  double nodes;
+  if (cfg.xi_max > 0.0) nodes = std::round(cfg.xi_max / cfg.dxi) + 1;
+  else nodes = (tau_p > tau_m0 ? std::floor(std::sqrt(0.5 * std::log(tau_p / tau_m0)) / cfg.dxi) : 0.0) + 3;
+  nodes = std::max(nodes, 3.0);
+  const double steps = std::ceil(cfg.tp / dt_), work = steps * nodes;
+  if (steps <= kMaxSteps / 3 && work <= kMaxNodeSteps) return;
+  const double tp_max = std::min(kMaxSteps / 3, kMaxNodeSteps / nodes) * dt_;
+  throw UsageError("the case cannot finish in this program's budget: --intensity " + fmt(cfg.I0, 4) +
+                   " W/m2, --pulse " + fmt(cfg.tp, 4) + " s, --radius " + fmt(cfg.R, 4) + " m, --dxi " +
+                   fmt(cfg.dxi, 4) + " need about " + fmt(steps, 3) + " steps of " + fmt(dt_, 4) + " s (" +
+                   reason_ + ") on " + fmt(nodes, 4) + " nodes = " + fmt(work, 3) +
+                   " node steps; at most " + fmt(kMaxSteps / 3, 3) + " steps and " + fmt(kMaxNodeSteps, 3) +
+                   " node steps are accepted: shorten --pulse to at most " + fmt(tp_max, 3) +
+                   " s, coarsen --dxi or lower --intensity");
 }
 
 Result TimeStepPolicy::run_at(Config cfg, double dt, const SinkFactory& make_sink, bool reported,
@@ -124,6 +147,7 @@ Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) cons
   s.volume_error = ev;
   s.runs = runs;
   s.steps_total = steps;
+  s.stable_limit = dt_stable_;
   s.reason = reason_ + (dt < dt_ ? ", refined to meet --tol" : "");
   if (std::max(ed, ev) > cfg.tol && (fine.status == "ok" || fine.status == "inaccurate")) {
     const std::string m = "estimated error of the time step: depth " + fmt(ed, 4) + ", volume " + fmt(ev, 4) +

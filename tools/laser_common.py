@@ -1,7 +1,9 @@
 """Helpers shared by the laser_*.py tools: locate and run laser_drill."""
+import glob
 import json
 import os
 import resource
+import shutil
 import subprocess
 import sys
 
@@ -9,11 +11,17 @@ TOP = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def find_exe(exe=None):
-    candidates = [exe] if exe else [os.path.join(TOP, d, "laser_drill") for d in ("build", "build-laser")]
+    """--exe if given; else build*/laser_drill of this repository (newest first), then PATH."""
+    if exe:
+        candidates = [exe]
+    else:
+        builds = sorted(glob.glob(os.path.join(TOP, "build*", "laser_drill")), key=os.path.getmtime, reverse=True)
+        candidates = builds + [shutil.which("laser_drill")]
     for c in candidates:
         if c and os.path.isfile(c) and os.access(c, os.X_OK):
             return c
-    sys.exit("laser_drill not found (tried %s); build it or pass --exe" % ", ".join(c for c in candidates if c))
+    sys.exit("laser_drill not found (tried %s); build it or pass --exe"
+             % (", ".join(c for c in candidates if c) or os.path.join(TOP, "build*", "laser_drill") + ", PATH"))
 
 
 def run_case(exe, out, args, quiet=True):
@@ -27,7 +35,8 @@ def run_case(exe, out, args, quiet=True):
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     summary = None
     path = os.path.join(out, "summary.json")
-    if p.returncode == 0 and os.path.exists(path):
+    # exit 0 (finished) and 3 (diverged) both write summary.json
+    if p.returncode in (0, 3) and os.path.exists(path):
         with open(path) as f:
             summary = json.load(f)
         summary["cpu_time_s"] = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)

@@ -96,7 +96,14 @@ TEST(LaserCases, L3EnergyBalanceOverThePulse) {
     c.melt_energy = energy;
     auto_step(c);
     const Result r = run_simulation(c);
-    ASSERT_EQ(r.status, "ok");
+    // the text's layer pays no sensible heat for the vaporized liquid and fails
+    // the physical energy bound (section 2.9), which its status names
+    if (energy == MeltEnergy::Text) {
+      ASSERT_EQ(r.status, "inaccurate") << r.message;
+      EXPECT_EQ(r.causes.front(), "energy bound of the whole melt") << r.message;
+    } else {
+      ASSERT_EQ(r.status, "ok") << r.message;
+    }
     const Energy& e = r.energy;
     const double imbalance = (e.sum() - e.laser_exact) / e.laser_exact;
     std::printf("[ L3 ] %-10s %-7s %-8s laser %.4f J: solid %.4f + preheat %.4f + melt %.4f + melt sensible %.4f + "
@@ -319,7 +326,8 @@ TEST(LaserCases, EnergyBoundFromInputsAlone) {
       c.melt_energy = energy;
       auto_step(c);
       const Result r = run_simulation(c);
-      ASSERT_EQ(r.status, "ok");
+      if (energy == MeltEnergy::Advected) ASSERT_EQ(r.status, "ok") << r.message;
+      else ASSERT_EQ(r.status, "inaccurate") << "the text's layer fails the bound and must say so";
       const Material& m = c.mat;
       const double Ts = r.T_center;
       const double H = m.cps * (m.Tm - m.Ti) + m.hls + m.cpl * (Ts - m.Tm) + m.hlv;

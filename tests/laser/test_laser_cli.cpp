@@ -145,7 +145,15 @@ INSTANTIATE_TEST_SUITE_P(
                 {"--dt", "shorter than the pulse"}},
         BadCase{"repeated_option", "--intensity 5e10 --intensity 6e10", "", {"--intensity"}},
         BadCase{"unknown_option", "--no-such-option 3", "", {"--no-such-option"}},
-        BadCase{"stray_argument", "stray", "", {"stray"}}),
+        BadCase{"stray_argument", "stray", "", {"stray"}},
+        BadCase{"melt_flow_unknown", "--melt-flow upwind", "", {"--melt-flow", "conservative, text", "upwind"}},
+        BadCase{"T_critical_below_sat", "--T-critical 3000", "", {"--T-critical", "--T-sat0", "3000 K"}},
+        BadCase{"absorptivity_above_one", "--absorptivity 1.2", "", {"--absorptivity", "(0, 1]", "1.2"}},
+        BadCase{"absorptivity_zero", "--absorptivity 0", "", {"--absorptivity", "(0, 1]"}},
+        BadCase{"recoil_unknown", "--recoil half", "", {"--recoil", "full, knight", "half"}},
+        BadCase{"cannot_finish_1e13", "--intensity 1e13", "", {"--intensity 1e+13 W/m2", "--pulse", "node steps"}},
+        BadCase{"cannot_finish_fine_grid", "--intensity 5e12 --dxi 0.001", "", {"--dxi", "cannot finish", "node steps"}},
+        BadCase{"T_critical_negative", "--T-critical -5", "", {"--T-critical", "K", "-5"}}),
     [](const ::testing::TestParamInfo<BadCase>& info) { return info.param.what; });
 
 TEST(LaserCli, VersionAndHelp) {

@@ -1,0 +1,283 @@
+// Melt flow and run status: the flux-conservative surface velocity conserves
+// the melt (melted = vaporized + expelled over the rim + still molten), the
+// text's form (4-22) stays available and reproduces the printed model, and
+// the status names the physics check that failed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <chrono>
+#include <thread>
+
+#include "laser_model.h"
+#include "laser_timestep.h"
+
+#ifndef LASER_DRILL_EXE
+#error "LASER_DRILL_EXE must name the laser_drill executable"
+#endif
+
+using namespace laser;
+namespace fs = std::filesystem;
+
+namespace {
+// Table 5.1 case over 50 us at a fixed step with the implicit melt update.
+Config short_case(double Pr, MeltFlow flow) {
+  Config c;
+  c.quiet = true;
+  c.tp = 50e-6;
+  c.dt = 2.5e-7;
+  c.implicit_melt = true;
+  c.mat.Pr = Pr;
+  c.melt_flow = flow;
+  validate(c);
+  return c;
+}
+
+struct Volumes {
+  double melted = 0, vaporized = 0, molten = 0;
+};
+// The volumes from the final profiles alone: node areas of the grid, pi (d/2)^2
+// at the axis and 2 pi xi d otherwise (in R^2).
+Volumes volumes(const Config& c, const Result& r) {
+  Volumes v;
+  const Frame& f = r.final_frame;
+  for (size_t i = 0; i < r.xi.size(); ++i) {
+    const double xi = r.xi[i];
+    const double a = (i == 0 ? kPi * 0.25 * c.dxi * c.dxi : 2.0 * kPi * xi * c.dxi) * c.R * c.R;
+    v.melted += f.S2[i] * a;
+    v.vaporized += f.S1[i] * a;
+    v.molten += f.g[i] * a;
+  }
+  return v;
+}
+
+bool has_cause(const Result& r, const std::string& name) {
+  for (const auto& c : r.causes)
+    if (c == name) return true;
+  return false;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+}  // namespace
+
+// Conservative form: the balance closes to round-off at Pr = 0.142, 142 and 1420
+// (measured 1e-16 .. 4e-16), and at high Pr the flow does expel melt over the rim.
+TEST(LaserMelt, VolumeBalanceClosesWithConservativeFlow) {
+  for (double Pr : {0.142, 142.0, 1420.0}) {
+    const Config c = short_case(Pr, MeltFlow::Conservative);
+    const Result r = run_simulation(c);
+    ASSERT_TRUE(r.status == "ok" || r.status == "inaccurate") << r.status << ": " << r.message;
+    const Volumes v = volumes(c, r);
+    const double residual = (v.melted - v.vaporized - r.volume_expelled - v.molten) / v.melted;
+    std::printf("[ MELT ] Pr = %g conservative: melted %.6e, vaporized %.6e, expelled %.6e, molten %.6e m3, "
+                "residual %.2e (summary %.2e), status %s\n", Pr, v.melted, v.vaporized, r.volume_expelled,
+                v.molten, residual, r.melt_balance, r.status.c_str());
+    EXPECT_LT(std::fabs(residual), 1e-6) << Pr;
+    EXPECT_NEAR(residual, r.melt_balance, 1e-9) << Pr;
+    EXPECT_LE(r.vaporization_cut, 1e-6 * v.melted) << Pr;
+    if (Pr >= 142.0) EXPECT_GT(r.volume_expelled, 1e-5 * v.melted) << "no melt expelled at Pr " << Pr;
+  }
+}
+
+// The text's surface velocity (4-22) as printed (--melt-flow text) reproduces
+// the model of the version before the conservative form to the last digits,
+// and its melt balance does not close at Pr = 142 (melt disappears), which the
+// status names.
+TEST(LaserMelt, TextFlowReproducesPrintedFormAndIsFlagged) {
+  const Config c = short_case(142.0, MeltFlow::Text);
+  const Result r = run_simulation(c);
+  // laser_drill --pr 142 --pulse 50e-6 --dt 2.5e-7 --melt-update implicit, before --melt-flow existed
+  EXPECT_NEAR(r.depth_center / 4.922925055021487e-05, 1.0, 1e-12);
+  EXPECT_NEAR(r.volume_removed / 8.747259614962258e-12, 1.0, 1e-12);
+  EXPECT_NEAR(r.volume_flow / 9.88411139832998e-13, 1.0, 1e-12);
+  const Volumes v = volumes(c, r);
+  const double residual = (v.melted - v.vaporized - r.volume_expelled - v.molten) / v.melted;
+  std::printf("[ MELT ] Pr = 142 text: residual %.3e of the melted volume, status %s: %s\n", residual,
+              r.status.c_str(), r.message.c_str());
+  EXPECT_GT(std::fabs(residual), 1e-2);
+  EXPECT_EQ(r.status, "inaccurate");
+  EXPECT_TRUE(has_cause(r, "melt volume balance"));
+  EXPECT_EQ(r.message.rfind("melt volume balance", 0), 0u) << "the first named cause leads the message";
+  // Table 5.1 (Pr = 0.142) at the automatic step: the values of the version before
+  Config t;
+  t.quiet = true;
+  t.melt_flow = MeltFlow::Text;
+  validate(t);
+  t.dt = TimeStepPolicy(t).dt();
+  const Result rt = run_simulation(t);
+  EXPECT_EQ(rt.status, "ok") << rt.message;
+  EXPECT_NEAR(rt.depth_center / 6.583351290659386e-04, 1.0, 1e-12);
+  EXPECT_NEAR(rt.volume_removed / 1.27518717477387e-10, 1.0, 1e-12);
+}
+
+// A safeguard that fires on many node steps makes the run inaccurate, with
+// its name and count (Pr = 1420: the b2 limiter of (4-25)).
+TEST(LaserStatus, SafeguardCountsAreNamed) {
+  const Result r = run_simulation(short_case(1420.0, MeltFlow::Conservative));
+  std::printf("[ STATUS ] Pr = 1420: %s: %s\n", r.status.c_str(), r.message.c_str());
+  EXPECT_EQ(r.status, "inaccurate");
+  EXPECT_TRUE(has_cause(r, "b2 limiter"));
+  EXPECT_GT(r.b2_clamps, 1e-4 * r.steps * r.nodes);
+  EXPECT_NE(r.message.find(std::to_string(r.b2_clamps)), std::string::npos);
+  EXPECT_EQ(r.message.find("energy bookkeeping"), std::string::npos) << "a harmless imbalance is not a cause";
+}
+
+// The surface temperature against the critical temperature: a warning above
+// 0.8 T_c, diverged above T_c (1e13 W/m2 reaches about 8200 K).
+TEST(LaserStatus, CriticalTemperature) {
+  Config c;
+  c.quiet = true;
+  c.I0 = 1e13;
+  c.tp = 1e-6;
+  validate(c);
+  c.dt = TimeStepPolicy(c).dt();
+  const Result r = run_simulation(c);
+  std::printf("[ STATUS ] 1e13 W/m2: T_peak %.0f K, T/T_c %.3f, %s, warnings %zu\n", r.T_peak, r.T_over_Tc,
+              r.status.c_str(), r.warnings.size());
+  ASSERT_GT(r.T_peak, 0.8 * c.mat.Tc);
+  EXPECT_NEAR(r.T_over_Tc, r.T_peak / c.mat.Tc, 1e-12);
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("critical temperature"), std::string::npos);
+  Config low = c;
+  low.mat.Tc = 0.5 * (r.T_peak + c.mat.Tsat0);  // below the surface temperature reached
+  const Result d = run_simulation(low);
+  EXPECT_EQ(d.status, "diverged");
+  EXPECT_TRUE(has_cause(d, "surface temperature above the critical temperature"));
+  const Result t51 = run_simulation([] { Config k; k.quiet = true; validate(k); k.dt = 1.5e-6; k.tp = 50e-6; return k; }());
+  EXPECT_TRUE(t51.warnings.empty()) << "Table 5.1 stays far below T_c";
+}
+
+// A non-finite or absurd state is diverged, exits non-zero and prints no error
+// estimate: --hlv 1e9 drives the surface temperature to 1.6e5 K with p = inf.
+TEST(LaserStatus, AbsurdStateIsDivergedWithNonZeroExit) {
+  const fs::path dir = fs::temp_directory_path() / ("laser_status_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string cmd = std::string(LASER_DRILL_EXE) + " --hlv 1e9 --pulse 50e-6 --quiet --out " +
+                          (dir / "out").string() + " >" + (dir / "o.txt").string() + " 2>" + (dir / "e.txt").string();
+  const int st = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(st));
+  EXPECT_EQ(WEXITSTATUS(st), 3);
+  const std::string j = slurp(dir / "out" / "summary.json"), o = slurp(dir / "o.txt"), e = slurp(dir / "e.txt");
+  EXPECT_NE(j.find("\"status\": \"diverged\""), std::string::npos) << j.substr(0, 400);
+  EXPECT_NE(j.find("non-finite surface state"), std::string::npos);
+  EXPECT_EQ(o.find("error 0.0"), std::string::npos) << o;
+  EXPECT_NE(o.find("no error estimate"), std::string::npos) << o;
+  EXPECT_NE(e.find("diverged"), std::string::npos) << e;
+  // the CSV holds the last admissible state, not the absurd one
+  const std::string csv = slurp(dir / "out" / "final_profile.csv");
+  EXPECT_EQ(csv.find("inf"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+// --absorptivity a runs the model with a I0: identical to the run at the
+// absorbed intensity (same step), and the summary keeps the beam's I0.
+TEST(LaserOptions, AbsorptivityScalesTheIntensity) {
+  Config a;
+  a.quiet = true;
+  a.tp = 100e-6;
+  a.I0 = 1e11;
+  a.absorptivity = 0.75;
+  validate(a);
+  a.dt = TimeStepPolicy(a).dt();
+  Config b = a;
+  b.I0 = 7.5e10;
+  b.absorptivity = 1.0;
+  EXPECT_EQ(TimeStepPolicy(b).dt(), a.dt);
+  const Result ra = run_simulation(a), rb = run_simulation(b);
+  ASSERT_EQ(ra.status, "ok") << ra.message;
+  EXPECT_EQ(ra.depth_center, rb.depth_center);
+  EXPECT_EQ(ra.volume_removed, rb.volume_removed);
+  EXPECT_NEAR(ra.energy.laser_exact / rb.energy.laser_exact, 1.0, 1e-15);
+}
+
+// --recoil knight drives the flow with 0.54 p_sat: no effect without a flow;
+// with the flow the least-squares coefficient A changes. Measured: at
+// Pr = 1420 A drops from 3.42e5 to 3.12e5, at Pr = 142 it stays 8034 (the
+// root the rule of (4-19) selects there is nearly independent of the pressure,
+// docs/laser_model.md 2.6), so the test holds the Pr = 1420 case.
+TEST(LaserOptions, RecoilKnightEntersTheFlowOnly) {
+  Config c = short_case(1420.0, MeltFlow::Conservative);
+  c.model = FlowModel::Conduction;
+  Config k = c;
+  k.recoil = 0.54;
+  EXPECT_EQ(run_simulation(c).volume_removed, run_simulation(k).volume_removed);
+  c.model = k.model = FlowModel::RisingFall;
+  const Result rf = run_simulation(c), rk = run_simulation(k);
+  std::printf("[ RECOIL ] Pr = 1420, 50 us: A full %.6g, knight %.6g; expelled %.4e / %.4e m3\n", rf.A_last,
+              rk.A_last, rf.volume_expelled, rk.volume_expelled);
+  EXPECT_LT(rk.A_last, 0.95 * rf.A_last);
+  EXPECT_GT(rk.A_last, 0.0);
+}
+
+// summary.json max_stable_dt_s is the limit whose quarter the automatic step
+// takes (as the docs say); the implicit update has none (null).
+TEST(LaserStatus, MaxStableStepAgreesWithTheAutomaticStep) {
+  const fs::path dir = fs::temp_directory_path() / ("laser_stable_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const std::string upd : {"explicit", "implicit"}) {
+    const fs::path out = dir / upd;
+    // Table 5.1 (700 us): the automatic step is set by the stability limit
+    const std::string cmd = std::string(LASER_DRILL_EXE) + (upd == "explicit" ? "" : " --pulse 100e-6") +
+                            " --melt-update " + upd +
+                            " --quiet --out " + out.string() + " >/dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const std::string j = slurp(out / "summary.json");
+    const auto num_after = [&](const std::string& key) {
+      const size_t k = j.find("\"" + key + "\": ");
+      EXPECT_NE(k, std::string::npos) << key;
+      return j.substr(k + key.size() + 4, 24);
+    };
+    if (upd == "explicit") {
+      const double lim = std::stod(num_after("max_stable_dt_s")), dt = std::stod(num_after("dt_s"));
+      EXPECT_NEAR(dt, 0.25 * lim, 1e-12 * lim) << j.substr(0, 300);
+    } else {
+      EXPECT_EQ(num_after("max_stable_dt_s").rfind("null", 0), 0u);
+    }
+  }
+  fs::remove_all(dir);
+}
+
+// Killed while running (SIGTERM, SIGINT), laser_drill leaves no .part file and
+// no lock behind, and removes the folder it created.
+TEST(LaserOutput, KilledRunLeavesNothingBehind) {
+  for (int sig : {SIGTERM, SIGINT}) {
+    const fs::path dir = fs::temp_directory_path() / ("laser_kill_" + std::to_string(::getpid()) + "_" +
+                                                      std::to_string(sig));
+    fs::remove_all(dir);
+    const std::string out = dir.string();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      ::execl(LASER_DRILL_EXE, LASER_DRILL_EXE, "--pr", "142", "--dt", "1e-7", "--melt-update", "implicit", "--quiet",
+              "--out", out.c_str(), static_cast<char*>(nullptr));
+      std::_Exit(127);
+    }
+    ASSERT_GT(pid, 0);
+    bool staged = false;
+    for (int k = 0; k < 200 && !staged; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      staged = fs::exists(dir / "profiles.h5.part");
+    }
+    EXPECT_TRUE(staged) << "the run did not start writing";
+    ::kill(pid, sig);
+    int st = 0;
+    ::waitpid(pid, &st, 0);
+    EXPECT_TRUE(WIFSIGNALED(st) && WTERMSIG(st) == sig);
+    EXPECT_FALSE(fs::exists(dir)) << "left behind in " << out;
+    fs::remove_all(dir);
+  }
+}
