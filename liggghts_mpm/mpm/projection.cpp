@@ -46,10 +46,9 @@ namespace {
 // leaves the column moving (0.07 m/s after 1 s) and the MPM16 dam-break front 0.39 a off; 0.25:
 // at rest to 1e-12 m/s, front 0.037 a (apic).
 constexpr double kSurfaceFill = 0.25;
-// Ghost surface: a node is FLUID when its level (fill - 1/2) exceeds this. A fluid filled up to a
-// node plane gives its nodes a fill of exactly 1/2 up to round-off; with 0 as the bound they
-// flipped between EMPTY and FLUID from step to step (F1 at rest: 2.6e-4 m/s after 1 s).
-constexpr double kLevelTie = 1e-9;
+// Ghost surface: a node is FLUID when level_is_fluid(fill - 1/2) (projection_ops.h, kLevelTie). A
+// fluid filled up to a node plane gives its nodes a fill of exactly 1/2 up to round-off; with 0 as
+// the bound they flipped between EMPTY and FLUID from step to step (F1 at rest: 2.6e-4 m/s after 1 s).
 }  // namespace
 
 /* FLUID where the node holds fluid (mass above the threshold and kSurfaceFill of a full cell),
@@ -80,7 +79,7 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
       // level set: the fill of a node whose dual cell the surface halves is 1/2 (a symmetric
       // kernel), so fill - 1/2 changes sign at the surface; FLUID where it is positive
       lab_.level[n] = fill - 0.5;
-      if (m <= mmin || m <= 0.0 || !(lab_.level[n] > kLevelTie)) lab_.kind[n] = kEmpty;
+      if (m <= mmin || m <= 0.0 || !level_is_fluid(lab_.level[n])) lab_.kind[n] = kEmpty;
     } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
       lab_.kind[n] = kEmpty;
     }

@@ -87,6 +87,19 @@ struct ProjectionGeometry {
 // coefficient 1 / s_f: at most 20x the face's own).
 constexpr double kMinSurfaceFraction = 1e-3;
 
+// Ghost surface: a node is FLUID when its level exceeds this bound. The level of every node is at
+// least -1/2 (fill >= 0), so a FLUID node's fraction s_f = level_n / (level_n - level_m) is then
+// at least kMinSurfaceFraction on each face and the clamp never binds. With a smaller bound (1e-9
+// measured) a node a hair inside the surface (a fluid filled up to a node plane: level 0 up to
+// round-off, some 1e-7 where grains displace it) was FLUID with its surface face clamped, and
+// the fraction of its face to an EMPTY neighbour as near the surface, l_n / (l_n - l_m) with both
+// levels near 0, made the pressure oversensitive to the levels: a level moved by delta changed
+// the pressure by 11 rho g dx delta instead of 0.45 (PressureSolver.GhostSurfaceOnANodePlane-
+// IsWellConditioned), and np 2 drifted from np 1 (docs/projection.md). The bound also keeps a
+// fluid filled up to a node plane from flipping its nodes between EMPTY and FLUID.
+constexpr double kLevelTie = 0.5 * kMinSurfaceFraction / (1.0 - kMinSurfaceFraction);
+inline bool level_is_fluid(double level) { return level > kLevelTie; }
+
 // 1 / s_f for a face between a FLUID and an EMPTY node when labels.level is set, 1 otherwise.
 inline double surface_scale(const NodeLabels &labels, std::size_t n, std::size_t m) {
   if (labels.level.empty() || labels.kind[n] == labels.kind[m]) return 1.0;
