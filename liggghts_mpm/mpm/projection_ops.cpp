@@ -202,9 +202,11 @@ void corrected_flux_divergence(const LocalGrid &grid, const NodeLabels &labels,
   });
 }
 
-void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad) {
+void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad,
+                       const double *theta) {
   const double inv_dx = 1.0 / grid.spec().dx;
-  // Face areas do not enter a nodal gradient: any geometry will do.
+  // Face areas do not enter a nodal gradient (the two faces of a node along d have the same
+  // area): any geometry will do.
   ProjectionGeometry geo;
   geo.spec = grid.spec();
   geo.half_cells = false;
@@ -212,22 +214,31 @@ void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const do
     for (int d = 0; d < 3; ++d) grad[3 * n + d] = 0.0;
   });
   // for_faces visits the faces of a node in the order (x,-), (x,+), (y,-), ...
-  double sum = 0.0;
-  int open = 0;
+  double num = 0.0, den = 0.0;
   for_faces_if(grid, labels, geo,
                [&](int i, int j, int k, std::size_t n) { return !empty_away_from_fluid(grid, labels, i, j, k, n); },
                [&](std::size_t n, const Face &f, int d, int side) {
-    if (side < 0) {
-      sum = 0.0;
-      open = 0;
+    if (side < 0) num = den = 0.0;
+    if (!f.wall) {
+      const std::uint8_t a = labels.kind[n], b = labels.kind[f.m];
+      const double s = 1.0 / surface_scale(labels, n, f.m);  // s_f (1 off the surface)
+      const double G = side * (p[f.m] - p[n]) * inv_dx;       // face gradient along +d, p = 0 at EMPTY
+      if (a == kFluid) {
+        // the adjoint of flux_divergence: weight theta_f w_n, w_n = 1/2 between two FLUID nodes
+        // and 1 towards an EMPTY one (whose face carries u_n); the denominator sum theta_f w_n s_f
+        // is the node's share of the faces' fluid lengths (hydrostatic exact)
+        const double th = theta ? 0.5 * (theta[n] + theta[f.m]) : 1.0;
+        const double w = th * (b == kFluid ? 0.5 : 1.0);
+        num += w * G;
+        den += w * s;
+      } else if (b == kFluid) {
+        // an EMPTY node: the gradient of its faces to FLUID nodes, continued from the fluid side
+        // (a face between two EMPTY nodes carries no pressure information)
+        num += G / s;
+        den += 1.0;
+      }
     }
-    // at an EMPTY node only the faces to FLUID nodes: the gradient extrapolated from the fluid
-    // side (a face between two EMPTY nodes carries no pressure information)
-    if (!f.wall && !(labels.kind[n] == kEmpty && labels.kind[f.m] == kEmpty)) {
-      sum += side * surface_scale(labels, n, f.m) * (p[f.m] - p[n]) * inv_dx;
-      ++open;
-    }
-    if (side > 0) grad[3 * n + d] = open ? sum / open : 0.0;
+    if (side > 0) grad[3 * n + d] = den > 0.0 ? num / den : 0.0;
   });
 }
 

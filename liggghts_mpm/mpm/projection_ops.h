@@ -139,12 +139,20 @@ void corrected_flux_divergence(const LocalGrid &grid, const NodeLabels &labels,
                                const ProjectionGeometry &geo, const double *u, const double *theta,
                                const double *beta, const double *p, double dt, double *div);
 
-// Nodal pressure gradient at the owned non-SOLID nodes (0 at SOLID ones): per
-// direction the mean of the two face gradients (p_m - p_n) / dx, the one of the
-// open face alone next to a wall, 0 between two walls. This is the gradient the
-// fluid's nodes feel and the one to interpolate to grains (the same discrete
-// operator for both: docs/projection.md).
-void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad);
+// Nodal pressure gradient at the owned non-SOLID nodes (0 at SOLID ones). At a FLUID node, per
+// direction d, the adjoint of flux_divergence divided by the node's share of fluid length:
+//   g_n = sum_f theta_f w_f G_f / sum_f theta_f w_f s_f
+// over its two open faces f along d, G_f = (p_upper - p_lower) / dx with p = 0 at EMPTY nodes,
+// w_f = 1/2 towards a FLUID node and 1 towards an EMPTY one (the face carries u_n there), s_f the
+// ghost-fluid fraction of the face (1 off the surface); wall faces carry no u_n (w = 0): the open
+// face alone next to a wall, 0 between two walls. With u -= h g / rho the projection then removes
+// kinetic energy (in the norm sum rho theta_f w_f s_f u^2) and a hydrostatic pressure is balanced
+// exactly (docs/projection.md, "Free surface: energy and stiffness"). Off the surface and with
+// theta = 1 it is the mean of the two face gradients. At an EMPTY node: the mean of the ghost-fluid
+// gradients of its faces to FLUID nodes (continued from the fluid side). theta null: 1. The
+// gradient the fluid's nodes feel and the one to interpolate to grains.
+void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad,
+                       const double *theta = nullptr);
 
 // u -= dt inv_rho grad at the owned non-SOLID nodes (inv_rho per node).
 void correct_velocity(const LocalGrid &grid, const NodeLabels &labels, const double *grad,
