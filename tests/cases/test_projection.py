@@ -71,7 +71,8 @@ def case_dambreak(r):
     d, p = r.dambreak("projection_dambreak", cells=24, pressure="projection")
     # measured flip, ghost-fluid surface (default): front 0.428 / 0.187 / 0.083 a, height 0.023 /
     # 0.018 / 0.018 a at MPM16 / 24 / 32; 'free_surface node': front 0.378 / 0.120 / 0.063 a,
-    # height 0.031 / 0.023 / 0.022 a (docs/projection.md, "Free surface")
+    # height 0.031 / 0.023 / 0.022 a (docs/projection.md, "Free surface"); with the adjoint nodal
+    # gradient and the level as the distance to the surface: MPM32 front 0.072 a, height 0.019 a
     check_dambreak(d, "MPM24 projection", 0.21, 0.025)
     check("pressure projection, no sound speed" in p.stdout, "the fix reports the limit it applied")
     # the input's step: dtfactor dx / (2 sqrt(g h)), no sound speed: 0.25 * (4 / 24) / 12.53
