@@ -112,6 +112,14 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
       lab_.kind[n] = kEmpty;
     }
   });
+  if (opt_.surface_ghost) {
+    // the EMPTY nodes holding fluid: their velocity enters the surface faces' flux (surface_weight)
+    lab_.wet.assign(grid_.size(), 0);
+    grid_.for_owned([&](int, int, int, std::size_t n) {
+      const double m = p2g[P2gRec::N * n + P2gRec::M];
+      if (lab_.kind[n] == kEmpty && m > mmin && m > 0.0) lab_.wet[n] = 1;
+    });
+  }
   const Gate &g = opt_.gate;
   if (g.active) {
     const GridSpec &gs = opt_.grid;

@@ -72,8 +72,12 @@ double face_flux(const NodeLabels &lab, std::size_t n, const Face &f, int d, con
   double uf;
   if (a == b)
     uf = 0.5 * (u[3 * n + d] + u[3 * f.m + d]);
-  else
-    uf = (a == kFluid) ? u[3 * n + d] : u[3 * f.m + d];
+  else {
+    // FLUID-EMPTY: the FLUID node's velocity, and the EMPTY node's with surface_weight if it holds fluid
+    const double al = surface_weight(lab, n, f.m);
+    const std::size_t fl = a == kFluid ? n : f.m, em = a == kFluid ? f.m : n;
+    uf = (1.0 - al) * u[3 * fl + d] + al * u[3 * em + d];
+  }
   return th * uf;
 }
 
@@ -96,6 +100,7 @@ void NodeLabels::reset(const LocalGrid &grid, const IndexBox *work) {
   kind.assign(grid.size(), work ? kEmpty : kFluid);
   if (work) grid.for_box(work->cut(pb), [&](int, int, int, std::size_t n) { kind[n] = kFluid; });
   closed.assign(grid.size(), 0);
+  wet.clear();
   wall_u.clear();
   if (!work) level.clear();  // with a work box the caller fills the level in the box (kept sized)
   // the padding: the slabs of the patch below node 0 and above node ncell of each non-periodic d
@@ -120,13 +125,14 @@ void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm) {
   buf_.resize(grid.size());
   const std::vector<IndexBox> boxes = grid.exchanged_boxes();
   for (const IndexBox &b : boxes)
-    grid.for_box(b, [&](int, int, int, std::size_t n) { buf_[n] = kind[n] + 4.0 * closed[n]; });
+    grid.for_box(b, [&](int, int, int, std::size_t n) { buf_[n] = kind[n] + 4.0 * closed[n] + (wet.empty() ? 0.0 : 256.0 * wet[n]); });
   grid.forward(buf_.data(), 1);
   for (const IndexBox &b : boxes)
     grid.for_box(b, [&](int, int, int, std::size_t n) {
       const int v = static_cast<int>(buf_[n]);
       kind[n] = std::uint8_t(v & 3);
-      closed[n] = std::uint8_t(v >> 2);
+      closed[n] = std::uint8_t((v >> 2) & 63);
+      if (!wet.empty()) wet[n] = std::uint8_t(v >> 8);
     });
   int moving = wall_u.empty() ? 0 : 1, any = 0;
   MPI_Allreduce(&moving, &any, 1, MPI_INT, MPI_MAX, comm);
@@ -228,7 +234,12 @@ void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const do
         // and 1 towards an EMPTY one (whose face carries u_n); the denominator sum theta_f w_n s_f
         // is the node's share of the faces' fluid lengths (hydrostatic exact)
         const double th = theta ? 0.5 * (theta[n] + theta[f.m]) : 1.0;
-        const double w = th * (b == kFluid ? 0.5 : 1.0);
+        const double w = th * (b == kFluid ? 0.5 : 1.0 - surface_weight(labels, n, f.m));
+        num += w * G;
+        den += w * s;
+      } else if (b == kFluid && !labels.wet.empty() && labels.wet[n]) {
+        // an EMPTY node holding fluid: the adjoint too, with its weight in the face's flux
+        const double w = (theta ? 0.5 * (theta[n] + theta[f.m]) : 1.0) * surface_weight(labels, n, f.m);
         num += w * G;
         den += w * s;
       } else if (b == kFluid) {
