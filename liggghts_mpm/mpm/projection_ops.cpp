@@ -60,8 +60,9 @@ bool empty_away_from_fluid(const LocalGrid &grid, const NodeLabels &lab, int i, 
 }
 
 // Flux theta u along +d through face f of node n (see flux_divergence).
+// mix false: the FLUID node's value alone on FLUID-EMPTY faces (a field given at the FLUID nodes only).
 double face_flux(const NodeLabels &lab, std::size_t n, const Face &f, int d, const double *u,
-                 const double *theta) {
+                 const double *theta, bool mix = true) {
   if (f.wall) {
     const bool other = f.has_m && lab.kind[f.m] != kSolid;
     const double th = other ? 0.5 * (theta[n] + theta[f.m]) : theta[n];
@@ -74,7 +75,7 @@ double face_flux(const NodeLabels &lab, std::size_t n, const Face &f, int d, con
     uf = 0.5 * (u[3 * n + d] + u[3 * f.m + d]);
   else {
     // FLUID-EMPTY: the FLUID node's velocity, and the EMPTY node's with surface_weight if it holds fluid
-    const double al = surface_weight(lab, n, f.m);
+    const double al = mix ? surface_weight(lab, n, f.m) : 0.0;
     const std::size_t fl = a == kFluid ? n : f.m, em = a == kFluid ? f.m : n;
     uf = (1.0 - al) * u[3 * fl + d] + al * u[3 * em + d];
   }
@@ -180,7 +181,7 @@ void acceleration_rhs(const LocalGrid &grid, const NodeLabels &labels, const Pro
   for_faces_if(
       grid, labels, geo, [&](int, int, int, std::size_t n) { return labels.kind[n] == kFluid; },
       [&](std::size_t n, const Face &f, int d, int side) {
-        if (!f.wall) rhs[n] += side * f.area * face_flux(labels, n, f, d, a, theta) * inv_dx;
+        if (!f.wall) rhs[n] += side * f.area * face_flux(labels, n, f, d, a, theta, false) * inv_dx;
       });
 }
 

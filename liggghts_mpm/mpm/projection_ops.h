@@ -139,7 +139,8 @@ void pressure_rhs(const LocalGrid &grid, const NodeLabels &labels, const Project
 // Right-hand side of the pressure of an acceleration field a (keyword pressure_output
 // acceleration): rhs_n = D_n of flux_divergence with a for u, at the owned FLUID nodes (0
 // elsewhere), but no flux through wall faces (a wall at rest or moving at a constant velocity has
-// no normal acceleration). The solve then gives the p of div(beta grad p) = div(theta a).
+// no normal acceleration) and on FLUID-EMPTY faces the FLUID node's a alone (a is given at the
+// FLUID nodes only). The solve then gives the p of div(beta grad p) = div(theta a).
 void acceleration_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
                       const double *a, const double *theta, double *rhs);
 // The operator the solver inverts, at the owned FLUID nodes (0 elsewhere):
