@@ -46,9 +46,36 @@ namespace {
 // leaves the column moving (0.07 m/s after 1 s) and the MPM16 dam-break front 0.39 a off; 0.25:
 // at rest to 1e-12 m/s, front 0.037 a (apic).
 constexpr double kSurfaceFill = 0.25;
-// Ghost surface: a node is FLUID when level_is_fluid(fill - 1/2) (projection_ops.h, kLevelTie). A
-// fluid filled up to a node plane gives its nodes a fill of exactly 1/2 up to round-off; with 0 as
-// the bound they flipped between EMPTY and FLUID from step to step (F1 at rest: 2.6e-4 m/s after 1 s).
+// Ghost surface: a node is FLUID when level_is_fluid(level) (projection_ops.h, kLevelTie). A fluid
+// filled up to a node plane gives its nodes a level of exactly 0 up to round-off; with 0 as the
+// bound they flipped between EMPTY and FLUID from step to step (F1 at rest: 2.6e-4 m/s after 1 s).
+
+// The signed distance (units of dx, positive inside) from a node to a plane free surface whose
+// fluid gives the node the fill f: the inverse of the fill F(s) = int_{-inf}^{s} N(x) dx of the
+// shape function N across the surface (uniform fluid up to the plane at s cells above the node;
+// docs/projection.md, "Free surface: energy and stiffness"). With fill - 1/2 as the level instead,
+// the ghost surface moved 1 / N(0) = 4/3 (quadratic B-spline) times as far as the water near a
+// node and the surface was too stiff: the standing wave ran fast.
+double surface_distance(double f, ShapeKind shape) {
+  if (shape == ShapeKind::Linear) {  // hat: F = (1 + s)^2 / 2 (s < 0), 1 - (1 - s)^2 / 2
+    if (f <= 0.0) return -1.0;
+    if (f >= 1.0) return 1.0;
+    return f < 0.5 ? std::sqrt(2.0 * f) - 1.0 : 1.0 - std::sqrt(2.0 * (1.0 - f));
+  }
+  // quadratic B-spline: F = (s + 3/2)^3 / 6 on [-3/2, -1/2], 1 - (3/2 - s)^3 / 6 on [1/2, 3/2],
+  // 1/2 + 3 s / 4 - s^3 / 3 between
+  if (f <= 0.0) return -1.5;
+  if (f >= 1.0) return 1.5;
+  if (f <= 1.0 / 6.0) return std::cbrt(6.0 * f) - 1.5;
+  if (f >= 5.0 / 6.0) return 1.5 - std::cbrt(6.0 * (1.0 - f));
+  double x = (f - 0.5) / 0.75;  // Newton on the middle branch (F' = 3/4 - s^2 >= 1/2 there)
+  for (int it = 0; it < 30; ++it) {
+    const double r = 0.5 + 0.75 * x - x * x * x / 3.0 - f;
+    x -= r / (0.75 - x * x);
+    if (std::fabs(r) < 1e-15) break;
+  }
+  return x;
+}
 }  // namespace
 
 /* FLUID where the node holds fluid (mass above the threshold and kSurfaceFill of a full cell),
@@ -78,12 +105,20 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     if (opt_.surface_ghost) {
       // level set: the fill of a node whose dual cell the surface halves is 1/2 (a symmetric
       // kernel), so fill - 1/2 changes sign at the surface; FLUID where it is positive
-      lab_.level[n] = fill - 0.5;
+      lab_.level[n] = surface_distance(fill, opt_.shape);
       if (m <= mmin || m <= 0.0 || !level_is_fluid(lab_.level[n])) lab_.kind[n] = kEmpty;
     } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
       lab_.kind[n] = kEmpty;
     }
   });
+  if (opt_.surface_ghost) {
+    // the EMPTY nodes holding fluid: their velocity enters the surface faces' flux (surface_weight)
+    lab_.wet.assign(grid_.size(), 0);
+    grid_.for_owned([&](int, int, int, std::size_t n) {
+      const double m = p2g[P2gRec::N * n + P2gRec::M];
+      if (lab_.kind[n] == kEmpty && m > mmin && m > 0.0) lab_.wet[n] = 1;
+    });
+  }
   const Gate &g = opt_.gate;
   if (g.active) {
     const GridSpec &gs = opt_.grid;
@@ -425,7 +460,7 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
 
 void Projection::form_gradient(std::vector<double> &p, std::vector<double> &grad, const double *p2g, double mmin,
                                bool above_surface, bool with_p) {
-  pressure_gradient(grid_, lab_, p.data(), grad.data());
+  pressure_gradient(grid_, lab_, p.data(), grad.data(), theta_now_);
   grid_.forward(grad.data(), 3);
   if (above_surface && opt_.surface_ghost) extrapolate_above_surface(p2g, mmin, p, grad, with_p);
   if (mesh_) fill_wall_gradient(grad);
@@ -484,6 +519,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   });
   grid_.forward(u_.data(), 3);
   const double *th = theta ? theta : theta_.data();
+  theta_now_ = theta;
   if (theta)
     for (std::size_t n = 0; n < beta_.size(); ++n) beta_[n] = theta[n] / opt_.rho0;
   pressure_rhs(grid_, lab_, geo_, u_.data(), th, theta_prev, h, rhs_.data());

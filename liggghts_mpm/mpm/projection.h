@@ -122,6 +122,7 @@ class Projection {
   ProjectionGeometry geo_;
   std::unique_ptr<PressureSolver> solver_;
   NodeLabels lab_;
+  const double *theta_now_ = nullptr;  // the fluid fraction of this step (null: 1), for the gradient
   std::vector<double> u_, theta_, beta_, rhs_, p_, p_ext_, grad_, grad_ext_, inv_rho_;
   std::vector<double> fold_mass_;   // node mass, owned and halos (ghost surface's fill)
   std::vector<double> frac_, u_ext_;  // mesh walls (make_labels, project)

@@ -60,8 +60,9 @@ bool empty_away_from_fluid(const LocalGrid &grid, const NodeLabels &lab, int i, 
 }
 
 // Flux theta u along +d through face f of node n (see flux_divergence).
+// mix false: the FLUID node's value alone on FLUID-EMPTY faces (a field given at the FLUID nodes only).
 double face_flux(const NodeLabels &lab, std::size_t n, const Face &f, int d, const double *u,
-                 const double *theta) {
+                 const double *theta, bool mix = true) {
   if (f.wall) {
     const bool other = f.has_m && lab.kind[f.m] != kSolid;
     const double th = other ? 0.5 * (theta[n] + theta[f.m]) : theta[n];
@@ -72,8 +73,12 @@ double face_flux(const NodeLabels &lab, std::size_t n, const Face &f, int d, con
   double uf;
   if (a == b)
     uf = 0.5 * (u[3 * n + d] + u[3 * f.m + d]);
-  else
-    uf = (a == kFluid) ? u[3 * n + d] : u[3 * f.m + d];
+  else {
+    // FLUID-EMPTY: the FLUID node's velocity, and the EMPTY node's with surface_weight if it holds fluid
+    const double al = mix ? surface_weight(lab, n, f.m) : 0.0;
+    const std::size_t fl = a == kFluid ? n : f.m, em = a == kFluid ? f.m : n;
+    uf = (1.0 - al) * u[3 * fl + d] + al * u[3 * em + d];
+  }
   return th * uf;
 }
 
@@ -96,6 +101,7 @@ void NodeLabels::reset(const LocalGrid &grid, const IndexBox *work) {
   kind.assign(grid.size(), work ? kEmpty : kFluid);
   if (work) grid.for_box(work->cut(pb), [&](int, int, int, std::size_t n) { kind[n] = kFluid; });
   closed.assign(grid.size(), 0);
+  wet.clear();
   wall_u.clear();
   if (!work) level.clear();  // with a work box the caller fills the level in the box (kept sized)
   // the padding: the slabs of the patch below node 0 and above node ncell of each non-periodic d
@@ -120,13 +126,14 @@ void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm) {
   buf_.resize(grid.size());
   const std::vector<IndexBox> boxes = grid.exchanged_boxes();
   for (const IndexBox &b : boxes)
-    grid.for_box(b, [&](int, int, int, std::size_t n) { buf_[n] = kind[n] + 4.0 * closed[n]; });
+    grid.for_box(b, [&](int, int, int, std::size_t n) { buf_[n] = kind[n] + 4.0 * closed[n] + (wet.empty() ? 0.0 : 256.0 * wet[n]); });
   grid.forward(buf_.data(), 1);
   for (const IndexBox &b : boxes)
     grid.for_box(b, [&](int, int, int, std::size_t n) {
       const int v = static_cast<int>(buf_[n]);
       kind[n] = std::uint8_t(v & 3);
-      closed[n] = std::uint8_t(v >> 2);
+      closed[n] = std::uint8_t((v >> 2) & 63);
+      if (!wet.empty()) wet[n] = std::uint8_t(v >> 8);
     });
   int moving = wall_u.empty() ? 0 : 1, any = 0;
   MPI_Allreduce(&moving, &any, 1, MPI_INT, MPI_MAX, comm);
@@ -174,7 +181,7 @@ void acceleration_rhs(const LocalGrid &grid, const NodeLabels &labels, const Pro
   for_faces_if(
       grid, labels, geo, [&](int, int, int, std::size_t n) { return labels.kind[n] == kFluid; },
       [&](std::size_t n, const Face &f, int d, int side) {
-        if (!f.wall) rhs[n] += side * f.area * face_flux(labels, n, f, d, a, theta) * inv_dx;
+        if (!f.wall) rhs[n] += side * f.area * face_flux(labels, n, f, d, a, theta, false) * inv_dx;
       });
 }
 
@@ -202,9 +209,11 @@ void corrected_flux_divergence(const LocalGrid &grid, const NodeLabels &labels,
   });
 }
 
-void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad) {
+void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad,
+                       const double *theta) {
   const double inv_dx = 1.0 / grid.spec().dx;
-  // Face areas do not enter a nodal gradient: any geometry will do.
+  // Face areas do not enter a nodal gradient (the two faces of a node along d have the same
+  // area): any geometry will do.
   ProjectionGeometry geo;
   geo.spec = grid.spec();
   geo.half_cells = false;
@@ -212,22 +221,36 @@ void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const do
     for (int d = 0; d < 3; ++d) grad[3 * n + d] = 0.0;
   });
   // for_faces visits the faces of a node in the order (x,-), (x,+), (y,-), ...
-  double sum = 0.0;
-  int open = 0;
+  double num = 0.0, den = 0.0;
   for_faces_if(grid, labels, geo,
                [&](int i, int j, int k, std::size_t n) { return !empty_away_from_fluid(grid, labels, i, j, k, n); },
                [&](std::size_t n, const Face &f, int d, int side) {
-    if (side < 0) {
-      sum = 0.0;
-      open = 0;
+    if (side < 0) num = den = 0.0;
+    if (!f.wall) {
+      const std::uint8_t a = labels.kind[n], b = labels.kind[f.m];
+      const double s = 1.0 / surface_scale(labels, n, f.m);  // s_f (1 off the surface)
+      const double G = side * (p[f.m] - p[n]) * inv_dx;       // face gradient along +d, p = 0 at EMPTY
+      if (a == kFluid) {
+        // the adjoint of flux_divergence: weight theta_f w_n, w_n = 1/2 between two FLUID nodes
+        // and 1 towards an EMPTY one (whose face carries u_n); the denominator sum theta_f w_n s_f
+        // is the node's share of the faces' fluid lengths (hydrostatic exact)
+        const double th = theta ? 0.5 * (theta[n] + theta[f.m]) : 1.0;
+        const double w = th * (b == kFluid ? 0.5 : 1.0 - surface_weight(labels, n, f.m));
+        num += w * G;
+        den += w * s;
+      } else if (b == kFluid && !labels.wet.empty() && labels.wet[n]) {
+        // an EMPTY node holding fluid: the adjoint too, with its weight in the face's flux
+        const double w = (theta ? 0.5 * (theta[n] + theta[f.m]) : 1.0) * surface_weight(labels, n, f.m);
+        num += w * G;
+        den += w * s;
+      } else if (b == kFluid) {
+        // an EMPTY node: the gradient of its faces to FLUID nodes, continued from the fluid side
+        // (a face between two EMPTY nodes carries no pressure information)
+        num += G / s;
+        den += 1.0;
+      }
     }
-    // at an EMPTY node only the faces to FLUID nodes: the gradient extrapolated from the fluid
-    // side (a face between two EMPTY nodes carries no pressure information)
-    if (!f.wall && !(labels.kind[n] == kEmpty && labels.kind[f.m] == kEmpty)) {
-      sum += side * surface_scale(labels, n, f.m) * (p[f.m] - p[n]) * inv_dx;
-      ++open;
-    }
-    if (side > 0) grad[3 * n + d] = open ? sum / open : 0.0;
+    if (side > 0) grad[3 * n + d] = den > 0.0 ? num / den : 0.0;
   });
 }
 

@@ -34,6 +34,10 @@ enum NodeKind : std::uint8_t { kFluid = 0, kEmpty = 1, kSolid = 2 };
 struct NodeLabels {
   std::vector<std::uint8_t> kind;
   std::vector<std::uint8_t> closed;  // bit d: the face to index + e_d is a wall
+  // Ghost-fluid surface: 1 at the EMPTY nodes that hold fluid mass (the B-spline spreads the points'
+  // mass up to 1.5 cells beyond the surface): their velocity takes part in the flux of their faces
+  // to FLUID nodes (surface_weight). Empty: none (free_surface node, or set by the caller).
+  std::vector<std::uint8_t> wet;
   std::vector<double> wall_u;
   // Ghost-fluid free surface (docs/projection.md, "Free surface"): per node the signed distance
   // to the free surface in units of dx, positive inside the fluid (empty: p = 0 at the EMPTY
@@ -87,8 +91,9 @@ struct ProjectionGeometry {
 // coefficient 1 / s_f: at most 20x the face's own).
 constexpr double kMinSurfaceFraction = 1e-3;
 
-// Ghost surface: a node is FLUID when its level exceeds this bound. The level of every node is at
-// least -1/2 (fill >= 0), so a FLUID node's fraction s_f = level_n / (level_n - level_m) is then
+// Ghost surface: a node is FLUID when its level exceeds this bound. The level, the distance to the
+// surface in cells, is at least -kLevelMin (the shape function's support: 3/2 for the quadratic
+// B-spline, 1 for the hat), so a FLUID node's fraction s_f = level_n / (level_n - level_m) is then
 // at least kMinSurfaceFraction on each face and the clamp never binds. With a smaller bound (1e-9
 // measured) a node a hair inside the surface (a fluid filled up to a node plane: level 0 up to
 // round-off, some 1e-7 where grains displace it) was FLUID with its surface face clamped, and
@@ -97,7 +102,8 @@ constexpr double kMinSurfaceFraction = 1e-3;
 // the pressure by 11 rho g dx delta instead of 0.45 (PressureSolver.GhostSurfaceOnANodePlane-
 // IsWellConditioned), and np 2 drifted from np 1 (docs/projection.md). The bound also keeps a
 // fluid filled up to a node plane from flipping its nodes between EMPTY and FLUID.
-constexpr double kLevelTie = 0.5 * kMinSurfaceFraction / (1.0 - kMinSurfaceFraction);
+constexpr double kLevelMin = 1.5;
+constexpr double kLevelTie = kLevelMin * kMinSurfaceFraction / (1.0 - kMinSurfaceFraction);
 inline bool level_is_fluid(double level) { return level > kLevelTie; }
 
 // 1 / s_f for a face between a FLUID and an EMPTY node when labels.level is set, 1 otherwise.
@@ -108,6 +114,18 @@ inline double surface_scale(const NodeLabels &labels, std::size_t n, std::size_t
   const double lf = nf ? labels.level[n] : labels.level[m], le = nf ? labels.level[m] : labels.level[n];
   const double s = (lf - le > 0.0) ? lf / (lf - le) : 1.0;
   return 1.0 / std::min(1.0, std::max(kMinSurfaceFraction, s));
+}
+
+// The weight of the EMPTY node's velocity in the flux through a face between a FLUID node and an
+// EMPTY node: s_f / 2 if the EMPTY node holds fluid (labels.wet), 0 otherwise (the FLUID node's
+// velocity alone: the velocity extended into the empty region). s_f / 2 places the face's velocity
+// at the middle of the wetted part of the segment between the two nodes (linear interpolation);
+// a surface at the EMPTY node (s_f = 1) gives the mean of two FLUID nodes' faces.
+inline double surface_weight(const NodeLabels &labels, std::size_t n, std::size_t m) {
+  if (labels.wet.empty()) return 0.0;
+  const std::size_t e = labels.kind[n] == kEmpty ? n : m;
+  if (!labels.wet[e]) return 0.0;
+  return 0.5 / surface_scale(labels, n, m);
 }
 
 // True if the face of node (i, j, k) towards (i, j, k) + side e_d (side = -1 or
@@ -122,7 +140,8 @@ bool open_face(const LocalGrid &grid, const NodeLabels &labels, int i, int j, in
 // theta_f u_f with theta_f the mean of the two nodes' theta and u_f the mean
 // of their velocity components along the face normal; between a FLUID and an
 // EMPTY node u_f is the FLUID node's (the velocity is extended across the
-// free surface, so a falling body of fluid is not squeezed at its surface).
+// free surface, so a falling body of fluid is not squeezed at its surface),
+// mixed with the EMPTY node's by surface_weight where that node holds fluid.
 void flux_divergence(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
                      const double *u, const double *theta, double *div);
 
@@ -135,7 +154,8 @@ void pressure_rhs(const LocalGrid &grid, const NodeLabels &labels, const Project
 // Right-hand side of the pressure of an acceleration field a (keyword pressure_output
 // acceleration): rhs_n = D_n of flux_divergence with a for u, at the owned FLUID nodes (0
 // elsewhere), but no flux through wall faces (a wall at rest or moving at a constant velocity has
-// no normal acceleration). The solve then gives the p of div(beta grad p) = div(theta a).
+// no normal acceleration) and on FLUID-EMPTY faces the FLUID node's a alone (a is given at the
+// FLUID nodes only). The solve then gives the p of div(beta grad p) = div(theta a).
 void acceleration_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
                       const double *a, const double *theta, double *rhs);
 // The operator the solver inverts, at the owned FLUID nodes (0 elsewhere):
@@ -152,12 +172,21 @@ void corrected_flux_divergence(const LocalGrid &grid, const NodeLabels &labels,
                                const ProjectionGeometry &geo, const double *u, const double *theta,
                                const double *beta, const double *p, double dt, double *div);
 
-// Nodal pressure gradient at the owned non-SOLID nodes (0 at SOLID ones): per
-// direction the mean of the two face gradients (p_m - p_n) / dx, the one of the
-// open face alone next to a wall, 0 between two walls. This is the gradient the
-// fluid's nodes feel and the one to interpolate to grains (the same discrete
-// operator for both: docs/projection.md).
-void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad);
+// Nodal pressure gradient at the owned non-SOLID nodes (0 at SOLID ones). At a FLUID node, per
+// direction d, the adjoint of flux_divergence divided by the node's share of fluid length:
+//   g_n = sum_f theta_f w_f G_f / sum_f theta_f w_f s_f
+// over its two open faces f along d, G_f = (p_upper - p_lower) / dx with p = 0 at EMPTY nodes,
+// w_f the weight of u_n in the face's flux (1/2 towards a FLUID node, 1 - surface_weight towards an
+// EMPTY one), s_f the ghost-fluid fraction of the face (1 off the surface); wall faces carry no u_n
+// (w = 0): the open face alone next to a wall, 0 between two walls. At an EMPTY node holding fluid
+// (labels.wet) the same over its faces to FLUID nodes with w_f = surface_weight. With u -= h g / rho the projection then removes
+// kinetic energy (in the norm sum rho theta_f w_f s_f u^2) and a hydrostatic pressure is balanced
+// exactly (docs/projection.md, "Free surface: energy and stiffness"). Off the surface and with
+// theta = 1 it is the mean of the two face gradients. At another EMPTY node: the mean of the
+// ghost-fluid gradients of its faces to FLUID nodes (continued from the fluid side). theta null: 1. The
+// gradient the fluid's nodes feel and the one to interpolate to grains.
+void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad,
+                       const double *theta = nullptr);
 
 // u -= dt inv_rho grad at the owned non-SOLID nodes (inv_rho per node).
 void correct_velocity(const LocalGrid &grid, const NodeLabels &labels, const double *grad,
