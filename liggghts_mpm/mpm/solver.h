@@ -251,9 +251,9 @@ class FluidSolver {
   double dt_couple_ = HUGE_VAL, dt_grain_ = HUGE_VAL, c_couple_ = 0.0, c_grain_ = 0.0;
   double couple_theta_min_ = 1.0, couple_rho_grain_ = 0.0;
   double rho_range_[2] = {0.0, 0.0};  // lowest and highest density of the points at the last check
-  bool density_warned_ = false;       // density_warning() given in this run
+  bool range_warned_ = false;         // range_warning() given in this run
   double p_max_ = 0.0, p_scale_ = 0.0;  // pressure eos: largest point pressure, rho0 (|a| H + |v|^2)
-  std::string density_warning();
+  std::string range_warning();
   // finite position, velocity, mass (compute_shapes): q - q is 0 for a finite q and NaN for an
   // infinite or NaN one, one test for the usual case (the build does not assume finite math);
   // bad_point names the first bad value

@@ -19,12 +19,13 @@ double FluidSolver::stable_dt() {
   // maxima and the points' arrays in locals (registers, not reloaded per point).
   double v2max = 0.0, rho_max = eos.rho0, mrho_max = -eos.rho0, ratio_max = 0.0, mth_max = -1.0,
          mgrain_max = -HUGE_VAL;
-  // pressure eos, for the scene's pressure scale (pressure_warning): the largest point pressure,
-  // the largest |f/m| squared of the points' external force (gravity), the points' extent
+  // pressure eos until range_warning has warned in this run: the largest point pressure and, for
+  // the scene's pressure scale, the largest |f/m| squared of the points' external force (gravity)
+  // and the points' extent
   double p_max = -HUGE_VAL, a2max = 0.0, ext[6] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   const int n = pts.nlocal, *mask = pts.mask, point_bit = pts.point_bit;
   double *const *vel = pts.v, *const *state = pts.state;
-  const bool coupled = opt.coupled, eos_scale = !opt.projection;
+  const bool coupled = opt.coupled, eos_scale = !opt.projection && !range_warned_;
   for (int i = 0; i < n; ++i) {
     if (mask[i] & point_bit) {
       const double *v = vel[i], *s = state[i];
@@ -97,14 +98,14 @@ double FluidSolver::stable_dt() {
 // kPressureFactor times the scene's scale rho0 (|a| H + |v|max^2) (hydrostatic plus dynamic): the
 // weakly compressible fluid is out of its range (a soft bulk modulus, a fast impact, pressure noise
 // in a dense bed), and its pressures and densities are not those of water.
-std::string FluidSolver::density_warning() {
+std::string FluidSolver::range_warning() {
   constexpr double kDensityDeviation = 0.03, kPressureFactor = 5.0;
-  if (opt.projection || density_warned_) return "";
+  if (opt.projection || range_warned_) return "";
   const double r0 = opt.eos.rho0, lo = rho_range_[0] / r0, hi = rho_range_[1] / r0;
   const bool density = lo < 1.0 - kDensityDeviation || hi > 1.0 + kDensityDeviation;
   const bool pressure = p_max_ > kPressureFactor * p_scale_ && p_scale_ > 0.0;
   if (!density && !pressure) return "";
-  density_warned_ = true;
+  range_warned_ = true;
   std::ostringstream os;
   os.precision(4);
   os << "WARNING: fix mpm/fluid (pressure eos): at step " << clock.step;
@@ -121,7 +122,7 @@ std::string FluidSolver::density_warning() {
 }
 
 std::string FluidSolver::check_timestep(bool at_setup) {
-  if (at_setup) density_warned_ = false;
+  if (at_setup) range_warned_ = false;
   dt_stable_ = stable_dt();
   const int every = opt.fluid_every;
   const double dt = every * clock.dt, cfl = opt.cfl, dx = opt.grid.dx;
@@ -155,7 +156,7 @@ std::string FluidSolver::check_timestep(bool at_setup) {
   // the fluid (sub-)step: its own limit and, so that a step that is not sub-cycled also
   // satisfies it, the coupled one
   const double dt_sub = std::min(dt_stable_, dt_couple_);
-  std::string log = density_warning();
+  std::string log = range_warning();
   if (opt.projection && (dt > dt_sub ? !opt.subcycle : at_setup)) {
     // the limit applied: advective cfl*dx/|v|max or viscous dx^2 rho/(2 dim eta)
     const double dt_adv = acoustic_dt_limit(cfl, dx, 0.0, vmax_);
