@@ -524,7 +524,7 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_pmin, false},
     {"couple", "group-ID", "-", "an existing group of grains", "none", "the group-ID of the DEM grains",
      nullptr, 0, 0, false, false, nullptr, parse_couple, false},
-    {"drag", "law", "-", "ergun_wenyu, difelice, stokes", "ergun_wenyu consistent",
+    {"drag", "law", "-", "ergun_wenyu, difelice, stokes", "ergun_wenyu",
      "a drag law ergun_wenyu, difelice or stokes", nullptr, 0, 0, false, false, nullptr, parse_drag, false},
     {"cell_check", "yes/no", "-", "", "yes", "'yes' or 'no'",
      nullptr, 0, 0, false, false, &Options::cell_check, nullptr, true},
