@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cmath>
 #include <iterator>
 #include <cstdlib>
 #include <cstring>
@@ -15,6 +16,9 @@ const char *const kPointFields[10] = {"v", "p", "rho", "vol", "tau", "theta", "i
 const char *const kGridFields[2] = {"mass", "v"};
 
 namespace {
+
+// gravity of the default volume_correction rate (m/s^2)
+constexpr double kVolumeCorrectionG = 9.81;
 
 const char *kFaceNames[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
 
@@ -507,7 +511,7 @@ const std::vector<Keyword> kTable = {
      REAL(pressure_tolerance), 0.0, kInf, true, true, nullptr, nullptr, false},
     {"max_iterations", "integer", "-", "[1, 1000000]", "200", "an integer in [1, 1000000] (iterations of the pressure solve)",
      nullptr, 0, 0, false, false, nullptr, parse_max_iterations, false},
-    {"volume_correction", "real", "1/time", ">= 0", "0", "a rate (1/time) >= 0 at which compressed points are pushed apart",
+    {"volume_correction", "real", "1/time", ">= 0", "sqrt(9.81 m/s^2 / cell)", "a rate (1/time) >= 0 at which the points' volume error is removed",
      REAL(volume_correction), 0.0, kInf, false, true, nullptr, nullptr, false},
     {"pressure_output", "multiplier | acceleration", "-", "", "multiplier", "'multiplier' or 'acceleration'",
      nullptr, 0, 0, false, false, nullptr, parse_pressure_output, false},
@@ -623,6 +627,10 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
   }
   o.dimension = env.dimension;
   o.grid.dx = o.cell_size;
+  // volume_correction: by default at the rate of a gravity wave one cell long, sqrt(g / cell)
+  // (g = 9.81 m/s^2, SI units; docs/projection.md, "Volume over long runs")
+  if (o.projection && std::find(seen.begin(), seen.end(), "volume_correction") == seen.end())
+    o.volume_correction = std::sqrt(kVolumeCorrectionG / o.grid.dx);
   o.eos.rho0 = o.rho0;
   o.eos.K = o.bulk;
   fit_grid(o, env);

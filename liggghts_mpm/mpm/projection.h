@@ -61,6 +61,10 @@ class Projection {
   // largest nodal pressure of the last solve on this rank's owned nodes, averaged in time
   // (keyword pressure_average tau: exponential average with time constant tau; 0: as solved)
   double largest_average_pressure() const { return p_avg_max_; }
+  // volume correction (keyword volume_correction): the velocity, owned nodes and halos, that
+  // moves the points this step on top of the fluid's and is not the fluid's (it enters the points'
+  // positions only, never their velocity or momentum); empty when there is no correction
+  const std::vector<double> &volume_drift() const { return drift_; }
   int iterations() const { return last_.iterations; }
   double residual() const { return last_.relative_residual; }
   // since construction, this rank: wall time in the pressure solver (hypre assembly, setup and
@@ -130,7 +134,9 @@ class Projection {
   std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)
   bool have_theta_last_ = false;
   std::vector<double> vol_;         // volume correction: sum S V with the padding folded back
+  std::vector<double> q_, grad_q_, drift_;  // volume correction: its potential, gradient and drift
   void add_volume_correction(const double *pvol, const double *theta, double h);
+  void volume_drift(const double *pvol, const double *theta, double h, long step);
   bool deep_inside(int i, int j, int k) const;
   std::vector<double> p_avg_;       // pressure_average: the nodal pressure averaged in time (sized only then)
   bool have_avg_ = false;

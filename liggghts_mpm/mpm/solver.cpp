@@ -488,6 +488,17 @@ void FluidSolver::advance_positions(double h) {
     lo[d] = gs.periodic[d] ? -HUGE_VAL : gs.origin[d];
     hi[d] = gs.periodic[d] ? HUGE_VAL : gs.upper(d);
   }
+  // the volume correction's drift (Projection::volume_drift): positions only
+  if (proj_ && !proj_->volume_drift().empty()) {
+    const double *w = proj_->volume_drift().data();
+    const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+    with_stencil(opt.shape, [&](auto ns) {
+      for (const int i : plist_)
+        for_stencil<decltype(ns)::value>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double s, double, double, double) {
+          for (int d = 0; d < 3; ++d) vpic_[3 * i + d] += s * w[3 * n + d];
+        });
+    });
+  }
   for (int i = 0; i < pts.nlocal; ++i) {
     if (!is_point(i)) continue;
     double *xi = x[i];
