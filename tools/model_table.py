@@ -7,7 +7,8 @@ against the case's reference (CASES.md), with the wall time of each run.
                                          [--models projection eos] [--json rows.jsonl]
 
 ROW: f1 f2 f3 f4 c1 c1var (C1 with the fluid damped while the grain is held) c2 c5 c5wall c5tilt
-c6 porewave transfer (the coupled rows again with transfer apic), or all. Each run prints one line: row, model, settings, figures, wall time (s).
+c6 porewave transfer (the coupled rows again with transfer apic) damping (C5 undamped while settling,
+C6 damped while held) f3var (F3 with the other transfer), or all. Each run prints one line: row, model, settings, figures, wall time (s).
 """
 import argparse
 import json
@@ -74,20 +75,23 @@ def row_f2(r, models, cells=(16, 32)):
                                                              "mass_exact": s["mass"][0] == s["mass0"][0]}, w)
 
 
-def row_f3(r, models, cells=(20, 40)):
+def row_f3(r, models, cells=(20, 40), extra=""):
     """F3 released column (free-slip walls): kinetic energy / inviscid at 0.01 and 0.02 s."""
     from test_projection import inviscid_column_ke_rate
     rate = inviscid_column_ke_rate(0.05, 0.1, 0.1)
     for m in models:
         for c in cells:
-            d, p, w = timed(r, f"f3/{m}_g{c}", "tank/in.column", {"cells": c, "pressure": m, "wallkind": "freeslip"})
+            v = {"cells": c, "pressure": m, "wallkind": "freeslip"}
+            if extra:
+                v["extra"] = extra
+            d, p, w = timed(r, f"f3/{m}_g{c}{extra.replace(' ', '_')}", "tank/in.column", v)
             s = read_csv(os.path.join(d, "column.csv"))
             f = {}
             for t in (0.01, 0.02):
                 i = min(range(len(s["t"])), key=lambda j: abs(s["t"][j] - t))
                 f[f"ke_ratio_{t}s"] = s["ke"][i] / (rate * s["t"][i] ** 2)
             f["ke_0.01s_J"] = rate * 0.01 ** 2
-            emit("F3", m, f"Grid{c}, free-slip", f, w)
+            emit("F3", m, f"Grid{c}, free-slip" + (", " + extra if extra else ""), f, w)
 
 
 def row_f4(r, models, cells=(20, 40)):
@@ -139,15 +143,16 @@ def bed(r, case, **v):
     return float(m.group(1)), int(float(m.group(2))), float(m.group(3)), w
 
 
-def row_c5(r, models, extra=""):
+def row_c5(r, models, extra="", **more):
     """C5 random held bed (150 grains of 2 mm, phi 0.3, cell 1.5 d): mid-depth and on the floor."""
     for m in models:
         for where, fl in (("mid-depth", 0), ("floor", 1)):
-            v = {"pressure": m, "floor": fl}
+            v = dict({"pressure": m, "floor": fl}, **more)
             if extra:
                 v["extra"] = extra
-            q, n, side, w = bed(r, f"c5/{m}_{fl}{extra.replace(' ', '_')}", **v)
-            emit("C5", m, f"{where}, cell 1.5 d, {n} grains" + (", " + extra if extra else ""), {"archimedes_ratio": q}, w)
+            tag = extra + "".join(f" {k} {x}" for k, x in more.items())
+            q, n, side, w = bed(r, f"c5/{m}_{fl}{tag.replace(' ', '_')}", **v)
+            emit("C5", m, f"{where}, cell 1.5 d, {n} grains" + (", " + tag.strip() if tag else ""), {"archimedes_ratio": q}, w)
 
 
 def row_c5wall(r, models, extra=""):
@@ -176,22 +181,23 @@ def row_c5tilt(r, models):
                  {"archimedes_ratio": q, "side_over_buoyancy": side}, w)
 
 
-def row_c6(r, models, extra="", phis=(0.1, 0.2, 0.3)):
+def row_c6(r, models, extra="", phis=(0.1, 0.2, 0.3), **more):
     """C6 hindered settling (reduced: 4 x 4 x 12 cells of 2 mm, 0.15 s): v / reference (tools/suspension.py)."""
     import suspension
     for m in models:
         for phi in phis:
-            v = {"nxy": 4, "nsus": 12, "tend": 0.15, "phi": phi, "pressure": m}
+            v = dict({"nxy": 4, "nsus": 12, "tend": 0.15, "phi": phi, "pressure": m}, **more)
             if extra:
                 v["extra"] = extra
-            d, p, w = timed(r, f"c6/{m}_{phi}{extra.replace(' ', '_')}", "suspension/in.suspension", v)
+            tag = extra + "".join(f" {k} {x}" for k, x in more.items())
+            d, p, w = timed(r, f"c6/{m}_{phi}{tag.replace(' ', '_')}", "suspension/in.suspension", v)
             info = suspension.result_line(p.stdout)
             csv = os.path.join(d, "suspension.csv")
             res = suspension.analyse(csv, 1.0, t1=0.08)
             ph = suspension.phi_mid(res, info)
             vref = suspension.reference(ph)[0]
             res = suspension.analyse(csv, vref, t1=0.08)
-            emit("C6", m, f"phi {phi} (middle {ph:.3f}), reduced" + (", " + extra if extra else ""),
+            emit("C6", m, f"phi {phi} (middle {ph:.3f}), reduced" + (", " + tag.strip() if tag else ""),
                  {"v_ratio": res["ratio"], "ringing": res["ring"], "p_ringing": res["pring"]}, w)
 
 
@@ -220,6 +226,19 @@ def row_c1var(r, models):
     row_c1(r, models, extra="transfer apic", damp=100.0)
 
 
+def row_damping(r, models):
+    """C5 without the damping while settling (in.bed damps with eos), C6 (phi 0.3) with 200 1/s."""
+    row_c5(r, models, damp=0.0)
+    row_c6(r, models, phis=(0.3,), damp=200.0)
+
+
+def row_f3var(r, models):
+    """F3 with the other transfer: flip 1 for the projection (in.column sets apic), apic for eos."""
+    other = {"projection": "transfer flip 1", "eos": "transfer apic"}
+    for m in models:
+        row_f3(r, [m], extra=other[m])
+
+
 def row_transfer(r, models):
     """The coupled rows with transfer apic instead of the default flip 1."""
     row_c1(r, models, extra="transfer apic")
@@ -228,7 +247,7 @@ def row_transfer(r, models):
 
 
 ROWS = {"f1": row_f1, "f2": row_f2, "f3": row_f3, "f4": row_f4, "c1": row_c1, "c2": row_c2, "c5": row_c5,
-        "c5wall": row_c5wall, "c1var": row_c1var, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer}
+        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer}
 
 
 def main():

@@ -87,14 +87,15 @@ def case_np2_vs_np1(r):
 
 
 def case_settling(r):
-    """C1 with projection: one sphere settles at the isolated-sphere terminal velocity within 1 %."""
+    """C1 with the input's defaults (projection, flip, no damping): one sphere settles at the
+    isolated-sphere terminal velocity within 1 %."""
     from cases import schiller_naumann_settling
     d, _ = r.run("projection_settling", os.path.join(r.inputs, "settling", "in.settling"), {"pressure": "projection"})
     sim = read_csv(os.path.join(d, "settling.csv"))
     _, vt = schiller_naumann_settling(1e-4, 3000.0, 10.0, 1e-5, 9.81, sim["t"][-1])
     err = abs(-sim["v_z"][-1] - vt) / vt
     print(f"  terminal velocity {-sim['v_z'][-1]:.5f} m/s, Schiller-Naumann {vt:.5f} m/s ({100 * err:.2f} %)")
-    check(err < 0.01, "terminal velocity within 1 % (measured 0.94 %)")
+    check(err < 0.01, "terminal velocity within 1 % (measured 0.996 %; 0.94 % with apic and the fluid damped while held)")
 
 
 def case_archimedes(r):
