@@ -8,7 +8,7 @@ against the case's reference (CASES.md), with the wall time of each run.
 
 ROW: f1 f2 f3 f4 c1 c1var (C1 with the fluid damped while the grain is held) c2 c5 c5wall c5tilt
 c6 porewave transfer (the coupled rows again with transfer apic) damping (C5 undamped while settling,
-C6 damped while held) f3var (F3 with the other transfer), or all. Each run prints one line: row, model, settings, figures, wall time (s).
+C6 damped while held) f3var (F3 with the other transfer) f4fine (F4 at 80 cells), or all. Each run prints one line: row, model, settings, figures, wall time (s).
 """
 import argparse
 import json
@@ -232,6 +232,11 @@ def row_damping(r, models):
     row_c6(r, models, phis=(0.3,), damp=200.0)
 
 
+def row_f4fine(r, models):
+    """F4 at 80 cells along the tank."""
+    row_f4(r, models, cells=(80,))
+
+
 def row_f3var(r, models):
     """F3 with the other transfer: flip 1 for the projection (in.column sets apic), apic for eos."""
     other = {"projection": "transfer flip 1", "eos": "transfer apic"}
@@ -247,7 +252,7 @@ def row_transfer(r, models):
 
 
 ROWS = {"f1": row_f1, "f2": row_f2, "f3": row_f3, "f4": row_f4, "c1": row_c1, "c2": row_c2, "c5": row_c5,
-        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer}
+        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "f4fine": row_f4fine, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer}
 
 
 def main():
