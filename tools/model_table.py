@@ -8,7 +8,7 @@ against the case's reference (CASES.md), with the wall time of each run.
 
 ROW: f1 f2 f3 f4 c1 c1var (C1 with the fluid damped while the grain is held) c2 c5 c5wall c5tilt
 c6 porewave transfer (the coupled rows again with transfer apic) damping (C5 undamped while settling,
-C6 damped while held) f3var (F3 with the other transfer) f4fine (F4 at 80 cells), or all. Each run prints one line: row, model, settings, figures, wall time (s).
+C6 damped while held) f3var (F3 with the other transfer) f4fine (F4 at 80 cells) fluidapic (F2 MPM32, F4 with transfer apic), or all. Each run prints one line: row, model, settings, figures, wall time (s).
 """
 import argparse
 import json
@@ -64,14 +64,17 @@ def row_f1(r, models):
                   "crossings": int(s["crossings"][0]), "ke_end_J": s["ke"][0]}, w)
 
 
-def row_f2(r, models, cells=(16, 32)):
+def row_f2(r, models, cells=(16, 32), extra=""):
     """F2 dam break, no-slip floor, to T = 3, RMS front and height errors against Martin & Moyce."""
     for m in models:
         for c in cells:
-            d, p, w = timed(r, f"f2/{m}_c{c}", "dambreak/in.dambreak", {"cells": c, "pressure": m, "tend": 3.0})
+            v = {"cells": c, "pressure": m, "tend": 3.0}
+            if extra:
+                v["extra"] = extra
+            d, p, w = timed(r, f"f2/{m}_c{c}{extra.replace(' ', '_')}", "dambreak/in.dambreak", v)
             ef, eh = rms_vs_martin_moyce(os.path.join(d, "front.csv"))
             s = read_csv(os.path.join(d, "summary.csv"))
-            emit("F2", m, f"MPM{c}, no-slip floor, T = 3", {"front_rms_a": ef, "height_rms_a": eh,
+            emit("F2", m, f"MPM{c}, no-slip floor, T = 3" + (", " + extra if extra else ""), {"front_rms_a": ef, "height_rms_a": eh,
                                                              "mass_exact": s["mass"][0] == s["mass0"][0]}, w)
 
 
@@ -94,14 +97,17 @@ def row_f3(r, models, cells=(20, 40), extra=""):
             emit("F3", m, f"Grid{c}, free-slip" + (", " + extra if extra else ""), f, w)
 
 
-def row_f4(r, models, cells=(20, 40)):
+def row_f4(r, models, cells=(20, 40), extra=""):
     """F4 standing wave (in.wave, h 0.25, L 1, amplitude 2 % h, three periods)."""
     import sloshing
     for m in models:
         for c in cells:
-            d, p, w = timed(r, f"f4/{m}_c{c}", "sloshing/in.wave", {"cells": c, "pressure": m})
+            v = {"cells": c, "pressure": m}
+            if extra:
+                v["extra"] = extra
+            d, p, w = timed(r, f"f4/{m}_c{c}{extra.replace(' ', '_')}", "sloshing/in.wave", v)
             f = sloshing.fit(os.path.join(d, "wave.csv"))
-            emit("F4", m, f"{c} cells, 3 periods", {"w_ratio": f["w_ratio"], "amp_end_ratio": f["amp_ratio_end"],
+            emit("F4", m, f"{c} cells, 3 periods" + (", " + extra if extra else ""), {"w_ratio": f["w_ratio"], "amp_end_ratio": f["amp_ratio_end"],
                                                    "amp0_ratio": f["b_ratio"]}, w)
 
 
@@ -237,6 +243,12 @@ def row_f4fine(r, models):
     row_f4(r, models, cells=(80,))
 
 
+def row_fluidapic(r, models):
+    """F2 MPM32 and F4 (20, 40 cells) with transfer apic instead of the default flip 1."""
+    row_f4(r, models, extra="transfer apic")
+    row_f2(r, models, cells=(32,), extra="transfer apic")
+
+
 def row_f3var(r, models):
     """F3 with the other transfer: flip 1 for the projection (in.column sets apic), apic for eos."""
     other = {"projection": "transfer flip 1", "eos": "transfer apic"}
@@ -252,7 +264,7 @@ def row_transfer(r, models):
 
 
 ROWS = {"f1": row_f1, "f2": row_f2, "f3": row_f3, "f4": row_f4, "c1": row_c1, "c2": row_c2, "c5": row_c5,
-        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "f4fine": row_f4fine, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer}
+        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "f4fine": row_f4fine, "fluidapic": row_fluidapic, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer}
 
 
 def main():
