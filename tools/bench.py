@@ -528,7 +528,7 @@ def section_sph(a):
         d = os.path.join(a.out, "sph", "mpm_c%d" % c)
         shutil.rmtree(d, ignore_errors=True)
         wall, out, _ = run([a.exe, "-in", os.path.join(TOP, "inputs", "dambreak", "in.dambreak"), "-echo", "none",
-                            "-var", "cells", str(c), "-var", "tend", str(tend)], d)
+                            "-var", "cells", str(c), "-var", "tend", str(tend), "-var", "pressure", "eos"], d)
         ef, eh, _ = dambreak_error.errors(os.path.join(d, "front.csv"), tmax=tend)
         pts["mpm"].append((wall, ef))
         RUNS.append(dict(section="sph", case="MPM%d" % c, points=4 * c * c, wall_s=wall, front_rms_a=ef,

@@ -159,11 +159,11 @@ def run_case(c, a, defaults):
     cmd += [os.path.abspath(a.exe), "-in", "in.dambreak", "-echo", "none", "-screen", "none",
             "-var", "cells", str(c["cells"]),
             "-var", "floor", c["floor"], "-var", "tend", repr(c["tend"]), "-var", "h5every", "0"]
-    cmd += ["-var", "pressure", "projection"] if c["bulk"] == 0 else ["-var", "bulk", repr(c["bulk"])]
+    cmd += ["-var", "pressure", "projection"] if c["bulk"] == 0 else ["-var", "pressure", "eos", "-var", "bulk", repr(c["bulk"])]
     if c["dt_in"] > 0:
         cmd += ["-var", "dt", repr(c["dt_in"])]
     if c["pass_transfer"]:
-        cmd += ["-var", "transfer", c["transfer"]]
+        cmd += ["-var", "extra", "transfer " + c["transfer"]]
     t0 = time.perf_counter()
     with open(os.path.join(d, "stdout.txt"), "w") as fo, open(os.path.join(d, "stderr.txt"), "w") as fe:
         rc = subprocess.run(cmd, cwd=d, stdout=fo, stderr=fe).returncode
@@ -337,7 +337,7 @@ def main():
     ap.add_argument("--projection", action="store_true", help="also run 'pressure projection' (incompressible)")
     ap.add_argument("--floor", choices=["noslip", "freeslip"], default="noslip")
     ap.add_argument("--transfer", nargs="+", default=None,
-                    help="passed as -var transfer (e.g. apic, pic, flip 0.99); default: the input's")
+                    help="passed as -var extra 'transfer X' (e.g. apic, pic, flip 0.99); default: the fix's")
     ap.add_argument("--tend", type=float, default=3.0, help="end time in units of sqrt(a/g)")
     ap.add_argument("--dt", type=float, default=0.0, help="explicit time step (s) for every case (0 = rule below)")
     ap.add_argument("--dt-stiff", type=float, default=1e-5, help="time step (s) for bulk >= --stiff-bulk")

@@ -36,9 +36,10 @@ cp "$input" "$work/in.dambreak"
 # HDF5 every h5every steps with h5every dividing the settling steps, so that one
 # frame is the column at gate removal and ~8 frames cover T = 0 ... tend.
 val() { sed -n "s/^variable[[:space:]]\+$1[[:space:]]\+index[[:space:]]\+\([^[:space:]]\+\).*/\1/p" "$input"; }
-h5every=$(awk -v a="$(val width)" -v h="$(val height)" -v n="$cells" -v K="$(val bulk)" \
-  -v rho="$(val rho)" -v g="$(val g)" -v f="$(val dtfactor)" -v ts="$(val tsettle)" -v tend="$tend" 'BEGIN {
-    dx = a / n; dt = f * dx / (sqrt(K / rho) + 2 * sqrt(g * h))
+# (the default pressure projection has no sound speed: dt = dtfactor dx / (2 sqrt(g h)))
+h5every=$(awk -v a="$(val width)" -v h="$(val height)" -v n="$cells" \
+  -v g="$(val g)" -v f="$(val dtfactor)" -v ts="$(val tsettle)" -v tend="$tend" 'BEGIN {
+    dx = a / n; dt = f * dx / (2 * sqrt(g * h))
     ns = ts / dt; nsettle = (ns == int(ns)) ? ns : int(ns) + 1
     target = tend * sqrt(a / g) / dt / 8
     m = int(nsettle / target + 0.5); if (m < 1) m = 1

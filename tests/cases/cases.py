@@ -164,10 +164,10 @@ def pressure_errors(d):
 # ---------------------------------------------------------------- cases
 
 def case_hydrostatic_convergence(r):
-    """F1: pressure converges to rho g (h - z); mass exact; no point crosses a wall."""
+    """F1 with pressure eos: pressure converges to rho g (h - z); mass exact; no point crosses a wall."""
     res = {}
     for cells in (8, 16):
-        d, _ = r.hydro(f"hydrostatic_convergence/c{cells}", cells=cells)
+        d, _ = r.hydro(f"hydrostatic_convergence/c{cells}", cells=cells, pressure="eos")
         res[cells] = pressure_errors(d)
         e_all, e_in, s = res[cells]
         print(f"  cells {cells}: L2 all points {e_all:.4f}, interior {e_in:.4f}")
@@ -182,8 +182,8 @@ def case_hydrostatic_convergence(r):
 
 
 def case_dambreak_reduced(r):
-    """F2 at MPM16 (no-slip floor) against Martin & Moyce; mass exact."""
-    d, _ = r.dambreak("dambreak_reduced", cells=16, tend=3.0)
+    """F2 at MPM16 (no-slip floor, pressure eos) against Martin & Moyce; mass exact."""
+    d, _ = r.dambreak("dambreak_reduced", cells=16, tend=3.0, pressure="eos")
     # measured 0.185 / 0.021; the MPM32 acceptance figure is a benchmark (tools/dambreak_study.py)
     check_dambreak(d, "MPM16", 0.25, 0.05)
     f = read_csv(os.path.join(d, "front.csv"))
@@ -197,7 +197,7 @@ def case_shear_face(r):
     runs = {}
     for name, floor in (("noslip", "noslip"), ("freeslip", "freeslip"), ("thin", "shear 1e-12"),
                         ("thick", "shear 1e3"), ("mid", "shear 1e-6")):
-        d, _ = r.dambreak(f"shear_face/{name}", cells=8, tend=1.5, floor=floor)
+        d, _ = r.dambreak(f"shear_face/{name}", cells=8, tend=1.5, floor=floor, pressure="eos")
         runs[name] = read_csv(os.path.join(d, "front.csv"))["x_front"]
     # rate nu / (delta dx) with nu = 1e-6, dx = 0.5: 2e6 1/s (thin: exp(-2e6 h) = 0 each step),
     # 2e-9 1/s (thick: a factor 1 - 1e-12 per step), 2 1/s (mid: half the slip gone in 0.35 s)
@@ -211,8 +211,9 @@ def case_shear_face(r):
 
 
 def dambreak_np2_vs_np1(r, case, tol, what, **v):
-    """The dam break (length 12, cells 8) on 2 ranks against 1: front and height within tol (m)."""
-    v = dict(dict(cells=8, length=12.0), **v)
+    """The dam break (length 12, cells 8, pressure eos unless v names another) on 2 ranks against 1:
+    front and height within tol (m)."""
+    v = dict(dict(cells=8, length=12.0, pressure="eos"), **v)
     d1, _ = r.dambreak(f"{case}/np1", **v)
     d2, _ = r.dambreak(f"{case}/np2", np=2, **v)
     f1 = read_csv(os.path.join(d1, "front.csv"))
@@ -289,7 +290,7 @@ run 0
 def case_dt_error(r):
     """Real water with dt = 1e-4 at MPM16: a clear error stating the largest stable dt, no NaN."""
     d, p = r.run("dt_error", os.path.join(r.inputs, "dambreak", "in.dambreak"),
-                 {"cells": 16, "bulk": 2.2e9, "dt": 1e-4, "tend": 0.1}, expect_ok=False)
+                 {"cells": 16, "pressure": "eos", "bulk": 2.2e9, "dt": 1e-4, "tend": 0.1}, expect_ok=False)
     msg = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
     check(p.returncode != 0, "run stopped with a non-zero exit code")
     check("exceeds the largest stable time step" in msg and "subcycle yes" in msg,
@@ -300,7 +301,8 @@ def case_dt_error(r):
 def case_subcycle(r):
     """The same setting with 'subcycle yes' runs, reports its sub-steps and stays finite."""
     d, p = r.run("subcycle", os.path.join(r.inputs, "dambreak", "in.dambreak"),
-                 {"cells": 8, "bulk": 2.2e9, "dt": 2e-4, "tend": 0.3, "tsettle": 0.02, "subcycle": "yes"})
+                 {"cells": 8, "pressure": "eos", "bulk": 2.2e9, "dt": 2e-4, "tend": 0.3, "tsettle": 0.02,
+                  "extra": "subcycle yes"})
     check("sub-cycling with" in p.stdout, "log states the number of fluid sub-steps")
     f = read_csv(os.path.join(d, "front.csv"))
     check(all(math.isfinite(v) for v in f["x_front"]), "front.csv finite")
@@ -309,7 +311,7 @@ def case_subcycle(r):
 
 def case_realwater_short(r):
     """Real water (K = 2.2e9, dt = 1e-5) at MPM8 over a short span: stable, finite."""
-    d, p = r.dambreak("realwater_short", cells=8, bulk=2.2e9, dt=1e-5, tsettle=0.02, tend=0.4)
+    d, p = r.dambreak("realwater_short", cells=8, pressure="eos", bulk=2.2e9, dt=1e-5, tsettle=0.02, tend=0.4)
     f = read_csv(os.path.join(d, "front.csv"))
     check(all(math.isfinite(v) for v in f["x_front"] + f["h_wall"]), "front.csv finite")
     s = read_csv(os.path.join(d, "summary.csv"))
@@ -319,7 +321,7 @@ def case_realwater_short(r):
 
 def case_hdf5_output(r):
     """HDF5 + XDMF series written every N steps with only the requested fields."""
-    d, p = r.dambreak("hdf5_output", cells=8, tend=0.3, h5every=200)
+    d, p = r.dambreak("hdf5_output", cells=8, tend=0.3, h5every=200, pressure="eos")
     h5 = sorted(f for f in os.listdir(d) if f.startswith("dambreak_") and f.endswith(".h5"))
     check(len(h5) >= 3, f"several step files written ({len(h5)})")
     check(all(open(os.path.join(d, f), "rb").read(8) == b"\x89HDF\r\n\x1a\n" for f in h5), "files are HDF5")
@@ -396,7 +398,7 @@ def h5_series_same(d1, d2, prefix, rel):
 
 def case_hdf5_np2_vs_np1(r):
     """The HDF5 series of 2 ranks (parallel HDF5: each rank its rows) holds the same as 1 rank's."""
-    v = dict(cells=8, length=12.0, tend=2.0, h5every=500, extra="id grid mass v")
+    v = dict(cells=8, length=12.0, tend=2.0, h5every=500, extra="id grid mass v", pressure="eos")
     d1, _ = r.dambreak("hdf5_np2_vs_np1/np1", **v)
     d2, _ = r.dambreak("hdf5_np2_vs_np1/np2", np=2, **v)
     worst, files = h5_series_same(d1, d2, "dambreak", 1e-9)
@@ -480,19 +482,15 @@ def case_sparse_grid_projection(r):
 
 def case_sparse_grid_coupled(r):
     """The sparse grid with couple (the fluid's phases on the active blocks, the coupling's on the
-    whole patch) against the dense grid: free grains driven through the fluid (inputs/ergun, APIC,
-    theta_smooth) on 2 ranks, and a moving bed (inputs/porewave): their outputs identical to the
+    whole patch) against the dense grid: free grains driven through the fluid (inputs/ergun, eos,
+    APIC) on 2 ranks, and a moving bed (inputs/porewave, eos, APIC): their outputs identical to the
     bit."""
     import filecmp
-    src = open(os.path.join(r.inputs, "ergun", "in.ergun")).read()
     ds = []
     for sp in ("no", "yes"):
-        d = r.fresh(f"sparse_grid_coupled/ergun_np2_{sp}")
-        text = src.replace("theta_smooth ${smooth}\n", f"theta_smooth ${{smooth}} sparse {sp}\n", 1)
-        check(text != src, "in.ergun: the fix's last line ends with 'theta_smooth ${smooth}'")
-        with open(os.path.join(d, "in.ergun"), "w") as f:
-            f.write(text)
-        r.execute(d, "in.ergun", {"G": 2000.0, "mobile": 1, "v0": 0.05, "tend": 0.01, "outdt": 0.001}, np=2)
+        d, _ = r.run(f"sparse_grid_coupled/ergun_np2_{sp}", os.path.join(r.inputs, "ergun", "in.ergun"),
+                     {"G": 2000.0, "mobile": 1, "v0": 0.05, "tend": 0.01, "outdt": 0.001, "pressure": "eos",
+                      "extra": f"transfer apic theta_smooth 0 sparse {sp}"}, np=2)
         ds.append(d)
     rows = read_csv(os.path.join(ds[1], "ergun.csv"))
     check(filecmp.cmp(os.path.join(ds[0], "ergun.csv"), os.path.join(ds[1], "ergun.csv"), shallow=False)
@@ -500,8 +498,8 @@ def case_sparse_grid_coupled(r):
     ds = []
     for sp in ("no", "yes"):
         d, _ = r.run(f"sparse_grid_coupled/porewave_{sp}", os.path.join(r.inputs, "porewave", "in.porewave"),
-                     dict(jitter=0.0008, zb="f", mobile=1, gdrive=200, nsteps=600, nout=50,
-                          extra=f"sparse {sp}"))
+                     dict(jitter=0.0008, zb="f", mobile=1, gdrive=200, nsteps=600, nout=50, pressure="eos",
+                          extra=f"transfer apic sparse {sp}"))
         ds.append(d)
     rows = read_csv(os.path.join(ds[1], "porewave.csv"))
     check(filecmp.cmp(os.path.join(ds[0], "porewave.csv"), os.path.join(ds[1], "porewave.csv"), shallow=False)
@@ -531,10 +529,15 @@ def schiller_naumann_settling(d, rhop, rhof, nu, g, t_end, n=20000):
     return out, 0.5 * (lo + hi)
 
 
+# the weakly compressible set-up of the C1 cases (inputs/settling defaults to the projection)
+SETTLING_EOS = {"pressure": "eos", "extra": "transfer apic", "damp": 100.0}
+
+
 def case_settling(r):
-    """C1: terminal velocity within 2 % of the isolated-sphere value, relaxation curve within 5 %."""
+    """C1 with pressure eos (APIC, the fluid damped while the grain is held): terminal velocity within
+    2 % of the isolated-sphere value, relaxation curve within 5 %."""
     inp = os.path.join(r.inputs, "settling", "in.settling")
-    d, _ = r.run("settling/heavy", inp, {})
+    d, _ = r.run("settling/heavy", inp, dict(SETTLING_EOS))
     sim = read_csv(os.path.join(d, "settling.csv"))
     curve, vt = schiller_naumann_settling(1e-4, 3000.0, 10.0, 1e-5, 9.81, sim["t"][-1])
     vsim = [-v for v in sim["v_z"]]
@@ -546,11 +549,11 @@ def case_settling(r):
     dev = max(abs(v - interp(t, tc, vc)) for t, v in zip(sim["t"], vsim)) / vt
     print(f"  largest deviation from the relaxation curve {100 * dev:.2f} % of v_t")
     check(dev < 0.05, "relaxation curve within 5 % of v_t")
-    d, _ = r.run("settling/neutral", inp, {"rhop": 10.0})
+    d, _ = r.run("settling/neutral", inp, dict(SETTLING_EOS, rhop=10.0))
     vn = read_csv(os.path.join(d, "settling.csv"))["v_z"][-1]
     print(f"  neutrally buoyant sphere: v_z = {vn:.2e} m/s")
     check(abs(vn) < 1e-3 * vt, "a sphere of the fluid's density stays at rest: |v| < 0.1 % of v_t")
-    d, _ = r.run("settling/light", inp, {"rhop": 1.0})
+    d, _ = r.run("settling/light", inp, dict(SETTLING_EOS, rhop=1.0))
     vl = read_csv(os.path.join(d, "settling.csv"))["v_z"][-1]
     # rise speed: the same balance with the density difference reversed
     _, vrise = schiller_naumann_settling(1e-4, 19.0, 10.0, 1e-5, 9.81, 0.01)
@@ -588,13 +591,14 @@ def case_theta_smooth(r):
     free grains the total momentum is still kept (the smoothing only changes theta)."""
     inp = os.path.join(r.inputs, "ergun", "in.ergun")
     eps = 1.0 - math.pi / 6.0
-    dd, _ = r.run("theta_smooth/ergun", inp, {"G": 1000.0, "smooth": 2.0e-3})
+    dd, _ = r.run("theta_smooth/ergun", inp, {"G": 1000.0, "pressure": "eos", "extra": "transfer apic theta_smooth 2e-3"})
     f = read_csv(os.path.join(dd, "ergun.csv"))
     th = (f["theta_min"][-1], f["theta_max"][-1])
     check(abs(th[0] - eps) < 1e-9 and abs(th[1] - eps) < 1e-9,
           f"smoothed fluid fraction of a uniform periodic bed is still the porosity (got {th[0]:.9f}..{th[1]:.9f})")
     dd, _ = r.run("theta_smooth/momentum", inp, {"G": 0.0, "mobile": 1, "v0": 0.05, "tend": 0.02,
-                                                  "outdt": 0.001, "smooth": 2.0e-3})
+                                                  "outdt": 0.001, "pressure": "eos",
+                                                  "extra": "transfer apic theta_smooth 2e-3"})
     f = read_csv(os.path.join(dd, "ergun.csv"))
     P0 = 0.05 * eps * 10.0 * (4 * 2.0e-3) ** 3
     drift = abs(f["P"][-1] - P0) / P0
@@ -606,7 +610,7 @@ def case_every(r):
     """'every N': the fluid advances every N-th step by N dt and the grain gets the impulse of the N
     steps at the fluid step; C1 terminal velocity still within 2 % (DEM step N times smaller)."""
     inp = os.path.join(r.inputs, "settling", "in.settling")
-    d, _ = r.run("every/heavy", inp, {"every": 4})
+    d, _ = r.run("every/heavy", inp, dict(SETTLING_EOS, every=4))
     sim = read_csv(os.path.join(d, "settling.csv"))
     _, vt = schiller_naumann_settling(1e-4, 3000.0, 10.0, 1e-5, 9.81, sim["t"][-1])
     v = -sim["v_z"][-1]
@@ -631,7 +635,8 @@ def case_buoyancy_floor(r):
 def case_momentum_balance(r):
     """Drag and pressure forces between free grains and fluid conserve total momentum (periodic, no gravity)."""
     inp = os.path.join(r.inputs, "ergun", "in.ergun")
-    dd, _ = r.run("momentum_balance", inp, {"G": 0.0, "mobile": 1, "v0": 0.05, "tend": 0.02, "outdt": 0.001})
+    dd, _ = r.run("momentum_balance", inp, {"G": 0.0, "mobile": 1, "v0": 0.05, "tend": 0.02, "outdt": 0.001,
+                                            "pressure": "eos", "extra": "transfer apic"})
     f = read_csv(os.path.join(dd, "ergun.csv"))
     # The fluid's mass is theta rho V once the grains are in (init_theta at the
     # first run), so the momentum to keep is v0 eps rho L^3. LIGGGHTS reports
@@ -645,9 +650,9 @@ def case_momentum_balance(r):
 
 
 def case_coupled_np2_vs_np1(r):
-    """Coupled fluid + free grains (C2 box, driven): 2 MPI ranks against 1."""
+    """Coupled fluid + free grains (C2 box, driven, pressure eos, APIC): 2 MPI ranks against 1."""
     inp = os.path.join(r.inputs, "ergun", "in.ergun")
-    v = {"G": 2000.0, "mobile": 1, "v0": 0.05, "tend": 0.02, "outdt": 0.001}
+    v = {"G": 2000.0, "mobile": 1, "v0": 0.05, "tend": 0.02, "outdt": 0.001, "pressure": "eos", "extra": "transfer apic"}
     d1, _ = r.run("coupled_np2_vs_np1/np1", inp, v)
     d2, _ = r.run("coupled_np2_vs_np1/np2", inp, v, np=2)
     f1 = read_csv(os.path.join(d1, "ergun.csv"))
@@ -834,8 +839,12 @@ def case_porewave(r):
     below the coupled limit (also sub-cycled and with every 2); above it a clear error, no NaN."""
     inp = os.path.join(r.inputs, "porewave", "in.porewave")
 
+    def with_eos(v):
+        # the weakly compressible fluid of this case, with APIC (inputs/porewave defaults to the projection)
+        return dict(v, pressure="eos", extra=("transfer apic " + v.get("extra", "")).strip())
+
     def decays(case, frac=0.25, **v):
-        d, p = r.run(f"porewave/{case}", inp, dict({"nsteps": 1000, "nout": 50}, **v))
+        d, p = r.run(f"porewave/{case}", inp, with_eos(dict({"nsteps": 1000, "nout": 50}, **v)))
         c = read_csv(os.path.join(d, "porewave.csv"))
         amp = [max(abs(a), abs(b)) for a, b in zip(c["pmax"], c["pmin"])]
         late = max(amp[3 * len(amp) // 4:])
@@ -845,7 +854,7 @@ def case_porewave(r):
         return p
 
     def fails(case, needles, **v):
-        d, p = r.run(f"porewave/{case}", inp, dict({"nsteps": 200}, **v), expect_ok=False)
+        d, p = r.run(f"porewave/{case}", inp, with_eos(dict({"nsteps": 200}, **v)), expect_ok=False)
         msg = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
         check(p.returncode != 0 and all(n in msg for n in needles) and "nan" not in p.stdout.lower(),
               f"{case}: error naming {needles} (got: {msg.strip()[:220]})")

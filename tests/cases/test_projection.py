@@ -34,8 +34,7 @@ def case_hydrostatic(r):
     """F1 with projection: pressure error first order in the cell, no checkerboard, at rest."""
     res = {}
     for cells in (8, 16):
-        d, p = r.hydro(f"projection_hydrostatic/c{cells}", cells=cells, pressure="projection", damping=0,
-                       tend=1.0)
+        d, p = r.hydro(f"projection_hydrostatic/c{cells}", cells=cells, pressure="projection", tend=1.0)
         e_all, e_in, s = pressure_errors(d)
         res[cells] = (e_all, e_in)
         vmax = last_thermo(p.stdout, 5)  # step time f1 f2 f3: |v|max
@@ -88,14 +87,15 @@ def case_np2_vs_np1(r):
 
 
 def case_settling(r):
-    """C1 with projection: one sphere settles at the isolated-sphere terminal velocity within 1 %."""
+    """C1 with the input's defaults (projection, flip, no damping): one sphere settles at the
+    isolated-sphere terminal velocity within 1 %."""
     from cases import schiller_naumann_settling
     d, _ = r.run("projection_settling", os.path.join(r.inputs, "settling", "in.settling"), {"pressure": "projection"})
     sim = read_csv(os.path.join(d, "settling.csv"))
     _, vt = schiller_naumann_settling(1e-4, 3000.0, 10.0, 1e-5, 9.81, sim["t"][-1])
     err = abs(-sim["v_z"][-1] - vt) / vt
     print(f"  terminal velocity {-sim['v_z'][-1]:.5f} m/s, Schiller-Naumann {vt:.5f} m/s ({100 * err:.2f} %)")
-    check(err < 0.01, "terminal velocity within 1 % (measured 0.94 %)")
+    check(err < 0.01, "terminal velocity within 1 % (measured 0.996 %; 0.94 % with apic and the fluid damped while held)")
 
 
 def case_archimedes(r):
@@ -323,7 +323,7 @@ def drift_run(r, case, cells, rate, transfer="flip", tend=3.0, outevery=5):
     with open(os.path.join(d, "in.drift"), "w") as f:
         f.write(text)
     t0 = time.time()
-    p = r.execute(d, "in.drift", {"pressure": "projection", "cells": cells, "vcorr": rate, "transfer": transfer,
+    p = r.execute(d, "in.drift", {"pressure": "projection", "cells": cells, "vcorr": rate, "extra": f"transfer {transfer}",
                                   "tend": tend})
     wall = time.time() - t0
     rows = [ln.split() for ln in p.stdout.splitlines() if re.match(r"^\s+\d+\s+[-0-9.e+]+\s", ln)]
@@ -348,12 +348,8 @@ def case_volume_correction(r):
     error is that of the run without); in the F2 dam break (MPM16, apic, 2 s after the release)
     the overlapping share of the points' volume falls and the fluid's volume on the grid stays
     nearer the held one than without."""
-    text = open(os.path.join(r.inputs, "hydrostatic", "in.hydrostatic")).read()
-    text = text.replace("damping ${damping}", "damping ${damping} volume_correction 10")
-    d = r.fresh("projection_volume_correction/f1")
-    with open(os.path.join(d, "in.vc"), "w") as f:
-        f.write(text)
-    p = r.execute(d, "in.vc", {"cells": 8, "pressure": "projection", "damping": 0, "tend": 1.0})
+    d, p = r.hydro("projection_volume_correction/f1", cells=8, pressure="projection", tend=1.0,
+                   extra="volume_correction 10")
     e_all, e_in, s = pressure_errors(d)
     vmax = last_thermo(p.stdout, 5)
     print(f"  F1, 8 cells, 1 s: |v|max {vmax:.2e} m/s, L2 pressure error all points {e_all:.2e}, interior {e_in:.2e}")
@@ -562,7 +558,7 @@ def case_pressure_output(r):
     h x 0.1 / 0.05 / 0.025 / 0.0125: 19.2 / 22.9 / 25.6 / 21.5 kPa and 15.5 / 15.9 / 13.8 / 13.2 kPa);
     both at least the stagnation pressure rho U^2 / 2, the average at most rho U b / tau + rho g b
     (the column's whole momentum per area, b = 0.5 m, stopped within tau, plus its weight)."""
-    d, p = r.hydro("projection_pressure_output/hydrostatic", cells=16, pressure="projection", damping=0, tend=1.0,
+    d, p = r.hydro("projection_pressure_output/hydrostatic", cells=16, pressure="projection", tend=1.0,
                    extra="pressure_output acceleration")
     e_all, e_in, _ = pressure_errors(d)
     print(f"  F1 16 cells, acceleration pressure: L2 error all points {e_all:.2e}, interior {e_in:.2e}")

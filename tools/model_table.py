@@ -1,0 +1,290 @@
+#!/usr/bin/env python3
+"""The figures of docs/model_table.md: each example input of the fluid and coupled cases run with
+the fix's defaults (`pressure projection`) and with `pressure eos` (the input's bulk), measured
+against the case's reference (CASES.md), with the wall time of each run.
+
+    tools/python tools/model_table.py ROW [ROW ...] [--exe build/liggghts_mpm] [--work /tmp/model_table]
+                                         [--models projection eos] [--json rows.jsonl]
+
+ROW: f1 f2 f3 f4 c1 c1var (C1 with the fluid damped while the grain is held) c2 c5 c5wall c5tilt
+c6 porewave transfer (the coupled rows again with transfer apic) damping (C5 undamped while settling,
+C6 damped while held) f3var (F3 with the other transfer) f4fine (F4 at 80 cells) fluidapic (F2 MPM32, F4 with transfer apic), or all. Each run prints one line: row, model, settings, figures, wall time (s).
+"""
+import argparse
+import json
+import math
+import os
+import re
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+TOP = os.path.dirname(HERE)
+sys.path.insert(0, os.path.join(TOP, "tests", "cases"))
+sys.path.insert(0, HERE)
+import cases  # noqa: E402
+from cases import pressure_errors, read_csv, rms_vs_martin_moyce, schiller_naumann_settling  # noqa: E402
+
+OUT = []
+
+
+class Args:
+    pass
+
+
+def runner(a):
+    ns = Args()
+    ns.exe, ns.inputs, ns.work, ns.mpirun = a.exe, os.path.join(TOP, "inputs"), a.work, "mpirun"
+    return cases.Runner(ns)
+
+
+def timed(r, case, inp, v):
+    t0 = time.time()
+    d, p = r.run(case, os.path.join(r.inputs, inp), v)
+    return d, p, time.time() - t0
+
+
+def emit(row, model, settings, figs, wall):
+    rec = {"row": row, "model": model, "settings": settings, "figures": figs, "wall_s": round(wall, 1)}
+    OUT.append(rec)
+    f = ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in figs.items())
+    print(f"{row} | {model} | {settings} | {f} | {wall:.1f} s", flush=True)
+
+
+def row_f1(r, models):
+    """F1 hydrostatic column, 16 cells, 0.4 s (eos: its damping 20 1/s; also without)."""
+    for m in models:
+        runs = [("", {})] + ([("no damping", {"extra": "damping 0"})] if m == "eos" else [])
+        for label, v in runs:
+            d, p, w = timed(r, f"f1/{m}{label.replace(' ', '_')}", "hydrostatic/in.hydrostatic",
+                            dict({"cells": 16, "pressure": m}, **v))
+            e_all, e_in, s = pressure_errors(d)
+            emit("F1", m, "cells 16, 0.4 s" + (", " + label if label else ""),
+                 {"L2_all": e_all, "L2_interior": e_in, "mass_exact": s["mass"][0] == s["mass0"][0],
+                  "crossings": int(s["crossings"][0]), "ke_end_J": s["ke"][0]}, w)
+
+
+def row_f2(r, models, cells=(16, 32), extra=""):
+    """F2 dam break, no-slip floor, to T = 3, RMS front and height errors against Martin & Moyce."""
+    for m in models:
+        for c in cells:
+            v = {"cells": c, "pressure": m, "tend": 3.0}
+            if extra:
+                v["extra"] = extra
+            d, p, w = timed(r, f"f2/{m}_c{c}{extra.replace(' ', '_')}", "dambreak/in.dambreak", v)
+            ef, eh = rms_vs_martin_moyce(os.path.join(d, "front.csv"))
+            s = read_csv(os.path.join(d, "summary.csv"))
+            emit("F2", m, f"MPM{c}, no-slip floor, T = 3" + (", " + extra if extra else ""), {"front_rms_a": ef, "height_rms_a": eh,
+                                                             "mass_exact": s["mass"][0] == s["mass0"][0]}, w)
+
+
+def row_f3(r, models, cells=(20, 40), extra=""):
+    """F3 released column (free-slip walls): kinetic energy / inviscid at 0.01 and 0.02 s."""
+    from test_projection import inviscid_column_ke_rate
+    rate = inviscid_column_ke_rate(0.05, 0.1, 0.1)
+    for m in models:
+        for c in cells:
+            v = {"cells": c, "pressure": m, "wallkind": "freeslip"}
+            if extra:
+                v["extra"] = extra
+            d, p, w = timed(r, f"f3/{m}_g{c}{extra.replace(' ', '_')}", "tank/in.column", v)
+            s = read_csv(os.path.join(d, "column.csv"))
+            f = {}
+            for t in (0.01, 0.02):
+                i = min(range(len(s["t"])), key=lambda j: abs(s["t"][j] - t))
+                f[f"ke_ratio_{t}s"] = s["ke"][i] / (rate * s["t"][i] ** 2)
+            f["ke_0.01s_J"] = rate * 0.01 ** 2
+            emit("F3", m, f"Grid{c}, free-slip" + (", " + extra if extra else ""), f, w)
+
+
+def row_f4(r, models, cells=(20, 40), extra=""):
+    """F4 standing wave (in.wave, h 0.25, L 1, amplitude 2 % h, three periods)."""
+    import sloshing
+    for m in models:
+        for c in cells:
+            v = {"cells": c, "pressure": m}
+            if extra:
+                v["extra"] = extra
+            d, p, w = timed(r, f"f4/{m}_c{c}{extra.replace(' ', '_')}", "sloshing/in.wave", v)
+            f = sloshing.fit(os.path.join(d, "wave.csv"))
+            emit("F4", m, f"{c} cells, 3 periods" + (", " + extra if extra else ""), {"w_ratio": f["w_ratio"], "amp_end_ratio": f["amp_ratio_end"],
+                                                   "amp0_ratio": f["b_ratio"]}, w)
+
+
+def row_c1(r, models, extra="", **more):
+    """C1 one sphere settling: terminal velocity against Schiller-Naumann."""
+    for m in models:
+        v = dict({"pressure": m}, **more)
+        if extra:
+            v["extra"] = extra
+        tag = extra + "".join(f" {k} {x}" for k, x in more.items())
+        d, p, w = timed(r, f"c1/{m}{tag.replace(' ', '_')}", "settling/in.settling", v)
+        sim = read_csv(os.path.join(d, "settling.csv"))
+        curve, vt = schiller_naumann_settling(1e-4, 3000.0, 10.0, 1e-5, 9.81, sim["t"][-1])
+        vs = [-x for x in sim["v_z"]]
+        tc, vc = [c[0] for c in curve], [c[1] for c in curve]
+        dev = max(abs(x - cases.interp(t, tc, vc)) for t, x in zip(sim["t"], vs)) / vt
+        emit("C1", m, "d 0.1 mm, cell 3 mm, 0.1 s" + (", " + tag.strip() if tag else ""),
+             {"vt_ratio": vs[-1] / vt, "vt_SN": vt, "curve_dev_vt": dev}, w)
+
+
+def row_c2(r, models):
+    """C2 Ergun: periodic simple-cubic bed driven by dp/L; U reached against Ergun."""
+    eps, mu, d, rho = 1.0 - math.pi / 6.0, 1.5e-3, 1e-3, 10.0
+    A = 150.0 * (1 - eps) ** 2 / eps ** 3 * mu / d ** 2
+    B = 1.75 * (1 - eps) / eps ** 3 * rho / d
+    for m in models:
+        for U in (0.002, 0.02):
+            G = A * U + B * U * U
+            dd, p, w = timed(r, f"c2/{m}_U{U}", "ergun/in.ergun", {"G": G, "pressure": m})
+            f = read_csv(os.path.join(dd, "ergun.csv"))
+            Us = f["U"][-1]
+            emit("C2", m, f"U {U} m/s", {"dp_rel_err": (A * Us + B * Us * Us) / G - 1.0}, w)
+
+
+def bed(r, case, **v):
+    base = {"nbeads": 150, "tsettle": 0.05, "tavg": 0.01}
+    d, p, w = timed(r, case, "archimedes/in.bed", dict(base, **v))
+    m = re.search(r"RESULT ratio (\S+) grains (\S+).* side (\S+)", p.stdout)
+    return float(m.group(1)), int(float(m.group(2))), float(m.group(3)), w
+
+
+def row_c5(r, models, extra="", **more):
+    """C5 random held bed (150 grains of 2 mm, phi 0.3, cell 1.5 d): mid-depth and on the floor."""
+    for m in models:
+        for where, fl in (("mid-depth", 0), ("floor", 1)):
+            v = dict({"pressure": m, "floor": fl}, **more)
+            if extra:
+                v["extra"] = extra
+            tag = extra + "".join(f" {k} {x}" for k, x in more.items())
+            q, n, side, w = bed(r, f"c5/{m}_{fl}{tag.replace(' ', '_')}", **v)
+            emit("C5", m, f"{where}, cell 1.5 d, {n} grains" + (", " + tag.strip() if tag else ""), {"archimedes_ratio": q}, w)
+
+
+def row_c5wall(r, models, extra=""):
+    """C5 beside a plane mesh wall (meshwall 1), cell 1.5 d, mid-depth; sideways force from the log."""
+    for m in models:
+        for cellf in (1.5, 3):
+            v = {"pressure": m, "meshwall": 1, "cellf": cellf}
+            if cellf == 3:
+                v["nbeads"] = 600
+            if extra:
+                v["extra"] = extra
+            q, n, side, w = bed(r, f"c5wall/{m}_c{cellf}{extra.replace(' ', '_')}", **v)
+            emit("C5 mesh wall", m, f"plane mesh wall, cell {cellf} d, {n} grains" + (", " + extra if extra else ""),
+                 {"archimedes_ratio": q, "side_over_buoyancy": side}, w)
+
+
+def row_c5tilt(r, models):
+    """C5 beside a mesh wall inclined 20 degrees over the water (meshwall 1, tilt 20), mid-depth."""
+    for m in models:
+        for cellf in (1.5, 3):
+            v = {"pressure": m, "meshwall": 1, "tilt": 20, "cellf": cellf}
+            if cellf == 3:
+                v["nbeads"] = 600
+            q, n, side, w = bed(r, f"c5tilt/{m}_c{cellf}", **v)
+            emit("C5 inclined mesh wall", m, f"mesh wall inclined 20 deg, cell {cellf} d, {n} grains",
+                 {"archimedes_ratio": q, "side_over_buoyancy": side}, w)
+
+
+def row_c6(r, models, extra="", phis=(0.1, 0.2, 0.3), **more):
+    """C6 hindered settling (reduced: 4 x 4 x 12 cells of 2 mm, 0.15 s): v / reference (tools/suspension.py)."""
+    import suspension
+    for m in models:
+        for phi in phis:
+            v = dict({"nxy": 4, "nsus": 12, "tend": 0.15, "phi": phi, "pressure": m}, **more)
+            if extra:
+                v["extra"] = extra
+            tag = extra + "".join(f" {k} {x}" for k, x in more.items())
+            d, p, w = timed(r, f"c6/{m}_{phi}{tag.replace(' ', '_')}", "suspension/in.suspension", v)
+            info = suspension.result_line(p.stdout)
+            csv = os.path.join(d, "suspension.csv")
+            res = suspension.analyse(csv, 1.0, t1=0.08)
+            ph = suspension.phi_mid(res, info)
+            vref = suspension.reference(ph)[0]
+            res = suspension.analyse(csv, vref, t1=0.08)
+            emit("C6", m, f"phi {phi} (middle {ph:.3f}), reduced" + (", " + tag.strip() if tag else ""),
+                 {"v_ratio": res["ratio"], "ringing": res["ring"], "p_ringing": res["pring"]}, w)
+
+
+def row_porewave(r, models):
+    """Pore-pressure wave: a dense free lattice perturbed at random, dt 1e-5, 1000 steps: decays?"""
+    for m in models:
+        d, p, w = timed(r, f"porewave/{m}", "porewave/in.porewave", {"pressure": m, "nsteps": 1000, "nout": 50,
+                                                                      "dt": 1e-5})
+        c = read_csv(os.path.join(d, "porewave.csv"))
+        amp = [max(abs(a), abs(b)) for a, b in zip(c["pmax"], c["pmin"])]
+        late = max(amp[3 * len(amp) // 4:])
+        emit("porewave", m, "random displacement 1e-5 m, dt 1e-5, 1000 steps",
+             {"p_max_Pa": max(amp), "p_last_quarter_Pa": late, "grain_ke_max_J": max(c["keg"])}, w)
+        d, p, w = timed(r, f"porewave/{m}_wave", "porewave/in.porewave",
+                        {"pressure": m, "nsteps": 1000, "nout": 50, "dt": 1e-5, "amp": 0.01, "lam": 0.02, "disp": 0.0})
+        c = read_csv(os.path.join(d, "porewave.csv"))
+        amp = [max(abs(a), abs(b)) for a, b in zip(c["pmax"], c["pmin"])]
+        emit("porewave", m, "grain velocity wave 0.01 m/s, wavelength 0.02 m, dt 1e-5, 1000 steps",
+             {"p_max_Pa": max(amp), "grain_ke_end_over_max": c["keg"][-1] / max(c["keg"]),
+              "grain_ke_max_J": max(c["keg"])}, w)
+
+
+def row_c1var(r, models):
+    """C1 with the fluid damped (100 1/s) while the grain is held, flip and apic."""
+    row_c1(r, models, damp=100.0)
+    row_c1(r, models, extra="transfer apic", damp=100.0)
+
+
+def row_damping(r, models):
+    """C5 without the damping while settling (in.bed damps with eos), C6 (phi 0.3) with 200 1/s."""
+    row_c5(r, models, damp=0.0)
+    row_c6(r, models, phis=(0.3,), damp=200.0)
+
+
+def row_f4fine(r, models):
+    """F4 at 80 cells along the tank."""
+    row_f4(r, models, cells=(80,))
+
+
+def row_fluidapic(r, models):
+    """F2 MPM32 and F4 (20, 40 cells) with transfer apic instead of the default flip 1."""
+    row_f4(r, models, extra="transfer apic")
+    row_f2(r, models, cells=(32,), extra="transfer apic")
+
+
+def row_f3var(r, models):
+    """F3 with the other transfer: flip 1 for the projection (in.column sets apic), apic for eos."""
+    other = {"projection": "transfer flip 1", "eos": "transfer apic"}
+    for m in models:
+        row_f3(r, [m], extra=other[m])
+
+
+def row_transfer(r, models):
+    """The coupled rows with transfer apic instead of the default flip 1."""
+    row_c1(r, models, extra="transfer apic")
+    row_c5(r, models, extra="transfer apic")
+    row_c6(r, models, extra="transfer apic", phis=(0.3,))
+
+
+ROWS = {"f1": row_f1, "f2": row_f2, "f3": row_f3, "f4": row_f4, "c1": row_c1, "c2": row_c2, "c5": row_c5,
+        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "f4fine": row_f4fine, "fluidapic": row_fluidapic, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("rows", nargs="+")
+    ap.add_argument("--exe", default=os.path.join(TOP, "build", "liggghts_mpm"))
+    ap.add_argument("--work", default="/tmp/model_table")
+    ap.add_argument("--models", nargs="+", default=["projection", "eos"])
+    ap.add_argument("--json", default=None, help="append one JSON line per run to this file")
+    a = ap.parse_args()
+    a.exe, a.work = os.path.abspath(a.exe), os.path.abspath(a.work)
+    r = runner(a)
+    names = sorted(ROWS) if a.rows == ["all"] else a.rows
+    for n in names:
+        ROWS[n](r, a.models)
+    if a.json:
+        with open(a.json, "a") as f:
+            for rec in OUT:
+                f.write(json.dumps(rec) + "\n")
+
+
+if __name__ == "__main__":
+    main()
