@@ -45,7 +45,7 @@ int FixMpmFluid::parse_mesh_wall(int narg, char **arg, int iarg) {
   using mpm::bad_arg;
   using mpm::parse_double;
   const mpm::Args a{narg, arg, iarg};
-  a.need(2, "mesh_wall", "a fix ID and noslip | freeslip | partial f | sticky f | shear delta f");
+  a.need(2, "mesh_wall", "a fix ID and noslip | freeslip | partial f | sticky f | shear delta|auto f");
   mpm::MeshWallSpec ms;
   ms.fix_id = arg[iarg + 1];
   ms.side = mpm::SIDE_AUTO;
@@ -63,10 +63,13 @@ int FixMpmFluid::parse_mesh_wall(int narg, char **arg, int iarg) {
   } else if (strcmp(k, "shear") == 0) {
     // wall shear stress mu (f w_t - v_t) / delta: an unresolved viscous layer of thickness delta
     if (iarg + 1 >= narg)
-      bad_arg("mesh_wall shear", "a wall layer thickness delta (length) and a fraction f in [0,1]", nullptr);
+      bad_arg("mesh_wall shear", "a wall layer thickness delta (length) or 'auto', and a fraction f in [0,1]", nullptr);
     ms.kind = mpm::WALL_SHEAR;
-    if (!parse_double(arg[iarg], ms.delta) || !(ms.delta > 0.0))
-      bad_arg("mesh_wall shear", "a positive wall layer thickness delta (length)", arg[iarg]);
+    // shear auto f: the Stokes layer sqrt(2 nu / omega) of the mesh's rotation rate omega
+    if (strcmp(arg[iarg], "auto") == 0)
+      ms.delta_auto = true;
+    else if (!parse_double(arg[iarg], ms.delta) || !(ms.delta > 0.0))
+      bad_arg("mesh_wall shear", "a positive wall layer thickness delta (length) or 'auto'", arg[iarg]);
     if (!parse_double(arg[iarg + 1], ms.sticky) || ms.sticky < 0.0 || ms.sticky > 1.0)
       bad_arg("mesh_wall shear", "a fraction f in [0,1] of the wall's tangential velocity", arg[iarg + 1]);
     iarg += 2;

@@ -69,7 +69,7 @@ std::string check_wall(WallSpec &s) {
         m << "sticky fraction " << s.sticky << " of a partial-slip wall must lie in [0,1]";
         return m.str();
       }
-      if (s.kind == WALL_SHEAR && !(s.delta > 0.0 && std::isfinite(s.delta))) {
+      if (s.kind == WALL_SHEAR && !s.delta_auto && !(s.delta > 0.0 && std::isfinite(s.delta))) {
         std::ostringstream m;
         m << "wall layer thickness " << s.delta << " of a shear wall must be positive";
         return m.str();
@@ -116,6 +116,7 @@ bool WallGeometry::set_triangles(std::vector<Tri> tris, const double box[6], dou
   std::memcpy(box_, box, sizeof(box_));
   tris_ = std::move(tris);
   margin_ = margin;
+  fit_rotation();
 
   // bins over my box
   for (int d = 0; d < 3; ++d) {
@@ -432,7 +433,7 @@ int WallGeometry::collect(const double x[3], double reach_fluid, double reach_be
       wall_velocity(t, hits[h].b, o.w);
       for (int q = 0; q < 3; ++q) o.n[q] = n[q];
       o.sticky = sticky;
-      o.rate = walls_[k].kind == WALL_SHEAR ? wall_layer_rate(nu_, walls_[k].delta, reach_fluid) : 0.0;
+      o.rate = walls_[k].kind == WALL_SHEAR ? wall_layer_rate(nu_, layer_thickness(static_cast<int>(k)), reach_fluid) : 0.0;
       o.behind = behind;
       o.imposed = walls_[k].kind == WALL_STICKY;
     }
@@ -762,6 +763,79 @@ int WallGeometry::node_side(const double x[3], double reach, double *dist) const
   }
   if (!found || two_sided) return 0;
   return all_back ? -1 : 1;
+}
+
+// The rigid motion w = v0 + omega x (x - c) nearest (least squares) to the node velocities of each
+// wall's triangles, c the mean node position, v0 the mean node velocity: with r = x - c and
+// u = w - v0, omega solves sum (|r|^2 I - r r^T) omega = sum r x u (exact for a rigid rotation;
+// singular only for nodes on one line, then 0).
+void WallGeometry::fit_rotation() {
+  const std::size_t nw = walls_.size();
+  omega_.assign(nw, 0.0);
+  for (std::size_t k = 0; k < nw; ++k) {
+    if (!(walls_[k].kind == WALL_SHEAR && walls_[k].delta_auto)) continue;
+    double c[3] = {0, 0, 0}, v0[3] = {0, 0, 0};
+    long n = 0;
+    for (const Tri &t : tris_)
+      if (t.mesh == static_cast<int>(k))
+        for (int a = 0; a < 3; ++a, ++n)
+          for (int d = 0; d < 3; ++d) {
+            c[d] += t.p[a][d];
+            v0[d] += t.w[a][d];
+          }
+    if (n < 3) continue;
+    for (int d = 0; d < 3; ++d) {
+      c[d] /= n;
+      v0[d] /= n;
+    }
+    double A[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, b[3] = {0, 0, 0};
+    for (const Tri &t : tris_) {
+      if (t.mesh != static_cast<int>(k)) continue;
+      for (int a = 0; a < 3; ++a) {
+        double r[3], u[3];
+        for (int d = 0; d < 3; ++d) {
+          r[d] = t.p[a][d] - c[d];
+          u[d] = t.w[a][d] - v0[d];
+        }
+        const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+        for (int d = 0; d < 3; ++d)
+          for (int e = 0; e < 3; ++e) A[d][e] += (d == e ? r2 : 0.0) - r[d] * r[e];
+        b[0] += r[1] * u[2] - r[2] * u[1];
+        b[1] += r[2] * u[0] - r[0] * u[2];
+        b[2] += r[0] * u[1] - r[1] * u[0];
+      }
+    }
+    // Cramer's rule on the symmetric 3x3 system
+    auto det3 = [](const double m[3][3]) {
+      return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+             m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    };
+    const double D = det3(A);
+    const double scale = A[0][0] + A[1][1] + A[2][2];
+    if (!(std::fabs(D) > 1e-12 * scale * scale * scale)) continue;
+    double om[3];
+    for (int col = 0; col < 3; ++col) {
+      double M[3][3];
+      for (int d = 0; d < 3; ++d)
+        for (int e = 0; e < 3; ++e) M[d][e] = e == col ? b[d] : A[d][e];
+      om[col] = det3(M) / D;
+    }
+    // a turn below the round-off of the node velocities is none (a translating wall)
+    double vmax = 0.0;
+    for (const Tri &t : tris_)
+      if (t.mesh == static_cast<int>(k))
+        for (int a = 0; a < 3; ++a) vmax = std::max(vmax, std::sqrt(t.w[a][0] * t.w[a][0] + t.w[a][1] * t.w[a][1] + t.w[a][2] * t.w[a][2]));
+    const double w = std::sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);
+    const double rrms = std::sqrt(0.5 * scale / n);  // trace A = 2 sum |r|^2
+    omega_[k] = w * rrms > 1e-12 * vmax ? w : 0.0;
+  }
+}
+
+double WallGeometry::layer_thickness(int k) const {
+  const WallSpec &s = walls_[k];
+  if (!s.delta_auto) return s.delta;
+  const double om = rotation_rate(k);
+  return om > 0.0 ? std::sqrt(2.0 * nu_ / om) : HUGE_VAL;
 }
 
 }  // namespace mpm

@@ -42,6 +42,8 @@ struct WallSpec {
   double sticky = 1.0;  // tangential damping in [0,1]; forced to 1 (noslip) or 0 (freeslip);
                         // sticky and shear: the fraction f of the wall's tangential velocity
   double delta = 0.0;   // shear: thickness of the (unresolved) viscous wall layer, > 0 (length)
+  bool delta_auto = false;  // shear auto: delta = sqrt(2 nu / omega), the Stokes layer of the
+                            // mesh's rotation rate omega (fitted to its triangles' velocities)
   int side = SIDE_NORMAL;  // MeshSide
 };
 
@@ -129,6 +131,12 @@ class WallGeometry {
   static void impose(const WallConstraint *c, int n, double vel[3], double h = 0.0);
   // Kinematic viscosity of the fluid, for the shear walls.
   void set_kinematic_viscosity(double nu) { nu_ = nu; }
+  // Rotation rate |omega| (rad/time) of wall k fitted to the velocities of its triangles' nodes
+  // held now (rigid motion w = v0 + omega x (x - c), least squares; 0 without triangles of wall k
+  // or for a translating or resting wall), and the wall layer thickness its shear condition uses
+  // (delta, or sqrt(2 nu / |omega|) with shear auto: infinite for a wall that does not turn).
+  double rotation_rate(int k) const { return k < static_cast<int>(omega_.size()) ? omega_[k] : 0.0; }
+  double layer_thickness(int k) const;
 
   // Nearest triangle face to x within 'reach' (the closest point inside a triangle, not on an edge
   // or vertex only): q = that point, n = unit normal towards x's side (the fluid side of a
@@ -190,6 +198,8 @@ class WallGeometry {
   double box_[6] = {0, 0, 0, 0, 0, 0};  // of the last set_triangles
   bool have_set_ = false;
   double nu_ = 0.0;  // kinematic viscosity (shear walls)
+  std::vector<double> omega_;  // rotation rate of each wall (set_triangles)
+  void fit_rotation();
   // uniform bins over [blo_, blo_ + nb_*bsize_]
   double blo_[3] = {0, 0, 0}, bsize_ = 1.0;
   int nb_[3] = {0, 0, 0};

@@ -414,3 +414,60 @@ TEST(WallGeometry, SetTrianglesReportsChange) {
   EXPECT_TRUE(g.set_triangles({faster[0]}, box2, 0.2));  // a triangle fewer
   EXPECT_EQ(g.gathered(), 1);
 }
+
+// shear auto: the wall layer is the Stokes layer sqrt(2 nu / omega) of the mesh's rotation, omega
+// fitted to its triangles' node velocities. A drum band (16 facets, axis along x through
+// (0, 0.2, -0.1)) turning at 10.9 rad/s while it also translates: the fit returns |omega| to
+// round-off, whatever the axis and the translation; a part of the band (one rank's triangles)
+// gives the same; the same band at rest or only translating has no rotation, so no layer stress.
+TEST(WallGeometry, ShearAutoTakesTheStokesLayerOfTheRotation) {
+  const double om[3] = {10.9 * 0.6, 10.9 * 0.8, 0.0}, axis_pt[3] = {0.0, 0.2, -0.1}, v0[3] = {0.3, -0.1, 0.05};
+  const double R = 0.08, len = 0.04;
+  // unit axis e1 = omega / |omega| and two normals e2, e3
+  const double e1[3] = {0.6, 0.8, 0.0}, e2[3] = {-0.8, 0.6, 0.0}, e3[3] = {0.0, 0.0, 1.0};
+  auto point = [&](double s, double phi, double *x, double *w) {
+    for (int d = 0; d < 3; ++d) x[d] = axis_pt[d] + s * e1[d] + R * (std::cos(phi) * e2[d] + std::sin(phi) * e3[d]);
+    const double r[3] = {x[0] - axis_pt[0], x[1] - axis_pt[1], x[2] - axis_pt[2]};
+    w[0] = v0[0] + om[1] * r[2] - om[2] * r[1];
+    w[1] = v0[1] + om[2] * r[0] - om[0] * r[2];
+    w[2] = v0[2] + om[0] * r[1] - om[1] * r[0];
+  };
+  auto band = [&](int first, int last, bool moving) {
+    std::vector<Tri> tris;
+    const int nf = 16;
+    for (int f = first; f < last; ++f) {
+      const double a0 = 2 * M_PI * f / nf, a1 = 2 * M_PI * (f + 1) / nf;
+      double p[4][3], w[4][3];
+      point(0.0, a0, p[0], w[0]);
+      point(0.0, a1, p[1], w[1]);
+      point(len, a1, p[2], w[2]);
+      point(len, a0, p[3], w[3]);
+      const int q[2][3] = {{0, 1, 2}, {0, 2, 3}};
+      for (int h = 0; h < 2; ++h) {
+        Tri t = make_tri(p[q[h][0]], p[q[h][1]], p[q[h][2]], 0, 2 * f + h);
+        for (int j = 0; j < 3; ++j)
+          for (int d = 0; d < 3; ++d) t.w[j][d] = moving ? w[q[h][j]][d] : v0[d];
+        tris.push_back(t);
+      }
+    }
+    return tris;
+  };
+  WallSpec s = wall(mpm::WALL_SHEAR, 1.0, mpm::SIDE_NORMAL, 0.0);
+  s.delta_auto = true;
+  EXPECT_EQ(mpm::check_wall(s), "");
+  const double nu = 1e-6, box[6] = {-1, -1, -1, 1, 1, 1};
+  WallGeometry g({s});
+  g.set_kinematic_viscosity(nu);
+  g.set_triangles(band(0, 16, true), box, 0.01);
+  EXPECT_NEAR(g.rotation_rate(0), 10.9, 1e-12 * 10.9);
+  EXPECT_NEAR(g.layer_thickness(0), std::sqrt(2 * nu / 10.9), 1e-12 * std::sqrt(2 * nu / 10.9));
+  g.set_triangles(band(3, 6, true), box, 0.01);  // three facets only
+  EXPECT_NEAR(g.rotation_rate(0), 10.9, 1e-10 * 10.9);
+  g.set_triangles(band(0, 16, false), box, 0.01);  // translating only
+  EXPECT_NEAR(g.rotation_rate(0), 0.0, 1e-12);
+  EXPECT_TRUE(std::isinf(g.layer_thickness(0)));
+  // a given delta is kept as it is
+  WallGeometry fixed({wall(mpm::WALL_SHEAR, 1.0, mpm::SIDE_NORMAL, 2.5e-4)});
+  fixed.set_triangles(band(0, 16, true), box, 0.01);
+  EXPECT_EQ(fixed.layer_thickness(0), 2.5e-4);
+}
