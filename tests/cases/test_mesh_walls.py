@@ -10,6 +10,7 @@ The inputs are tests/data/in.mesh_walls_box, in.mesh_walls_gate and in.mesh_wall
 STL files tests/data/box.stl, gate.stl and drum.stl. Exit status 0 when every check passes.
 """
 import argparse
+import math
 import os
 import subprocess
 import sys
@@ -160,6 +161,16 @@ def case_drum(r):
               f"{name}: vcm_x {c['vcm_x'][1]:.4f} vs {ref['vcm_x'][1]:.4f} m/s within 2 %")
     check(abs(thick["vcm_x"][1]) < 0.3 * abs(ns["vcm_x"][1]),
           f"shear 1e-4 1 drags little: |vcm_x| {abs(thick['vcm_x'][1]):.3f} < 0.3 x {abs(ns['vcm_x'][1]):.3f}")
+    # shear auto 1: the fix takes delta = sqrt(2 nu / omega) from the mesh's rotation; the same
+    # run with that delta given by hand (nu = 1e-3 / 1000, omega = 2 pi 104 / 60) must agree to
+    # round-off (the fitted omega is exact for a rigid rotation)
+    delta = math.sqrt(2.0 * 1e-6 / (2.0 * math.pi * 104.0 / 60.0))
+    au = drum_run(r, "drum_shear_auto", "shear auto 1")
+    byhand = drum_run(r, "drum_shear_byhand", f"shear {delta:.12g} 1")
+    for i in range(len(au["t"])):
+        check(abs(au["vcm_x"][i] - byhand["vcm_x"][i]) <= 1e-9 + 1e-6 * abs(byhand["vcm_x"][i]),
+              f"shear auto 1 = shear {delta:.4g} 1 at t = {au['t'][i]:.3f} s: vcm_x {au['vcm_x'][i]:.9f} "
+              f"vs {byhand['vcm_x'][i]:.9f} m/s")
 
 
 def case_drum_np2(r):
