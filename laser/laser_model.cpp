@@ -394,11 +394,16 @@ Drill::Geometry Drill::front_geometry(int i, const std::vector<double>& S2old, d
 }
 
 // Backward Euler in g: g_new = g_old + dtau (dS2 - dS1 + v)(g_new), with the
-// solid gradient, curvature, b2 and flow frozen over the step. The right side
+// solid gradient, curvature, the flow and its heat flux b2 g frozen over the step. The right side
 // decreases with g, so the root is unique and bracketed.
 void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n, double dtn) {
+  // The flow's part of the layer's gradients, b2 g (half the heat the flow
+  // carries sideways, 2 b2 g), is what the last step's (4-27) determined and is
+  // held over the step; holding b2 itself would let b2 g grow with g_new.
+  const double b2g = n.b2 * n.g;
+  auto b2_at = [&](double g) { return g > 0.0 ? b2g / g : 0.0; };
   auto rate = [&](double g) {
-    const InterfaceState st = solve_interface(G_, n.xi, g, n.b2, advected_);
+    const InterfaceState st = solve_interface(G_, n.xi, g, b2_at(g), advected_);
     const double d2 =
         std::max(melting_rate(G_, geo.Cc, grad_n, geo.J, st.grad_bottom, cfg_.moving_origin), 0.0);
     const double d1 = std::max(recession_rate(G_, n.xi, st), 0.0);
@@ -417,6 +422,7 @@ void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n
     for (int k = 0; Fhi < 0.0 && k < 60; ++k) { hi = 2.0 * hi + 1e-12; Fhi = F(hi); }
     g_new = illinois_root(F, 0.0, hi, F0, Fhi, 1e-12 * std::max(hi, 1e-12)).x;
   }
+  n.b2 = b2_at(g_new);
   n.itf = solve_interface(G_, n.xi, g_new, n.b2, advected_);
 }
 
