@@ -84,8 +84,10 @@ class Drill {
   double A_ = 0, u_peak_ = 0;
   double lambda_max_ = 0;
   double dtau_ = 0;
-  std::string flow_failure_;
+  double tb_ = 0;  // end of the current step (tau), for messages
+  std::string flow_failure_, flow_cause_;
   std::string first_clamp_;
+  std::string first_b2_, first_bl_;
   long flow_substeps_ = 0;
   int idx_x1_ = 0;
 };
@@ -184,6 +186,7 @@ bool Drill::solve_melt_flow(double ta, double tb) {
   if (Q1 == 0.0) return true;  // no melt off the axis yet
   const CubicRoot root = select_flow_root(Q1, Q2, Q3, Q4);
   if (!root.ok || !std::isfinite(root.A)) {
+    flow_cause_ = "no root of (4-19)";
     flow_failure_ = "no physical root of the cubic (4-19): " + root.note;
     return false;
   }
@@ -282,6 +285,7 @@ bool Drill::conservative_flow(const FlowProfile& profile, int first, double ta, 
     }
     t = (dts == dtau - t) ? dtau : t + dts;
     if (++sub > kMaxFlowSubsteps) {
+      flow_cause_ = "melt flow faster than the grid can carry";
       flow_failure_ = "melt flow faster than the grid can carry: more than " + std::to_string(kMaxFlowSubsteps) +
                       " flux sub-steps in one time step (A = " + fmt(A_, 4) + "; Courant number u dt/dr about " +
                       fmt(worst * dtau, 4) + ")";
@@ -330,6 +334,17 @@ void Drill::solve_boundary_layer(int& last_bl) {
   };
   if (!(U[1] > 0.0)) return;
   double d = std::sqrt(70.0 * Pr * h / (37.0 * U[1]));
+  // The boundary-layer profile (4-7) needs delta < g; where the layer is already
+  // thicker than the melt at the first node, the boundary model cannot be
+  // applied at all in this step (the integral profile takes over from the axis)
+  ++res_.bl_steps;
+  if (!(d < nodes_[1].g) && nodes_[1].g > 0.0) {
+    if (res_.bl_thicker_steps++ == 0) {
+      res_.bl_first_ratio = d / nodes_[1].g;
+      first_bl_ = "first at t = " + fmt(tb_ * G_.t_scale, 4) + " s: delta/g = " + fmt(d / nodes_[1].g, 4) +
+                  " at xi = " + fmt(nodes_[1].xi, 4);
+    }
+  }
   for (int i = 1; i < end - 1; ++i) {
     Node& n = nodes_[i];
     if (!(d > 0.0) || !std::isfinite(d) || d >= n.g) break;
@@ -579,6 +594,10 @@ void Drill::melt_temperature() {
     // Safeguard: keep the profile (4-25) monotone in [0, g], |b2 g^2| <= theta_sat.
     const double bmax = th / (g * g);
     if (std::fabs(n.b2) > bmax || !std::isfinite(n.b2)) {
+      const double ask = std::fabs(n.b2) / bmax;
+      if (res_.b2_clamps == 0)
+        first_b2_ = "first at xi = " + fmt(x, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
+      if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
       ++res_.b2_clamps;
       n.b2 = std::isfinite(n.b2) ? std::copysign(bmax, n.b2) : 0.0;
     }
@@ -719,8 +738,22 @@ void Drill::assess() {
                                                                          "not conserve the melt; --melt-flow conservative)"
                                                                        : ""));
   if (res_.b2_clamps > kSafeguardFraction * node_steps)
-    cause("b2 limiter", "|b2| g^2 <= theta_sat of (4-25) enforced " + std::to_string(res_.b2_clamps) +
-                            " times (" + fmt(res_.b2_clamps / node_steps, 3) + " of the node steps)");
+    cause("b2 limiter", "the quadratic melt temperature profile (4-25) cannot carry the heat the flow moves "
+                        "sideways: (4-27) asks for |b2| g^2 / theta_sat up to " + fmt(res_.b2_demand_max, 4) +
+                        " (monotone profile: at most 1); limited to 1 " + std::to_string(res_.b2_clamps) +
+                        " times (" + fmt(res_.b2_clamps / node_steps, 3) + " of the node steps; " + first_b2_ + ")");
+  // named as a cause where the boundary model was not applied in most steps; a
+  // few steps (the first ones after onset, when the melt is one step thick) are a note
+  if (cfg_.model == FlowModel::Boundary && res_.bl_thicker_steps > 0 && 2 * res_.bl_thicker_steps <= res_.bl_steps)
+    res_.notes.push_back("boundary layer thicker than the melt at the first node off the axis in " +
+                         std::to_string(res_.bl_thicker_steps) + " of " + std::to_string(res_.bl_steps) +
+                         " steps (" + first_bl_ + "): the integral profile was used from the axis there");
+  if (cfg_.model == FlowModel::Boundary && 2 * res_.bl_thicker_steps > res_.bl_steps)
+    cause("boundary layer thicker than the melt",
+          "the boundary layer (4-9) is thicker than the melt at the first node off the axis in " +
+              std::to_string(res_.bl_thicker_steps) + " of " + std::to_string(res_.bl_steps) +
+              " steps (" + first_bl_ + "); there the boundary-layer profile (4-7) does not apply and the "
+              "integral profile of --model risingfall is used from the axis");
   if (res_.curvature_clamps > kSafeguardFraction * node_steps)
     cause("curvature clamp", "|a d| >= 2 in (3-37) clamped " + std::to_string(res_.curvature_clamps) + " times (" +
                                  first_clamp_ + ")");
@@ -782,11 +815,13 @@ Result Drill::run() {
   for (long step = 0; step < nsteps; ++step) {
     const double ta = tau;
     const double tb = (step == nsteps - 1) ? tau_p : std::min(tau_p, (step + 1) * dtau_);
+    tb_ = tb;
     melt_onset(tb);
     solve_interfaces();
     if (!state_admissible(tb)) break;
     if (!solve_melt_flow(ta, tb)) {
       res_.status = "no_flow_solution";
+      res_.causes.push_back(flow_cause_);
       res_.message = flow_failure_ + " at t = " + fmt(ta * G_.t_scale, 4) + " s";
       break;
     }

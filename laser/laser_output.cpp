@@ -432,6 +432,8 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["A_last"] = num(r.A_last);
   j["xi_melt_edge"] = num(r.xi_melt_edge);
   j["boundary_layer_last_xi"] = num(r.bl_last_xi);
+  j["boundary_layer_thicker_than_melt_steps"] = r.bl_thicker_steps;
+  j["b2_demand_max"] = num(r.b2_demand_max);
   j["steps"] = r.steps;
   j["nodes"] = r.nodes;
   j["frames"] = r.frames_written;

@@ -315,3 +315,41 @@ TEST(LaserMelt, ImplicitUpdateStaysBoundedAtLargeSteps) {
     EXPECT_LT(r.T_peak, m.Tc) << dt;
   }
 }
+
+// Where the model's assumptions fail the run says so by name: no root of the
+// least-squares cubic (4-19) (Pr = 142000: no positive root at the first step);
+// a boundary layer (4-9) thicker than the melt (the boundary model at Pr = 142,
+// where delta/g at the first node off the axis is about 1e3); the quadratic
+// profile (4-25) asked by (4-27) for more than a monotone profile holds
+// (|b2| g^2 / theta_sat > 1 at Pr = 1420).
+TEST(LaserStatus, ModelAssumptionFailuresAreNamed) {
+  Config c = short_case(142000.0, MeltFlow::Conservative);
+  c.tp = 20e-6;
+  c.dt = 1e-7;
+  const Result r = run_simulation(c);
+  EXPECT_EQ(r.status, "no_flow_solution") << r.message;
+  EXPECT_TRUE(has_cause(r, "no root of (4-19)")) << r.message;
+  EXPECT_NE(r.message.find("(4-19)"), std::string::npos) << r.message;
+
+  Config b = short_case(142.0, MeltFlow::Conservative);
+  b.model = FlowModel::Boundary;
+  b.dt = 1e-7;
+  const Result rb = run_simulation(b);
+  std::printf("[ STATUS ] boundary model, Pr 142: %ld of %ld steps delta >= g, first delta/g %.4g; %s\n",
+              rb.bl_thicker_steps, rb.bl_steps, rb.bl_first_ratio, rb.status.c_str());
+  EXPECT_TRUE(has_cause(rb, "boundary layer thicker than the melt")) << rb.message;
+  EXPECT_GT(2 * rb.bl_thicker_steps, rb.bl_steps);
+  EXPECT_GT(rb.bl_first_ratio, 1.0);
+  EXPECT_EQ(rb.status, "inaccurate");
+  // at the text's Pr the layer is thinner than the melt in most steps: a note, not a cause
+  Config b0 = b;
+  b0.mat.Pr = 0.142;
+  const Result r0 = run_simulation(b0);
+  EXPECT_FALSE(has_cause(r0, "boundary layer thicker than the melt")) << r0.message;
+  EXPECT_LE(2 * r0.bl_thicker_steps, r0.bl_steps);
+
+  const Result rp = run_simulation(short_case(1420.0, MeltFlow::Conservative));
+  EXPECT_TRUE(has_cause(rp, "b2 limiter"));
+  EXPECT_GT(rp.b2_demand_max, 1.0);
+  EXPECT_NE(rp.message.find("cannot carry the heat"), std::string::npos) << rp.message;
+}
