@@ -20,6 +20,7 @@ struct Node {
   InterfaceState itf;
   double dS1 = 0, dS2 = 0, v = 0, f = 0;  // rates of the last step, f: u = f zeta
   double v_kin = 0;  // conservative flow: -(1/xi) d(xi Q)/dxi at the start of the step (used in (4-27))
+  double heat_div = 0;  // conservative flow: (1/xi) d(xi int u theta dzeta)/dxi by face fluxes, start of the step
   double last_dg = 0;  // dg/dtau of the last step
   int flips = 0;       // consecutive sign changes of dg/dtau with lambda dtau > 2
 };
@@ -142,7 +143,7 @@ void Drill::solve_interfaces() {
 // the vertical surface velocity v(xi, g) that enters (4-13).
 bool Drill::solve_melt_flow(double ta, double tb) {
   const int N = static_cast<int>(nodes_.size());
-  for (auto& n : nodes_) { n.v = 0.0; n.f = 0.0; n.v_kin = 0.0; }
+  for (auto& n : nodes_) { n.v = 0.0; n.f = 0.0; n.v_kin = 0.0; n.heat_div = 0.0; }
   A_ = 0.0;
   u_peak_ = 0.0;
   if (cfg_.model == FlowModel::Conduction) return true;
@@ -253,6 +254,12 @@ bool Drill::conservative_flow(const FlowProfile& profile, int first, double ta, 
     const double q = std::fabs(c[k]) * gs[up] * gs[up];
     nodes_[up].v_kin -= q / a[up];
     if (dn < N && active[dn]) nodes_[dn].v_kin += q / a[dn];
+    // heat carried through the face: the volume flux at the flux-weighted mean
+    // temperature of the upwind layer, int u theta / int u = 2 theta_sat/3 (u = f zeta,
+    // linear part of (4-25)); the same value leaves one cell and enters the next
+    const double H = q * 2.0 * std::max(nodes_[up].itf.theta_sat, 0.0) / 3.0;
+    nodes_[up].heat_div += H / a[up];
+    if (dn < N && active[dn]) nodes_[dn].heat_div -= H / a[dn];
   }
   double t = 0.0, expelled = 0.0;
   long sub = 0;
@@ -568,6 +575,24 @@ void Drill::advance_interfaces(double ta, double tb) {
 // g and f of this step. The text lags b2 between steps only in (4-30).
 void Drill::melt_temperature() {
   if (cfg_.model == FlowModel::Conduction) return;
+  if (cfg_.flux_heat) {
+    // finite-volume heat flux: the layer gives (takes) what the flow carries out of
+    // (into) the column through its faces; 2 b2 g = heat_div (docs 2.7)
+    for (auto& n : nodes_) {
+      if (!n.molten || !(n.g > 0.0)) { n.b2 = 0.0; continue; }
+      n.b2 = n.heat_div / (2.0 * n.g);
+      const double th = n.itf.theta_sat;
+      if (std::fabs(n.b2) * n.g * n.g > th) {
+        const double ask = th > 0.0 ? std::fabs(n.b2) * n.g * n.g / th : std::numeric_limits<double>::infinity();
+        if (res_.b2_clamps == 0) first_b2_ = "first at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
+        if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
+        ++res_.b2_clamps;
+        // without this limit the runs diverge (Pr 142, d(xi) 0.0125; docs 2.7)
+        n.b2 = th > 0.0 ? std::copysign(th / (n.g * n.g), n.b2) : 0.0;
+      }
+    }
+    return;
+  }
   const int N = static_cast<int>(nodes_.size());
   const double h = cfg_.dxi;
   const bool outward = A_ >= 0.0;

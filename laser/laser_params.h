@@ -45,6 +45,7 @@ struct Config {
   SolidModel solid = SolidModel::Exact;
   MeltEnergy melt_energy = MeltEnergy::Advected;
   MeltFlow melt_flow = MeltFlow::Conservative;
+  bool flux_heat = false;  // b2 of (4-25) from finite-volume face heat fluxes instead of the ODE (4-27)
   // Recoil pressure that drives the melt flow, as a fraction of p_sat(T_s): 1 =
   // the text (full saturation pressure), 0.54 = Anisimov (1968) / Knight (1979)
   // for strong evaporation with a Knudsen layer.

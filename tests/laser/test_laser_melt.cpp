@@ -353,3 +353,27 @@ TEST(LaserStatus, ModelAssumptionFailuresAreNamed) {
   EXPECT_GT(rp.b2_demand_max, 1.0);
   EXPECT_NE(rp.message.find("cannot carry the heat"), std::string::npos) << rp.message;
 }
+
+// The heat the flow carries sideways: an advective transport can only move heat,
+// so summed over the melt the heat taken sideways (energy term flow_advected)
+// is >= 0 (what leaves over the rim). The ODE (4-27) breaks this at Pr = 1420
+// (d(xi) 0.05: -0.119 of the beam, heat created, the mechanism of the failed
+// column bound); --melt-heat flux (face fluxes) keeps it, and every column
+// stays under its energy bound (measured 0.828 at both grids).
+TEST(LaserMelt, FluxHeatTransportCreatesNoHeat) {
+  for (double dxi : {0.05, 0.0125}) {
+    Config c = short_case(1420.0, MeltFlow::Conservative);
+    c.dxi = dxi;
+    Config f = c;
+    f.flux_heat = true;
+    const Result ro = run_simulation(c), rf = run_simulation(f);
+    std::printf("[ HEAT ] Pr 1420, d(xi) %g: flow_advected/beam ode %.4f flux %.4f; column bound ode %.4f flux %.4f\n",
+                dxi, ro.energy.flow_advected / ro.energy.laser_exact, rf.energy.flow_advected / rf.energy.laser_exact,
+                ro.check.worst_node_ratio, rf.check.worst_node_ratio);
+    EXPECT_GE(rf.energy.flow_advected, 0.0) << dxi;
+    EXPECT_LT(rf.check.worst_node_ratio, 1.0) << dxi;
+    EXPECT_LT(rf.check.melt_vap_over_beam, 1.0) << dxi;
+    EXPECT_NE(rf.status, "diverged");
+    if (dxi == 0.05) EXPECT_LT(ro.energy.flow_advected, 0.0) << "the ODE (4-27) creates heat here";
+  }
+}
