@@ -68,6 +68,7 @@ class Drill {
   void book_energy(const Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn);
   void move_fronts(Node& n, const Rates& r, double dtn);
   void melt_temperature();
+  void flux_heat_march();
   void record(double tau, bool frame);
   void emit(Frame&& f);
   void physical_check();
@@ -90,6 +91,8 @@ class Drill {
   std::string first_clamp_;
   std::string first_b2_, first_bl_;
   long flow_substeps_ = 0;
+  std::vector<double> face_c_;  // conservative flow: face volume-rate coefficients c_k (rate c_k g_up^2)
+  int first_c_ = 0;             // first node of the integral profiles
   int idx_x1_ = 0;
 };
 
@@ -248,6 +251,8 @@ bool Drill::conservative_flow(const FlowProfile& profile, int first, double ta, 
     const double xf = (i + 0.5) * h;
     c[i] = kPi * xf * flow_shape(profile, A_, xf);
   }
+  face_c_ = c;
+  first_c_ = first_c;
   for (int k = first_c; k < N; ++k) {  // rates at the start of the step, for (4-27)
     const int up = c[k] >= 0.0 ? k : k + 1, dn = c[k] >= 0.0 ? k + 1 : k;
     if (up >= N || !active[up]) continue;
@@ -575,22 +580,8 @@ void Drill::advance_interfaces(double ta, double tb) {
 // g and f of this step. The text lags b2 between steps only in (4-30).
 void Drill::melt_temperature() {
   if (cfg_.model == FlowModel::Conduction) return;
-  if (cfg_.flux_heat) {
-    // finite-volume heat flux: the layer gives (takes) what the flow carries out of
-    // (into) the column through its faces; 2 b2 g = heat_div (docs 2.7)
-    for (auto& n : nodes_) {
-      if (!n.molten || !(n.g > 0.0)) { n.b2 = 0.0; continue; }
-      n.b2 = n.heat_div / (2.0 * n.g);
-      const double th = n.itf.theta_sat;
-      if (std::fabs(n.b2) * n.g * n.g > th) {
-        const double ask = th > 0.0 ? std::fabs(n.b2) * n.g * n.g / th : std::numeric_limits<double>::infinity();
-        if (res_.b2_clamps == 0) first_b2_ = "first at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
-        if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
-        ++res_.b2_clamps;
-        // without this limit the runs diverge (Pr 142, d(xi) 0.0125; docs 2.7)
-        n.b2 = th > 0.0 ? std::copysign(th / (n.g * n.g), n.b2) : 0.0;
-      }
-    }
+  if (cfg_.flux_heat()) {
+    flux_heat_march();
     return;
   }
   const int N = static_cast<int>(nodes_.size());
@@ -627,6 +618,66 @@ void Drill::melt_temperature() {
       n.b2 = std::isfinite(n.b2) ? std::copysign(bmax, n.b2) : 0.0;
     }
     fJ_up = f * (th * g * g / 3.0 - n.b2 * std::pow(g, 4) / 12.0);
+  }
+}
+
+// --melt-heat flux (docs/laser_model.md 2.7): the heat the flow carries through
+// the cell faces, volume rate q = |c_k| g_up^2 at the flux-weighted mean
+// temperature 2 theta_sat/3 of the upwind layer, and the layer's gradients
+// 2 b2 g = D (heat per unit area and time leaving the column) are solved
+// together, marching with the flow: the heat entering a column comes from its
+// upwind neighbour (already solved), the heat leaving it depends on its own
+// theta_sat, which in turn falls as b2 g rises: one bracketed root in the
+// surface temperature (solve_interface_flux). Implicit and upwind, the
+// march has no grid-dependent step limit; lagging D from one step to the next
+// made an odd-even oscillation beyond xi = 1.6 at Pr 142 (docs 2.7).
+void Drill::flux_heat_march() {
+  const int N = static_cast<int>(nodes_.size());
+  const double R2 = cfg_.R * cfg_.R;
+  const bool outward = A_ >= 0.0;
+  std::vector<double> theta_out(N, 0.0);  // flux-weighted temperature of the heat a node sends
+  std::vector<char> done(N, 0);
+  auto active = [&](int i) { return i >= first_c_ && i < N && nodes_[i].molten && nodes_[i].g > 0.0; };
+  for (int k = 0; k < N; ++k) {
+    const int i = outward ? k : N - 1 - k;
+    Node& n = nodes_[i];
+    if (!active(i) || face_c_.empty()) { n.b2 = 0.0; continue; }
+    const double a = n.area / R2, g = n.g;
+    double qout = 0.0, hin = 0.0;
+    for (int f : {i - 1, i}) {  // faces between i-1|i and i|i+1
+      if (f < first_c_ || f < 0 || f >= N) continue;
+      const double cf = face_c_[f];
+      const int up = cf >= 0.0 ? f : f + 1;
+      if (up == i) {
+        qout += std::fabs(cf) * g * g;
+      } else if (active(up) && done[up]) {
+        hin += std::fabs(cf) * nodes_[up].g * nodes_[up].g * theta_out[up];
+      }
+    }
+    if (qout == 0.0 && hin == 0.0) {
+      n.b2 = 0.0;
+      done[i] = 1;
+      continue;
+    }
+    // b2 g = (qout 2 theta_sat/3 - hin) / (2 a) = beta theta_sat - gamma
+    n.itf = solve_interface_flux(G_, n.xi, g, qout / (3.0 * a), hin / (2.0 * a), advected_);
+    n.b2 = (qout / (3.0 * a) * std::max(n.itf.theta_sat, 0.0) - hin / (2.0 * a)) / g;
+    const double th = std::max(n.itf.theta_sat, 0.0);
+    if (std::fabs(n.b2) * g * g > th) {
+      const double ask = th > 0.0 ? std::fabs(n.b2) * g * g / th : std::numeric_limits<double>::infinity();
+      if (res_.b2_clamps == 0) first_b2_ = "first at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
+      if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
+      ++res_.b2_clamps;
+      n.b2 = th > 0.0 ? std::copysign(th / (g * g), n.b2) : 0.0;
+      n.itf = solve_interface(G_, n.xi, g, n.b2, advected_);
+    }
+    // what the column sends on is what came in minus what it keeps, 2 a b2 g: with
+    // the solved b2 g this is qout 2 theta_sat/3; where the limit of (4-25) held b2
+    // back, the heat the layer could not take (or give) stays with the flow, so the
+    // face fluxes still telescope (heat is moved, never lost or made)
+    theta_out[i] = qout > 0.0 ? std::max(hin + 2.0 * a * n.b2 * g, 0.0) / qout
+                              : 2.0 / 3.0 * std::max(n.itf.theta_sat, 0.0);
+    done[i] = 1;
   }
 }
 

@@ -455,7 +455,7 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
                {"Pr", num(cfg.mat.Pr)},             {"solid", to_string(cfg.solid)},
                {"melt_energy", to_string(cfg.melt_energy)},
                {"melt_flow", to_string(cfg.melt_flow)},
-               {"melt_heat", cfg.flux_heat ? "flux" : "ode"},
+               {"melt_heat", cfg.flux_heat() ? "flux" : "ode"},
                {"recoil_fraction_of_p_sat", num(cfg.recoil)},
                {"absorptivity", num(cfg.absorptivity)},
                {"melt_update", cfg.implicit_melt ? "implicit" : "explicit"},
