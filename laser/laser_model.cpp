@@ -20,7 +20,6 @@ struct Node {
   InterfaceState itf;
   double dS1 = 0, dS2 = 0, v = 0, f = 0;  // rates of the last step, f: u = f zeta
   double v_kin = 0;  // conservative flow: -(1/xi) d(xi Q)/dxi at the start of the step (used in (4-27))
-  double heat_div = 0;  // conservative flow: (1/xi) d(xi int u theta dzeta)/dxi by face fluxes, start of the step
   double last_dg = 0;  // dg/dtau of the last step
   int flips = 0;       // consecutive sign changes of dg/dtau with lambda dtau > 2
 };
@@ -146,7 +145,7 @@ void Drill::solve_interfaces() {
 // the vertical surface velocity v(xi, g) that enters (4-13).
 bool Drill::solve_melt_flow(double ta, double tb) {
   const int N = static_cast<int>(nodes_.size());
-  for (auto& n : nodes_) { n.v = 0.0; n.f = 0.0; n.v_kin = 0.0; n.heat_div = 0.0; }
+  for (auto& n : nodes_) { n.v = 0.0; n.f = 0.0; n.v_kin = 0.0; }
   A_ = 0.0;
   u_peak_ = 0.0;
   if (cfg_.model == FlowModel::Conduction) return true;
@@ -259,12 +258,6 @@ bool Drill::conservative_flow(const FlowProfile& profile, int first, double ta, 
     const double q = std::fabs(c[k]) * gs[up] * gs[up];
     nodes_[up].v_kin -= q / a[up];
     if (dn < N && active[dn]) nodes_[dn].v_kin += q / a[dn];
-    // heat carried through the face: the volume flux at the flux-weighted mean
-    // temperature of the upwind layer, int u theta / int u = 2 theta_sat/3 (u = f zeta,
-    // linear part of (4-25)); the same value leaves one cell and enters the next
-    const double H = q * 2.0 * std::max(nodes_[up].itf.theta_sat, 0.0) / 3.0;
-    nodes_[up].heat_div += H / a[up];
-    if (dn < N && active[dn]) nodes_[dn].heat_div -= H / a[dn];
   }
   double t = 0.0, expelled = 0.0;
   long sub = 0;
@@ -815,7 +808,7 @@ void Drill::assess() {
                                                                        : ""));
   if (res_.b2_clamps > kSafeguardFraction * node_steps)
     cause("b2 limiter", "the quadratic melt temperature profile (4-25) cannot carry the heat the flow moves "
-                        "sideways: (4-27) asks for |b2| g^2 / theta_sat up to " + fmt(res_.b2_demand_max, 4) +
+                        "sideways: " + std::string(cfg_.flux_heat() ? "the face heat fluxes ask" : "(4-27) asks") + " for |b2| g^2 / theta_sat up to " + fmt(res_.b2_demand_max, 4) +
                         " (monotone profile: at most 1); limited to 1 " + std::to_string(res_.b2_clamps) +
                         " times (" + fmt(res_.b2_clamps / node_steps, 3) + " of the node steps; " + first_b2_ + ")");
   // named as a cause where the boundary model was not applied in most steps; a
