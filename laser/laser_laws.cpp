@@ -223,6 +223,41 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
   return s;
 }
 
+InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
+                                    bool advected) {
+  if (!(g > 0.0) || !(beta >= 0.0)) return solve_interface(G, xi, g, 0.0, advected);
+  const double E = gaussian_beam(xi);
+  const double avail = E + G.kprime * gamma;
+  double phi = G.theta_m;
+  RootResult rr;
+  rr.converged = true;
+  if (vapour_term(G, G.theta_m, nullptr) - avail < 0.0) {
+    auto residual = [&](double p, double* df) {
+      const double th = (p - G.theta_m) / (1.0 - G.theta_m);
+      const double r = advected ? advected_residual(G, p, xi, g, 0.0, df) : interface_residual(G, p, xi, g, 0.0, df);
+      if (df) *df += G.kprime * beta / (1.0 - G.theta_m);
+      return r + G.kprime * (beta * th - gamma);
+    };
+    // vapour term >= 0 and F >= 1: theta_sat <= avail / (k' (1/g + beta))
+    const double hi = G.theta_m + avail * (1.0 - G.theta_m) / (G.kprime * (1.0 / g + beta));
+    if (residual(hi, nullptr) > 0.0) {
+      auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
+      rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+      phi = rr.x;
+    } else {
+      phi = hi;
+    }
+  }
+  const double th = (phi - G.theta_m) / (1.0 - G.theta_m);
+  InterfaceState s = interface_at(G, phi, g, (beta * th - gamma) / g, advected);
+  s.iterations = rr.iterations;
+  s.converged = rr.converged;
+  const double res = advected ? advected_residual(G, phi, xi, g, (beta * th - gamma) / g, nullptr)
+                              : interface_residual(G, phi, xi, g, (beta * th - gamma) / g);
+  s.residual = res / E;
+  return s;
+}
+
 double recession_rate(const Groups& G, double xi, const InterfaceState& s) {
   return G.Ni * gaussian_beam(xi) - G.Psi * s.p_star * std::sqrt(s.phi) -
          G.hls_hlv * G.Ste * s.grad_top;

@@ -136,6 +136,12 @@ InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bo
 // exp(-w g); their difference w theta_sat heats the vaporized liquid from T_m
 // to T_sat (docs/laser_model.md, "Energy-consistent melt layer").
 InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected = false);
+// The same with the flow's part of the gradients tied to the surface temperature,
+// b2 g = beta theta_sat - gamma (beta >= 0): the layer gives the heat its outflow
+// carries at its own temperature and takes gamma from upstream (--melt-heat flux,
+// docs/laser_model.md 2.7). Every term still rises with phi: one bracketed root.
+InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
+                                    bool advected = false);
 // Nondimensional vaporization recession rate dS1/dtau by (3-25).
 double recession_rate(const Groups& G, double xi, const InterfaceState& s);
 // The same rate from the dimensional laws (3-16), (3-17): rho ds1/dt = j_v M.

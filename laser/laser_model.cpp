@@ -67,6 +67,7 @@ class Drill {
   void book_energy(const Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn);
   void move_fronts(Node& n, const Rates& r, double dtn);
   void melt_temperature();
+  void flux_heat_march();
   void record(double tau, bool frame);
   void emit(Frame&& f);
   void physical_check();
@@ -84,9 +85,13 @@ class Drill {
   double A_ = 0, u_peak_ = 0;
   double lambda_max_ = 0;
   double dtau_ = 0;
-  std::string flow_failure_;
+  double tb_ = 0;  // end of the current step (tau), for messages
+  std::string flow_failure_, flow_cause_;
   std::string first_clamp_;
+  std::string first_b2_, first_bl_;
   long flow_substeps_ = 0;
+  std::vector<double> face_c_;  // conservative flow: face volume-rate coefficients c_k (rate c_k g_up^2)
+  int first_c_ = 0;             // first node of the integral profiles
   int idx_x1_ = 0;
 };
 
@@ -184,6 +189,7 @@ bool Drill::solve_melt_flow(double ta, double tb) {
   if (Q1 == 0.0) return true;  // no melt off the axis yet
   const CubicRoot root = select_flow_root(Q1, Q2, Q3, Q4);
   if (!root.ok || !std::isfinite(root.A)) {
+    flow_cause_ = "no root of (4-19)";
     flow_failure_ = "no physical root of the cubic (4-19): " + root.note;
     return false;
   }
@@ -244,6 +250,8 @@ bool Drill::conservative_flow(const FlowProfile& profile, int first, double ta, 
     const double xf = (i + 0.5) * h;
     c[i] = kPi * xf * flow_shape(profile, A_, xf);
   }
+  face_c_ = c;
+  first_c_ = first_c;
   for (int k = first_c; k < N; ++k) {  // rates at the start of the step, for (4-27)
     const int up = c[k] >= 0.0 ? k : k + 1, dn = c[k] >= 0.0 ? k + 1 : k;
     if (up >= N || !active[up]) continue;
@@ -282,6 +290,7 @@ bool Drill::conservative_flow(const FlowProfile& profile, int first, double ta, 
     }
     t = (dts == dtau - t) ? dtau : t + dts;
     if (++sub > kMaxFlowSubsteps) {
+      flow_cause_ = "melt flow faster than the grid can carry";
       flow_failure_ = "melt flow faster than the grid can carry: more than " + std::to_string(kMaxFlowSubsteps) +
                       " flux sub-steps in one time step (A = " + fmt(A_, 4) + "; Courant number u dt/dr about " +
                       fmt(worst * dtau, 4) + ")";
@@ -330,6 +339,17 @@ void Drill::solve_boundary_layer(int& last_bl) {
   };
   if (!(U[1] > 0.0)) return;
   double d = std::sqrt(70.0 * Pr * h / (37.0 * U[1]));
+  // The boundary-layer profile (4-7) needs delta < g; where the layer is already
+  // thicker than the melt at the first node, the boundary model cannot be
+  // applied at all in this step (the integral profile takes over from the axis)
+  ++res_.bl_steps;
+  if (!(d < nodes_[1].g) && nodes_[1].g > 0.0) {
+    if (res_.bl_thicker_steps++ == 0) {
+      res_.bl_first_ratio = d / nodes_[1].g;
+      first_bl_ = "first at t = " + fmt(tb_ * G_.t_scale, 4) + " s: delta/g = " + fmt(d / nodes_[1].g, 4) +
+                  " at xi = " + fmt(nodes_[1].xi, 4);
+    }
+  }
   for (int i = 1; i < end - 1; ++i) {
     Node& n = nodes_[i];
     if (!(d > 0.0) || !std::isfinite(d) || d >= n.g) break;
@@ -394,11 +414,16 @@ Drill::Geometry Drill::front_geometry(int i, const std::vector<double>& S2old, d
 }
 
 // Backward Euler in g: g_new = g_old + dtau (dS2 - dS1 + v)(g_new), with the
-// solid gradient, curvature, b2 and flow frozen over the step. The right side
+// solid gradient, curvature, the flow and its heat flux b2 g frozen over the step. The right side
 // decreases with g, so the root is unique and bracketed.
 void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n, double dtn) {
+  // The flow's part of the layer's gradients, b2 g (half the heat the flow
+  // carries sideways, 2 b2 g), is what the last step's (4-27) determined and is
+  // held over the step; holding b2 itself would let b2 g grow with g_new.
+  const double b2g = n.b2 * n.g;
+  auto b2_at = [&](double g) { return g > 0.0 ? b2g / g : 0.0; };
   auto rate = [&](double g) {
-    const InterfaceState st = solve_interface(G_, n.xi, g, n.b2, advected_);
+    const InterfaceState st = solve_interface(G_, n.xi, g, b2_at(g), advected_);
     const double d2 =
         std::max(melting_rate(G_, geo.Cc, grad_n, geo.J, st.grad_bottom, cfg_.moving_origin), 0.0);
     const double d1 = std::max(recession_rate(G_, n.xi, st), 0.0);
@@ -417,6 +442,7 @@ void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n
     for (int k = 0; Fhi < 0.0 && k < 60; ++k) { hi = 2.0 * hi + 1e-12; Fhi = F(hi); }
     g_new = illinois_root(F, 0.0, hi, F0, Fhi, 1e-12 * std::max(hi, 1e-12)).x;
   }
+  n.b2 = b2_at(g_new);
   n.itf = solve_interface(G_, n.xi, g_new, n.b2, advected_);
 }
 
@@ -547,6 +573,10 @@ void Drill::advance_interfaces(double ta, double tb) {
 // g and f of this step. The text lags b2 between steps only in (4-30).
 void Drill::melt_temperature() {
   if (cfg_.model == FlowModel::Conduction) return;
+  if (cfg_.flux_heat()) {
+    flux_heat_march();
+    return;
+  }
   const int N = static_cast<int>(nodes_.size());
   const double h = cfg_.dxi;
   const bool outward = A_ >= 0.0;
@@ -573,10 +603,74 @@ void Drill::melt_temperature() {
     // Safeguard: keep the profile (4-25) monotone in [0, g], |b2 g^2| <= theta_sat.
     const double bmax = th / (g * g);
     if (std::fabs(n.b2) > bmax || !std::isfinite(n.b2)) {
+      const double ask = std::fabs(n.b2) / bmax;
+      if (res_.b2_clamps == 0)
+        first_b2_ = "first at xi = " + fmt(x, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
+      if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
       ++res_.b2_clamps;
       n.b2 = std::isfinite(n.b2) ? std::copysign(bmax, n.b2) : 0.0;
     }
     fJ_up = f * (th * g * g / 3.0 - n.b2 * std::pow(g, 4) / 12.0);
+  }
+}
+
+// --melt-heat flux (docs/laser_model.md 2.7): the heat the flow carries through
+// the cell faces, volume rate q = |c_k| g_up^2 at the flux-weighted mean
+// temperature 2 theta_sat/3 of the upwind layer, and the layer's gradients
+// 2 b2 g = D (heat per unit area and time leaving the column) are solved
+// together, marching with the flow: the heat entering a column comes from its
+// upwind neighbour (already solved), the heat leaving it depends on its own
+// theta_sat, which in turn falls as b2 g rises: one bracketed root in the
+// surface temperature (solve_interface_flux). Implicit and upwind, the
+// march has no grid-dependent step limit; lagging D from one step to the next
+// made an odd-even oscillation beyond xi = 1.6 at Pr 142 (docs 2.7).
+void Drill::flux_heat_march() {
+  const int N = static_cast<int>(nodes_.size());
+  const double R2 = cfg_.R * cfg_.R;
+  const bool outward = A_ >= 0.0;
+  std::vector<double> theta_out(N, 0.0);  // flux-weighted temperature of the heat a node sends
+  std::vector<char> done(N, 0);
+  auto active = [&](int i) { return i >= first_c_ && i < N && nodes_[i].molten && nodes_[i].g > 0.0; };
+  for (int k = 0; k < N; ++k) {
+    const int i = outward ? k : N - 1 - k;
+    Node& n = nodes_[i];
+    if (!active(i) || face_c_.empty()) { n.b2 = 0.0; continue; }
+    const double a = n.area / R2, g = n.g;
+    double qout = 0.0, hin = 0.0;
+    for (int f : {i - 1, i}) {  // faces between i-1|i and i|i+1
+      if (f < first_c_ || f < 0 || f >= N) continue;
+      const double cf = face_c_[f];
+      const int up = cf >= 0.0 ? f : f + 1;
+      if (up == i) {
+        qout += std::fabs(cf) * g * g;
+      } else if (active(up) && done[up]) {
+        hin += std::fabs(cf) * nodes_[up].g * nodes_[up].g * theta_out[up];
+      }
+    }
+    if (qout == 0.0 && hin == 0.0) {
+      n.b2 = 0.0;
+      done[i] = 1;
+      continue;
+    }
+    // b2 g = (qout 2 theta_sat/3 - hin) / (2 a) = beta theta_sat - gamma
+    n.itf = solve_interface_flux(G_, n.xi, g, qout / (3.0 * a), hin / (2.0 * a), advected_);
+    n.b2 = (qout / (3.0 * a) * std::max(n.itf.theta_sat, 0.0) - hin / (2.0 * a)) / g;
+    const double th = std::max(n.itf.theta_sat, 0.0);
+    if (std::fabs(n.b2) * g * g > th) {
+      const double ask = th > 0.0 ? std::fabs(n.b2) * g * g / th : std::numeric_limits<double>::infinity();
+      if (res_.b2_clamps == 0) first_b2_ = "first at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
+      if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
+      ++res_.b2_clamps;
+      n.b2 = th > 0.0 ? std::copysign(th / (g * g), n.b2) : 0.0;
+      n.itf = solve_interface(G_, n.xi, g, n.b2, advected_);
+    }
+    // what the column sends on is what came in minus what it keeps, 2 a b2 g: with
+    // the solved b2 g this is qout 2 theta_sat/3; where the limit of (4-25) held b2
+    // back, the heat the layer could not take (or give) stays with the flow, so the
+    // face fluxes still telescope (heat is moved, never lost or made)
+    theta_out[i] = qout > 0.0 ? std::max(hin + 2.0 * a * n.b2 * g, 0.0) / qout
+                              : 2.0 / 3.0 * std::max(n.itf.theta_sat, 0.0);
+    done[i] = 1;
   }
 }
 
@@ -713,8 +807,22 @@ void Drill::assess() {
                                                                          "not conserve the melt; --melt-flow conservative)"
                                                                        : ""));
   if (res_.b2_clamps > kSafeguardFraction * node_steps)
-    cause("b2 limiter", "|b2| g^2 <= theta_sat of (4-25) enforced " + std::to_string(res_.b2_clamps) +
-                            " times (" + fmt(res_.b2_clamps / node_steps, 3) + " of the node steps)");
+    cause("b2 limiter", "the quadratic melt temperature profile (4-25) cannot carry the heat the flow moves "
+                        "sideways: " + std::string(cfg_.flux_heat() ? "the face heat fluxes ask" : "(4-27) asks") + " for |b2| g^2 / theta_sat up to " + fmt(res_.b2_demand_max, 4) +
+                        " (monotone profile: at most 1); limited to 1 " + std::to_string(res_.b2_clamps) +
+                        " times (" + fmt(res_.b2_clamps / node_steps, 3) + " of the node steps; " + first_b2_ + ")");
+  // named as a cause where the boundary model was not applied in most steps; a
+  // few steps (the first ones after onset, when the melt is one step thick) are a note
+  if (cfg_.model == FlowModel::Boundary && res_.bl_thicker_steps > 0 && 2 * res_.bl_thicker_steps <= res_.bl_steps)
+    res_.notes.push_back("boundary layer thicker than the melt at the first node off the axis in " +
+                         std::to_string(res_.bl_thicker_steps) + " of " + std::to_string(res_.bl_steps) +
+                         " steps (" + first_bl_ + "): the integral profile was used from the axis there");
+  if (cfg_.model == FlowModel::Boundary && 2 * res_.bl_thicker_steps > res_.bl_steps)
+    cause("boundary layer thicker than the melt",
+          "the boundary layer (4-9) is thicker than the melt at the first node off the axis in " +
+              std::to_string(res_.bl_thicker_steps) + " of " + std::to_string(res_.bl_steps) +
+              " steps (" + first_bl_ + "); there the boundary-layer profile (4-7) does not apply and the "
+              "integral profile of --model risingfall is used from the axis");
   if (res_.curvature_clamps > kSafeguardFraction * node_steps)
     cause("curvature clamp", "|a d| >= 2 in (3-37) clamped " + std::to_string(res_.curvature_clamps) + " times (" +
                                  first_clamp_ + ")");
@@ -776,11 +884,13 @@ Result Drill::run() {
   for (long step = 0; step < nsteps; ++step) {
     const double ta = tau;
     const double tb = (step == nsteps - 1) ? tau_p : std::min(tau_p, (step + 1) * dtau_);
+    tb_ = tb;
     melt_onset(tb);
     solve_interfaces();
     if (!state_admissible(tb)) break;
     if (!solve_melt_flow(ta, tb)) {
       res_.status = "no_flow_solution";
+      res_.causes.push_back(flow_cause_);
       res_.message = flow_failure_ + " at t = " + fmt(ta * G_.t_scale, 4) + " s";
       break;
     }

@@ -109,6 +109,10 @@ struct Result {
   double T_center = 0;     // K, centre surface temperature at the end
   double xi_melt_edge = 0;
   double bl_last_xi = 0;  // boundary model: outermost node where delta < g was met
+  long bl_thicker_steps = 0;   // boundary model: steps in which delta >= g at the first node off the axis
+  long bl_steps = 0;           // boundary model: steps with melt off the axis
+  double bl_first_ratio = 0;   // delta / g there, at the first such step
+  double b2_demand_max = 0;    // largest |b2| g^2 / theta_sat that (4-27) asked for (1: limit of (4-25))
   int steps = 0, nodes = 0;
   int melt_clamps = 0, melt_rate_clamps = 0, curvature_clamps = 0, b2_clamps = 0;
   double max_interface_residual = 0;

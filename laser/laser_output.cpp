@@ -432,6 +432,8 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["A_last"] = num(r.A_last);
   j["xi_melt_edge"] = num(r.xi_melt_edge);
   j["boundary_layer_last_xi"] = num(r.bl_last_xi);
+  j["boundary_layer_thicker_than_melt_steps"] = r.bl_thicker_steps;
+  j["b2_demand_max"] = num(r.b2_demand_max);
   j["steps"] = r.steps;
   j["nodes"] = r.nodes;
   j["frames"] = r.frames_written;
@@ -453,6 +455,7 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
                {"Pr", num(cfg.mat.Pr)},             {"solid", to_string(cfg.solid)},
                {"melt_energy", to_string(cfg.melt_energy)},
                {"melt_flow", to_string(cfg.melt_flow)},
+               {"melt_heat", cfg.flux_heat() ? "flux" : "ode"},
                {"recoil_fraction_of_p_sat", num(cfg.recoil)},
                {"absorptivity", num(cfg.absorptivity)},
                {"melt_update", cfg.implicit_melt ? "implicit" : "explicit"},

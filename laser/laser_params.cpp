@@ -309,6 +309,18 @@ const std::vector<Param>& params() {
         "(melt is conserved; includes -u(g) dg/dxi), text = v(xi, g) of (4-22) as printed",
         [](Config& c, const std::string& v) { c.melt_flow = v == "text" ? MeltFlow::Text : MeltFlow::Conservative; },
         [](const Config& c) { return std::string(to_string(c.melt_flow)); }));
+    t.push_back(choice(
+        "melt-heat", "model", {"auto", "ode", "flux"},
+        "heat the melt flow carries sideways, b2 of (4-25): ode = the text's integral balance (4-27) marched "
+        "along xi, flux = finite-volume face fluxes of the conservative flow (volume flux x upwind 2 theta_sat/3, "
+        "solved with the surface temperature; what leaves one column enters the next; needs --melt-flow "
+        "conservative), auto = flux with --melt-flow conservative, ode with --melt-flow text",
+        [](Config& c, const std::string& v) {
+          c.melt_heat = v == "flux" ? MeltHeat::Flux : v == "ode" ? MeltHeat::Ode : MeltHeat::Auto;
+        },
+        [](const Config& c) {
+          return std::string(c.melt_heat == MeltHeat::Flux ? "flux" : c.melt_heat == MeltHeat::Ode ? "ode" : "auto");
+        }));
     t.push_back(real("shift", "model", "tau_m", 0, 10, true,
                      "backward shift of the Stefan solution for --solid shifted (3-36: 3 tau_0 = 3/(4 pi))",
                      &Config::shift));
@@ -552,6 +564,9 @@ void validate(Config& c) {
     throw UsageError("--T-critical: must be above --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tc) + " K");
   if (!(m.Tsat0 > m.Tm))
     throw UsageError("--T-melt: must be below --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tm) + " K");
+  if (c.melt_heat == MeltHeat::Flux && c.melt_flow != MeltFlow::Conservative)
+    throw UsageError("--melt-heat: flux needs --melt-flow conservative (the face fluxes are the conservative flow's), "
+                     "got --melt-flow text");
   if (c.dtau > 0.0) c.dt = c.dtau * c.R * c.R / (m.kl / (m.rho * m.cpl));
   if (c.dt > 0.0 && !(c.dt < c.tp))
     throw UsageError(std::string(c.dtau > 0 ? "--dtau" : "--dt") + ": the time step " + fmt(c.dt) +

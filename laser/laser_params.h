@@ -27,6 +27,7 @@ enum class MeltEnergy { Advected, Text };
 // divergence of the layer's volume flux (includes -u(g) dg/dxi, the melt is
 // conserved), Text = v(xi, g) of (4-22)/(4-13) as printed.
 enum class MeltFlow { Conservative, Text };
+enum class MeltHeat { Auto, Ode, Flux };
 
 const char* to_string(FlowModel m);
 const char* to_string(SolidModel m);
@@ -45,6 +46,11 @@ struct Config {
   SolidModel solid = SolidModel::Exact;
   MeltEnergy melt_energy = MeltEnergy::Advected;
   MeltFlow melt_flow = MeltFlow::Conservative;
+  // b2 of (4-25): auto = flux with the conservative flow, ode with the text's flow
+  MeltHeat melt_heat = MeltHeat::Auto;
+  bool flux_heat() const {
+    return melt_heat == MeltHeat::Flux || (melt_heat == MeltHeat::Auto && melt_flow == MeltFlow::Conservative);
+  }
   // Recoil pressure that drives the melt flow, as a fraction of p_sat(T_s): 1 =
   // the text (full saturation pressure), 0.54 = Anisimov (1968) / Knight (1979)
   // for strong evaporation with a Knudsen layer.

@@ -18,6 +18,7 @@ double rel_diff(double a, double b) {
 constexpr double kStepsPerPulse = 100.0;
 constexpr double kStepsPerMelting = 200.0;
 constexpr double kStableFraction = 0.25;
+constexpr double kNoDecrease = 0.75;
 }  // namespace
 
 TimeStepPolicy::TimeStepPolicy(const Config& cfg) {
@@ -125,7 +126,14 @@ Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) cons
   }
   double ed = factor * rel_diff(fine.depth_center, coarse.depth_center);
   double ev = factor * rel_diff(fine.volume_removed, coarse.volume_removed);
-  while (automatic_ && std::max(ed, ev) > cfg.tol && double(steps) + 2.0 * cfg.tp / dt <= kMaxSteps) {
+  // Halving a step of a first-order scheme halves the estimate; where two
+  // halvings fail to bring it below kNoDecrease of the smallest one so far,
+  // the result is not converging in dt and refining further only costs time
+  double best = std::max(ed, ev);
+  int stalls = 0;
+  std::string history = fmt(best, 3) + " at " + fmt(dt, 4) + " s";
+  bool stalled = false;
+  while (automatic_ && std::max(ed, ev) > cfg.tol && double(steps) + 2.0 * cfg.tp / dt <= kMaxSteps && !stalled) {
     // halve: the reported run becomes the companion of the next one
     coarse = std::move(fine);
     companion = dt;
@@ -139,6 +147,10 @@ Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) cons
     if (fine.status == "unstable_time_step") return fine;
     ed = rel_diff(fine.depth_center, coarse.depth_center);
     ev = rel_diff(fine.volume_removed, coarse.volume_removed);
+    const double e = std::max(ed, ev);
+    history += ", " + fmt(e, 3) + " at " + fmt(dt, 4) + " s";
+    if (!(e < kNoDecrease * best)) stalled = ++stalls >= 2;
+    best = std::min(best, e);
   }
   StepReport& s = fine.step;
   s.automatic = automatic_;
@@ -153,9 +165,16 @@ Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) cons
     const std::string m = "estimated error of the time step: depth " + fmt(ed, 4) + ", volume " + fmt(ev, 4) +
                           " (step doubling, dt = " + fmt(dt, 4) + " s against " + fmt(companion, 4) +
                           " s) above --tol " + fmt(cfg.tol, 4) +
-                          (automatic_ ? " after refining to the step budget" : "; use a smaller --dt or leave it automatic");
-    fine.message = fine.status == "ok" ? m : fine.message + "; " + m;
+                          (automatic_ ? (stalled ? "" : " after refining to the step budget")
+                                      : "; use a smaller --dt or leave it automatic");
+    const std::string stall =
+        stalled ? "; time-step error not decreasing: the estimate did not fall below " + fmt(kNoDecrease, 3) +
+                      " of the smallest one in two halvings (" + history + "): the result does not converge in dt, "
+                      "refining stopped"
+                : "";
+    fine.message = fine.status == "ok" ? m + stall : fine.message + "; " + m + stall;
     fine.status = "inaccurate";
+    if (stalled) fine.causes.push_back("time-step error not decreasing");
   }
   return fine;
 }

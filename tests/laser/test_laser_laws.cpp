@@ -245,3 +245,29 @@ TEST(LaserLaws, EstablishedProfileAtOnset) {
   EXPECT_NEAR(established_profile(G.theta_i, 0.0), 0.0, 1e-15);
   EXPECT_NEAR(established_profile(G.theta_i, 30.0), G.theta_i, 1e-12);
 }
+
+// solve_interface_flux: the surface temperature with b2 g = beta theta_sat - gamma
+// is the root of the ordinary balance at the b2 it returns (checked by
+// solve_interface at that b2), for both melt layers, giving and receiving heat;
+// and beta = gamma = 0 is the plain balance.
+TEST(LaserLaws, InterfaceWithFlowHeatIsConsistent) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  int hot = 0;  // cases with theta_sat > 0 and a flow term
+  for (bool adv : {false, true}) {
+    for (double xi : {0.0, 0.8, 1.7}) {
+      for (double g : {1e-3, 2e-2, 8e-2}) {
+        for (auto [beta, gamma] : {std::pair{0.0, 0.0}, {50.0, 0.0}, {5e3, 10.0}, {0.0, 30.0}, {200.0, 300.0}}) {
+          const InterfaceState s = solve_interface_flux(G, xi, g, beta, gamma, adv);
+          const double b2 = (beta * s.theta_sat - gamma) / g;
+          const InterfaceState r = solve_interface(G, xi, g, b2, adv);
+          EXPECT_NEAR(s.phi, r.phi, 1e-10 * r.phi) << adv << " " << xi << " " << g << " " << beta << " " << gamma;
+          EXPECT_NEAR(s.grad_top, r.grad_top, 1e-8 * (1.0 + std::fabs(r.grad_top)));
+          EXPECT_LT(std::fabs(s.residual), 1e-10);
+          if (beta == 0.0 && gamma == 0.0) EXPECT_DOUBLE_EQ(s.phi, solve_interface(G, xi, g, 0.0, adv).phi);
+          if (s.theta_sat > 0.0 && b2 != 0.0) ++hot;
+        }
+      }
+    }
+  }
+  EXPECT_GT(hot, 40);
+}
