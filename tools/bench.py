@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Benchmark harness of issue 5 (docs/performance.md).
+"""Benchmark harness (docs/performance.md).
 
   tools/python tools/bench.py [--quick] [--out DIR] [--np 2] [--only SECTION ...]
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""fix mpm/fluid ... pressure projection (issue #13, docs/projection.md): the incompressible fluid
+"""fix mpm/fluid ... pressure projection (docs/projection.md): the incompressible fluid
 of a pressure solve, alone and coupled with grains.
 
     test_projection.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR --mpirun "mpirun ..."
@@ -139,7 +139,7 @@ def inviscid_column_ke_rate(width, height, depth, rho=1000.0, g=9.81, terms=2000
 
 
 def case_column(r):
-    """Acceptance 2 of issue #13: the released column (in.column, free-slip walls, gate removed at
+    """The released column (in.column, free-slip walls, gate removed at
     once) reaches at least 90 % of the inviscid early-time kinetic energy at 0.01 and 0.02 s, at two
     grids, with the finer grid closer to it."""
     rate = inviscid_column_ke_rate(0.05, 0.1, 0.1)

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""fix mpm/fluid ... pressure projection with mesh walls (issue #13, docs/projection.md, "Mesh walls"):
+"""fix mpm/fluid ... pressure projection with mesh walls (docs/projection.md, "Mesh walls"):
 closed grid faces where the triangles cross them, the nodes behind the walls out of the solve.
 
     test_projection_mesh.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR --mpirun "mpirun ..."

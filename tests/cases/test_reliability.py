@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Inputs that once gave silent wrong results, crashes or unhelpful messages (issue #15), each as a
+"""Inputs that once gave silent wrong results, crashes or unhelpful messages, each as a
 case that must now either run correctly or stop with a message naming the keyword or quantity.
 
     test_reliability.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR --mpirun "mpirun ..."

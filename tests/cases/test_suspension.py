@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A uniform suspension settles at its drag law's hindered velocity (issue #13, acceptance 4):
+"""A uniform suspension settles at its drag law's hindered velocity:
 inputs/suspension/in.suspension at reduced size, solid fraction 0.3, `pressure projection`. The
 mean settling velocity of the grains of the middle region against the steady velocity of a
 uniform suspension computed from the inputs alone (tools/suspension.py, docs/suspension.md), and

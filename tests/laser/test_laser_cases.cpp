@@ -314,7 +314,7 @@ TEST(LaserCases, ObservedConvergenceOrders) {
 // column cannot recede faster than q / (rho H), H = c_ps (T_m - T_i) + h_ls +
 // c_pl (T_s - T_m) + h_lv; rho H V_removed cannot exceed the beam energy.
 // The default (advected) melt layer stays below and approaches the bound as the
-// intensity grows; the text's linear layer exceeds it (issue #14).
+// intensity grows; the text's linear layer exceeds it.
 TEST(LaserCases, EnergyBoundFromInputsAlone) {
   double table51_depth = -1;  // the default layer at 7.5e10 W/m2 is the Table 5.1 case
   for (MeltEnergy energy : {MeltEnergy::Advected, MeltEnergy::Text}) {
@@ -352,7 +352,7 @@ TEST(LaserCases, EnergyBoundFromInputsAlone) {
         EXPECT_TRUE(r.check.holds);
         EXPECT_NEAR(r.check.centre_velocity_ratio, ratio, 1e-9);
       } else {
-        EXPECT_GT(ratio, 1.0) << "the text's layer is expected above the bound (issue #14)";
+        EXPECT_GT(ratio, 1.0) << "the text's layer is expected above the bound";
       }
       prev = ratio;
       if (energy == MeltEnergy::Advected && I == base().I0) table51_depth = r.depth_center;

@@ -69,7 +69,7 @@ fs::path scratch(const std::string& name) {
 }
 
 struct BadCase {
-  std::string what;       // the problem of issue #14
+  std::string what;       // the bad input checked
   std::string args;       // %D is replaced by the scratch folder
   std::string config;     // written to %D/case.toml when not empty
   std::string must_contain[3];
