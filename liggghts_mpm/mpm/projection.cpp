@@ -507,8 +507,13 @@ void Projection::extend_for_points(const std::vector<double> &p, const std::vect
   if (grad_out) extend_to_padding(gb, *grad_out, 3);
 }
 
+long Projection::volume_correction_every(double k, double hf) {
+  const double m = std::floor(kVolumeShare / (k * hf));
+  return m >= 1.0 ? (m < 1e9 ? static_cast<long>(m) : 1000000000L) : 1L;
+}
+
 void Projection::project(double *vel, const double *p2g, double mmin, const double *theta, double h,
-                         Boundaries &bc, long step, const double *pvol, const IndexBox *work) {
+                         Boundaries &bc, long step, const double *pvol, const IndexBox *work, double vc_time) {
   // sparse sweeps: every for_owned of this step visits the work box only
   work_ = work ? work->cut(grid_.patch()) : grid_.patch();
   if (work) retire(work_);
@@ -544,8 +549,8 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   }
   correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), h, u_.data());
   grid_.forward(u_.data(), 3);
-  if (pvol && opt_.volume_correction > 0.0)
-    volume_drift(pvol, theta, h, step);
+  if (pvol && opt_.volume_correction > 0.0 && vc_time > 0.0)
+    volume_drift(pvol, theta, h, std::min(opt_.volume_correction * vc_time, 1.0), step);
   else
     drift_.clear();
   if (acceleration_on()) acceleration_pressure(vel, th, h, p2g, mmin, step);
@@ -633,7 +638,7 @@ void Projection::mirror_normal(double *v, int i, int j, int k, const double *p2g
    they fill the space evenly (exactly, at rest, for a regular fill); the shares the B-spline gives
    to the padding nodes behind a box wall count at their mirror node inside (as the coupling folds
    the grains' volume). The continuity target of the solve gets the rate that removes the fraction
-   a = min(k h, 1) of the error e = phi - 1 in this step:
+   a = min(k M h, 1) of the error e = phi - 1 on every M-th step (volume_correction_every):
        D_new + volume(n) d(theta)/dt = volume(n) theta_n a e_n / h,
    i.e. rhs_n -= volume(n) theta_n a e_n / h^2: crowded points (e > 0) are pushed apart, and gaps
    (e < 0) drawn together, but the latter only where no EMPTY node lies within two nodes
@@ -643,11 +648,11 @@ void Projection::mirror_normal(double *v, int i, int j, int k, const double *p2g
    equation of Kugelstadt, Longva, Thuerey & Bender (2021), "Implicit density projection for
    volume conserving liquids", IEEE TVCG 27(4), here as a relaxation term of the one divergence
    solve instead of their second, position-based solve. */
-void Projection::add_volume_correction(const double *pvol, const double *theta, double h) {
+void Projection::add_volume_correction(const double *pvol, const double *theta, double h, double a) {
   const GridSpec &gs = opt_.grid;
   vol_.assign(pvol, pvol + grid_.size());
   grid_.forward(vol_.data(), 1);  // the padding nodes' shares, wherever they are owned
-  const double dx = gs.dx, dx3 = dx * dx * dx, a = std::min(opt_.volume_correction * h, 1.0);
+  const double dx = gs.dx, dx3 = dx * dx * dx;
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] != kFluid) return;
     const double sum = mirror_sum(vol_, i, j, k);
@@ -670,10 +675,10 @@ void Projection::add_volume_correction(const double *pvol, const double *theta, 
    (as a source in the velocity's own solve it damped a standing wave of 2 % of the depth by 14 %
    in three periods at 20 cells, docs/projection.md "Volume over long runs"). Zero first guess:
    the drift of a step is a function of that step's state only (restart, np 2 = np 1). */
-void Projection::volume_drift(const double *pvol, const double *theta, double h, long step) {
+void Projection::volume_drift(const double *pvol, const double *theta, double h, double share, long step) {
   const std::size_t n = grid_.size();
   rhs_.assign(n, 0.0);
-  add_volume_correction(pvol, theta, h);
+  add_volume_correction(pvol, theta, h, share);
   q_.assign(n, 0.0);
   grad_q_.assign(3 * n, 0.0);
   drift_.assign(3 * n, 0.0);

@@ -36,8 +36,16 @@ class Projection {
   // node with fluid mass grown by kWorkMargin nodes; the sweeps then visit its nodes only and every
   // array keeps outside it the value the full sweep gives there (no fluid within reach: 0, EMPTY).
   // Not with theta (couple) or mesh walls. null: the whole patch.
+  // vc_time: the time the volume correction of this step stands for (with pvol; see
+  // volume_correction_every).
   void project(double *vel, const double *p2g, double mmin, const double *theta, double h,
-               Boundaries &bc, long step, const double *pvol = nullptr, const IndexBox *work = nullptr);
+               Boundaries &bc, long step, const double *pvol = nullptr, const IndexBox *work = nullptr,
+               double vc_time = 0.0);
+  // The volume correction at rate k runs on every M-th fluid step of length hf, M = max(1,
+  // floor(kVolumeShare / (k hf))), and then removes the share min(k M hf, 1) of the error: the
+  // same rate, with one solve every M steps instead of every step.
+  static long volume_correction_every(double k, double hf);
+  static constexpr double kVolumeShare = 0.05;
   // the nodes the work box must reach beyond the nodes with mass: the farthest any sweep reads or
   // writes from them (the surface's gradient and extrapolation 1, deep_inside 2) and one more
   static constexpr int kWorkMargin = 4;
@@ -135,8 +143,8 @@ class Projection {
   bool have_theta_last_ = false;
   std::vector<double> vol_;         // volume correction: sum S V with the padding folded back
   std::vector<double> q_, grad_q_, drift_;  // volume correction: its potential, gradient and drift
-  void add_volume_correction(const double *pvol, const double *theta, double h);
-  void volume_drift(const double *pvol, const double *theta, double h, long step);
+  void add_volume_correction(const double *pvol, const double *theta, double h, double share);
+  void volume_drift(const double *pvol, const double *theta, double h, double share, long step);
   bool deep_inside(int i, int j, int k) const;
   std::vector<double> p_avg_;       // pressure_average: the nodal pressure averaged in time (sized only then)
   bool have_avg_ = false;

@@ -142,7 +142,18 @@ ProjectionState FluidSolver::projection_state() {
 void FluidSolver::step() {
   const double h = opt.fluid_every * clock.dt / state.nsub;
   if (opt.coupled) grain_force_.assign(3 * static_cast<std::size_t>(pts.nlocal), 0.0);
-  for (int s = 0; s < state.nsub; ++s) substep(h);
+  // the volume correction runs on every M-th fluid step (its first sub-step), removing the share
+  // min(k M hf, 1) of the volume error each time (Projection::volume_correction_every)
+  vc_interval_ = 0.0;
+  if (opt.projection && opt.volume_correction > 0.0) {
+    const double hf = opt.fluid_every * clock.dt;
+    const long every = Projection::volume_correction_every(opt.volume_correction, hf);
+    if ((clock.step / opt.fluid_every) % every == 0) vc_interval_ = every * hf;
+  }
+  for (int s = 0; s < state.nsub; ++s) {
+    substep(h);
+    vc_interval_ = 0.0;
+  }
   if (!opt.coupled) return;
   // fluid force on the grains (mean over the sub-steps), for the host's integrator. With every N
   // the grains get the impulse of the N steps, N h F, in this step (force N F): velocity Verlet
@@ -339,13 +350,13 @@ void FluidSolver::update_grid(double h) {
     for (int d = 0; d < 3; ++d) gv[VelRec::V_NEW + d] = vnew[d];
   });
   if (opt.projection) {
-    const bool vc = opt.volume_correction > 0.0;
+    const bool vc = vc_interval_ > 0.0;
     if (vc) point_volume_to_grid();
     IndexBox work;
     const bool sparse_proj = sparse_ && !opt.coupled && !bc.walls();
     if (sparse_proj) work = projection_work_box();
     proj_->project(g_.vel.data(), g_.p2g.data(), mmin, opt.coupled ? g_.th.data() : nullptr, h,
-                   bc, clock.step, vc ? pvol_.data() : nullptr, sparse_proj ? &work : nullptr);
+                   bc, clock.step, vc ? pvol_.data() : nullptr, sparse_proj ? &work : nullptr, vc_interval_);
   }
   grid_.forward(g_.vel.data(), VelRec::N);
 }

@@ -270,6 +270,7 @@ class FluidSolver {
   // the pressure solver's time, solves and PCG iterations of the Projections of earlier patches
   double proj_seconds_before_ = 0.0;
   long proj_solves_before_ = 0, proj_iterations_before_ = 0;
+  double vc_interval_ = 0.0;  // volume correction due this sub-step: the time it stands for (else 0)
   std::vector<double> pvol_;          // volume_correction: sum S V of the points per node
   double vmax_ = 0.0;                 // |v|max of the points at the last time-step check
   long last_output_step_ = -1;
