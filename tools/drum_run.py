@@ -7,7 +7,8 @@ run:     writes drum.stl (tools/make_drum_stl.py), sets the mixture height hfill
 check:   reads drum.csv and drum_run.txt of run folders and prints, per folder, the figures of the
          scene's physical checks (all computed from the inputs alone):
            * axial uniformity: share of the beads in the middle third of the drum length, every row
-             (the beads go in as 1/3 per third; uniform = 1/3; the bound: within 10 % of 1/3);
+             (the beads go in as 1/3 per third; uniform = 1/3); the bound: its mean over each
+             quarter turn within 10 % of 1/3 (rows alone carry the binomial noise of the bead count);
            * pressure: largest point pressure against 5 (rho g hfill + rho (omega R)^2);
            * fluid mass: largest relative change of f_fluid[1] over the rotation;
            * points outside the drum (beyond the mantle polygon or the end caps) and inside a
@@ -37,7 +38,9 @@ from make_drum_stl import drum_triangles, write_stl  # noqa: E402
 
 # the scene's geometry (in.drum's and make_drum_stl.py's defaults)
 D, L, HL, WL, NLIFT, PHASE, NSEG = 0.16, 0.04, 0.008, 0.008, 6, 90.0, 72
-UNIFORM_TOL = 0.10       # share of the middle third within 10 % of 1/3
+UNIFORM_TOL = 0.10       # share of the middle third within 10 % of 1/3 ...
+WINDOW = 0.25            # ... averaged over each quarter turn (the instantaneous share of 600 beads
+                         # in the dry drum swings by 13.5 %: binomial noise, 5.8 % for one sigma)
 PRESSURE_FACTOR = 5.0    # largest pressure below 5 (rho g h + rho (omega R)^2)
 
 
@@ -90,6 +93,16 @@ def analyse(d):
     bound = PRESSURE_FACTOR * (rho * g * hfill + rho * (omega * r) ** 2)
     mid = c["mid"]
     dev = [abs(m - 1.0 / 3.0) * 3.0 for m in mid]
+    # the share averaged over each quarter turn (rows with turn in (k W, (k + 1) W]); a run shorter
+    # than a quarter turn is one window
+    win = {}
+    for tu, m in zip(c["turn"], mid):
+        win.setdefault(max(0, math.ceil(tu / WINDOW - 1e-9) - 1), []).append(m)
+    groups = [v for _, v in sorted(win.items())]
+    if len(groups) > 1 and len(groups[-1]) < 3:  # a last row or two past the end: into the window before
+        groups[-2] += groups.pop()
+    means = [sum(v) / len(v) for v in groups]
+    wdev = [abs(m - 1.0 / 3.0) * 3.0 for m in means]
     m0 = c["mass"][0]
     wet = info.get("water", "1") == "1"
     r_in = math.pi * r * r * float(info["L"]) - NLIFT * HL * WL * float(info["L"])
@@ -106,6 +119,8 @@ def analyse(d):
         "mid_min": min(mid),
         "mid_max": max(mid),
         "mid_dev_max": max(dev),
+        "mid_window_means": means,
+        "mid_window_dev_max": max(wdev),
         "mid_at_turn": {f"{k}": mid[min(range(len(mid)), key=lambda i: abs(c["turn"][i] - k))]
                         for k in (0.25, 0.5, 1.0, 1.5, 2.0) if c["turn"][-1] >= k - 1e-9},
         "pmax_max": max(c["pmax"]),
@@ -126,7 +141,7 @@ def analyse(d):
     wt = os.path.join(d, "wall_time.txt")
     if os.path.exists(wt):
         f["wall_s"] = float(open(wt).read().split()[0])
-    f["uniform_ok"] = f["mid_dev_max"] <= UNIFORM_TOL
+    f["uniform_ok"] = f["mid_window_dev_max"] <= UNIFORM_TOL
     f["pressure_ok"] = f["pmax_max"] < bound or not wet
     return f
 
@@ -136,9 +151,11 @@ def report(f):
         f"{f['folder']}: pressure {f['pressure']}, {f['nbeads']} beads, cells {f['cells']} x {f['ppc']}^3 points, "
         f"{f['turns']:.3f} turns ({f['rows']} rows)",
         f"  share of beads in the middle third: start {f['mid_first']:.4f}, end {f['mid_last']:.4f}, "
-        f"range {f['mid_min']:.4f}-{f['mid_max']:.4f}, largest |share - 1/3| / (1/3) = {f['mid_dev_max']:.3f} "
-        f"({'within' if f['uniform_ok'] else 'OUTSIDE'} {UNIFORM_TOL:.0%}); at turns "
-        + ", ".join(f"{k}: {v:.4f}" for k, v in f["mid_at_turn"].items()),
+        f"range {f['mid_min']:.4f}-{f['mid_max']:.4f}, largest |share - 1/3| / (1/3) of a row {f['mid_dev_max']:.3f}; "
+        f"at turns " + ", ".join(f"{k}: {v:.4f}" for k, v in f["mid_at_turn"].items()),
+        f"  quarter-turn means " + " ".join(f"{m:.4f}" for m in f["mid_window_means"])
+        + f": largest deviation {f['mid_window_dev_max']:.3f} ({'within' if f['uniform_ok'] else 'OUTSIDE'} "
+        f"{UNIFORM_TOL:.0%})",
         f"  largest point pressure {f['pmax_max']:.4g} Pa (median of the rows {f['pmax_median']:.4g} Pa, "
         f"at turn {f['pmax_turn_of_max']:.3f}); bound 5 (rho g h + rho (omega R)^2) = 5 ({f['rho_g_h']:.4g} + "
         f"{f['rho_wR2']:.4g}) = {f['pressure_bound']:.4g} Pa: {'below' if f['pressure_ok'] else 'ABOVE'}",
