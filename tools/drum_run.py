@@ -100,7 +100,8 @@ def analyse(d):
         win.setdefault(max(0, math.ceil(tu / WINDOW - 1e-9) - 1), []).append(m)
     groups = [v for _, v in sorted(win.items())]
     if len(groups) > 1 and len(groups[-1]) < 3:  # a last row or two past the end: into the window before
-        groups[-2] += groups.pop()
+        last = groups.pop()
+        groups[-1] = groups[-1] + last
     means = [sum(v) / len(v) for v in groups]
     wdev = [abs(m - 1.0 / 3.0) * 3.0 for m in means]
     m0 = c["mass"][0]

@@ -50,7 +50,7 @@ def main():
     d = os.path.join(os.path.abspath(a.work), "drum_quick")
     hfill = drum_run.fill_height(NBEADS, 0.003)
     p, wall = drum_run.run(os.path.abspath(a.exe), d, {"nbeads": NBEADS, "cells": CELLS, "ppc": PPC,
-                                                       "turns": TURNS, "tdry": 0.15, "tsettle": 0.01,
+                                                       "turns": TURNS, "tdry": 0.3, "tsettle": 0.01,
                                                        "tsnap": 0, "hfill": f"{hfill:.6g}"}, timeout=900)
     print(f"drum_quick: liggghts_mpm exit {p.returncode}, wall time {wall:.1f} s")
     check(p.returncode == 0 and "ERROR" not in p.stdout, "the reduced drum runs without error")
