@@ -1,0 +1,91 @@
+#!/usr/bin/env python3
+"""mpm_case.drum_quick: the wet tumbling mill inputs/drum/in.drum (CASES.md C7, docs/drum.md) at
+reduced size on fix mpm/fluid's defaults (pressure projection): 600 beads, cells of 10 mm (16 across
+the drum, 1 point per cell), water filling a third of the drum, the drum turning for 0.15 turn at
+75 % of the critical speed.
+
+Checks, each against a bound computed from the inputs alone (tools/drum_run.py computes them):
+  * the run ends normally with the incompressible model;
+  * axial uniformity: the share of the beads in the middle third of the drum length, averaged over
+    the run (0.15 turn, 12 rows), within 10 % of 1/3 (the scene is symmetric about the drum's middle
+    plane; the beads go in a third per third). A single row carries the binomial noise of 600
+    beads (5.8 % for one sigma; the dry drum's rows swing by up to 13.5 % over 2 turns, its
+    quarter-turn means by up to 5.9 %);
+  * pressure: the largest point pressure of every row below 5 (rho g h + rho (omega R)^2), h the
+    mixture height at rest;
+  * fluid mass f_fluid[1] identical in every row of the rotation, and between 0.8 and 1 of the
+    water of a third of the drum's inside (one point per 10 mm cell, kept half a point spacing from
+    the mantle and the bars, fills the mixture region short of its volume: 0.84 measured);
+  * no point outside the drum (beyond the mantle polygon or the caps) or inside a lifter bar, no bead
+    outside the drum;
+  * the drum moves the water: fluid kinetic energy at the end at least 1 % of
+    M (omega R)^2 / 2 (a drum that did not turn, or a wall that did not act, leaves it near 0).
+  test_drum.py --exe build/liggghts_mpm --inputs inputs --work DIR
+"""
+import argparse
+import math
+import os
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+sys.path.insert(0, os.path.normpath(os.path.join(HERE, "..", "..", "tools")))
+import cases  # noqa: E402
+from cases import check  # noqa: E402
+import drum_run  # noqa: E402
+
+# 600 beads: one row's share of the middle third carries a binomial noise of 5.8 % of 1/3 (one
+# sigma); in the dry drum (in.drum -var water 0) its quarter-turn means stay within 5.9 % of 1/3
+# over 2 turns (within 6.3 % with 300 beads over half a turn)
+NBEADS, CELLS, PPC, TURNS = 600, 16, 1, 0.15
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--exe", required=True)
+    ap.add_argument("--inputs", required=True)
+    ap.add_argument("--work", required=True)
+    ap.add_argument("--mpirun", default="")
+    a = ap.parse_args()
+    d = os.path.join(os.path.abspath(a.work), "drum_quick")
+    hfill = drum_run.fill_height(NBEADS, 0.003)
+    p, wall = drum_run.run(os.path.abspath(a.exe), d, {"nbeads": NBEADS, "cells": CELLS, "ppc": PPC,
+                                                       "turns": TURNS, "tdry": 0.3, "tsettle": 0.01,
+                                                       "tsnap": 0, "hfill": f"{hfill:.6g}"}, timeout=900)
+    print(f"drum_quick: liggghts_mpm exit {p.returncode}, wall time {wall:.1f} s")
+    check(p.returncode == 0 and "ERROR" not in p.stdout, "the reduced drum runs without error")
+    if p.returncode != 0:
+        print("\n".join(p.stdout.splitlines()[-15:]))
+        return 1
+    check("pressure projection, no sound speed" in p.stdout, "fix mpm/fluid runs its default model (pressure projection)")
+    f = drum_run.analyse(d)
+    print(drum_run.report(f))
+    c = drum_run.read_csv(os.path.join(d, "drum.csv"))
+    info = drum_run.read_info(os.path.join(d, "drum_run.txt"))
+    period = float(info["period"])
+    check(f["rows"] >= 12 and f["turns"] >= TURNS - 1e-9, f"drum.csv rows to {TURNS} turn ({f['rows']} rows, "
+          f"{f['turns']:.4f} turns, period {period:.4f} s)")
+    check(f["nbeads"] == NBEADS, f"{NBEADS} beads in the drum ({f['nbeads']})")
+    check(f["uniform_ok"] and len(f["mid_window_means"]) == 1,
+          f"share of the beads in the middle third, mean over the run {f['mid_window_means'][0]:.4f}, within 10 % "
+          f"of 1/3 (deviation {f['mid_window_dev_max']:.3f}; rows {f['mid_min']:.4f}-{f['mid_max']:.4f})")
+    check(f["pressure_ok"], f"largest point pressure {f['pmax_max']:.4g} Pa below 5 (rho g h + rho (omega R)^2) "
+          f"= {f['pressure_bound']:.4g} Pa")
+    check(max(c["mass"]) == min(c["mass"]), f"fluid mass identical in all {len(c['mass'])} rows ({c['mass'][0]!r} kg)")
+    r = 0.5 * drum_run.D
+    water = 1000.0 / 3.0 * (math.pi * r * r - drum_run.NLIFT * drum_run.HL * drum_run.WL) * drum_run.L
+    check(0.8 * water < c["mass"][0] <= water,
+          f"fluid mass {c['mass'][0]:.5g} kg within 0.8..1 of a third of the drum's inside in water ({water:.5g} kg)")
+    check(f["points_outside_max"] == 0 and f["points_in_lifters_max"] == 0 and f["beads_outside_max"] == 0,
+          f"no point outside the drum ({f['points_outside_max']:.0f}) or inside a bar "
+          f"({f['points_in_lifters_max']:.0f}), no bead outside ({f['beads_outside_max']:.0f})")
+    omega = float(info["omega"])
+    ke_ref = 0.5 * c["mass"][0] * (omega * r) ** 2
+    check(c["ke"][-1] >= 0.01 * ke_ref, f"the drum moves the water: kinetic energy {c['ke'][-1]:.3g} J >= 1 % of "
+          f"M (omega R)^2 / 2 = {ke_ref:.3g} J")
+    print(f"drum_quick: {len(cases.FAILURES)} failed check(s)")
+    return 1 if cases.FAILURES else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
