@@ -8,7 +8,8 @@ against the case's reference (CASES.md), with the wall time of each run.
 
 ROW: f1 f2 f3 f4 c1 c1var (C1 with the fluid damped while the grain is held) c2 c5 c5wall c5tilt
 c6 porewave transfer (the coupled rows again with transfer apic) damping (C5 undamped while settling,
-C6 damped while held) f3var (F3 with the other transfer) f4fine (F4 at 80 cells) fluidapic (F2 MPM32, F4 with transfer apic), or all. Each run prints one line: row, model, settings, figures, wall time (s).
+C6 damped while held) f3var (F3 with the other transfer) f4fine (F4 at 80 cells) fluidapic (F2 MPM32, F4 with transfer apic),
+c3 (C3 tank, quick size, 0.26 s) c4 (C4 jar, full size, C4_TURNS turns, default 1) starter (quick and default size), or all. Each run prints one line: row, model, settings, figures, wall time (s).
 """
 import argparse
 import json
@@ -263,8 +264,88 @@ def row_transfer(r, models):
     row_c6(r, models, extra="transfer apic", phis=(0.3,))
 
 
+def row_c3(r, models):
+    """C3 tank, quick size (Grid20, 1 point per cell, 2000 beads) to 0.26 s after the start of the lift
+    (past the water's impact on the far wall), fronts.csv every 2 ms: the time the water reaches
+    0.19 m, the fronts at 0.05-0.2 s, the largest point pressure against rho g h + rho U_gate^2, the
+    highest bead against the highest water point, the fluid mass."""
+    bound = 1000.0 * 9.81 * 0.1 + 1000.0 * 0.68 ** 2
+    for m in models:
+        d, p, w = timed(r, f"c3/{m}", "tank/in.tank", {"quick": 1, "tend": 0.26, "tfront": 0.002, "pressure": m})
+        f = read_csv(os.path.join(d, "fronts.csv"))
+        t = f["t"]
+
+        def at(k, tt):
+            return f[k][min(range(len(t)), key=lambda j: abs(t[j] - tt))]
+        reach = next((t[i] for i in range(len(t)) if f["x_water"][i] >= 0.19), float("nan"))
+        gap = max(zb - zw for zb, zw in zip(f["z_beads"], f["z_water"]))
+        figs = {"t_water_0.19m_s": reach}
+        for tt in (0.05, 0.1, 0.15, 0.2):
+            figs[f"x_water_{tt}s"] = at("x_water", tt)
+            figs[f"x_beads_{tt}s"] = at("x_beads", tt)
+        figs.update({"pmax_over_rhogh_rhoU2": max(f["pmax"]) / bound, "bead_above_water_mm": 1e3 * gap,
+                     "v_beads_max": max(f["v_beads"]), "v_water_max": max(f["v_water"]),
+                     "bed_rise_to_0.2s_mm": 1e3 * (max(z for z, tt in zip(f["z_beads"], t) if tt <= 0.2 + 1e-9)
+                                                   - f["z_beads"][0]),
+                     "mass_exact": max(f["mass"]) == min(f["mass"])})
+        emit("C3", m, "quick (Grid20 x 1, 2000 beads), 0.26 s", figs, w)
+
+
+def row_c4(r, models, turns=float(os.environ.get("C4_TURNS", "1"))):
+    """C4 jar, full size (7755 beads, cells 18 x 1 point), C4_TURNS turns (default 1), dumps every
+    0.05 s: bed altitude (tools/jar_altitude.py, from turn 0.3) against 62.18 +- 1.71 mm, the fluid
+    mass, the largest point pressure from turn 0.3 against rho g D + rho (omega R)^2."""
+    import shutil
+    import subprocess
+    import numpy as np
+    import jar_altitude
+    omega_r = 2.0 * math.pi * 104.0 / 60.0 * 0.05
+    bound = 1000.0 * 9.81 * 0.1 + 1000.0 * omega_r ** 2
+    for m in models:
+        d = r.fresh(f"c4/{m}")
+        shutil.copy(os.path.join(r.inputs, "jar", "in.jar"), d)
+        subprocess.run([sys.executable, os.path.join(HERE, "make_jar_stl.py"), "jar.stl", "--axis", "y",
+                        "--centre", "0.05", "0.05", "0.05"], cwd=d, check=True, stdout=subprocess.DEVNULL)
+        t0 = time.time()
+        r.execute(d, "in.jar", {"pressure": m, "turns": turns, "tsnap": 0.05, "trestart": 0}, timeout=86400)
+        w = time.time() - t0
+        info, rows = jar_altitude.analyse(d, 3, 1.2)
+        alt = np.array([a for (t, tu, a, z, n) in rows if tu >= 0.3])
+        c = read_csv(os.path.join(d, "jar.csv"))
+        p = [x for x, tu in zip(c["pmax"], c["turn"]) if tu >= 0.3]
+        emit("C4", m, f"7755 beads, cells 18 x 1, {turns} turns",
+             {"altitude_mm": float(alt.mean()) if len(alt) else float("nan"),
+              "altitude_std_mm": float(alt.std()) if len(alt) else float("nan"), "dumps": len(alt),
+              "pmax_median_Pa": float(np.median(p)) if p else float("nan"), "pmax_Pa": max(p) if p else float("nan"),
+              "pmax_over_rhogD_rhowR2": (max(p) / bound) if p else float("nan"),
+              "mass_exact": max(c["mass"]) == min(c["mass"]), "mass_kg": c["mass"][0]}, w)
+
+
+def row_starter(r, models):
+    """Starter scene, quick (300 beads, cell 10 mm) and default size (800 beads, cell 5 mm): the
+    largest point pressure against rho g h + rho U^2, U = sqrt(2 g h) of the 0.06 m column. The starter
+    input runs the fix's defaults only (no eos branch): other models are skipped."""
+    sys.path.insert(0, os.path.join(TOP, "tests", "cases"))
+    from test_starter import thermo_blocks
+    bound = 1000.0 * 9.81 * 0.06 * 3.0
+    for m in models:
+        if m != "projection":
+            print(f"starter | {m} | skipped: in.pour_and_collapse runs the fix's defaults only", flush=True)
+            continue
+        for size, v in (("quick", {"quick": 1}), ("default size", {})):
+            d, p, w = timed(r, f"starter/{size.split()[0]}", "starter/in.pour_and_collapse", v)
+            b = thermo_blocks(p.stdout)
+            pm = max(row[h.index("fluid[10")] for h, rows in b[1:] for row in rows)
+            mass = [row[h.index("fluid[1]")] for h, rows in b[1:] for row in rows]
+            fh, fl = b[2]
+            emit("starter", m, size, {"pmax_Pa": pm, "pmax_over_rhogh_rhoU2": pm / bound,
+                                      "front_end_m": fl[-1][fh.index("fluid[4]")],
+                                      "mass_exact": max(mass) == min(mass)}, w)
+
+
 ROWS = {"f1": row_f1, "f2": row_f2, "f3": row_f3, "f4": row_f4, "c1": row_c1, "c2": row_c2, "c5": row_c5,
-        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "f4fine": row_f4fine, "fluidapic": row_fluidapic, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer}
+        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "f4fine": row_f4fine, "fluidapic": row_fluidapic, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer,
+        "c3": row_c3, "c4": row_c4, "starter": row_starter}
 
 
 def main():
