@@ -51,7 +51,7 @@ constexpr double kSurfaceFill = 0.25;
 // flow; corrected, it moved the surface of a standing wave of 2 % of the depth: amplitude over
 // three periods 0.84 of its start with no band, 1.003 with 0.02, 0.953 with 0.05 (0.953 without
 // any correction); the sloshing tank's volume after 10 s 1.007 / 1.009 / 1.018 of the start
-// (docs/projection.md, "Volume over long runs")
+// (docs/projection.md, "Volume drift and `volume_correction`")
 constexpr double kVolumeBand = 0.02;
 // Ghost surface: a node is FLUID when level_is_fluid(level) (projection_ops.h, kLevelTie). A fluid
 // filled up to a node plane gives its nodes a level of exactly 0 up to round-off; with 0 as the
@@ -672,8 +672,8 @@ void Projection::add_volume_correction(const double *pvol, const double *theta, 
    source gives the potential q, and w = -(dt / rho) grad q is the velocity whose divergence
    removes the fraction a of the error this step. The points move by dt w on top of the fluid's
    velocity; w never enters their velocity, so the correction neither adds momentum nor energy
-   (as a source in the velocity's own solve it damped a standing wave of 2 % of the depth by 14 %
-   in three periods at 20 cells, docs/projection.md "Volume over long runs"). Zero first guess:
+   (as a source in the velocity's own solve it entered the points' velocity, which FLIP keeps;
+   docs/projection.md "Volume drift and `volume_correction`"). Zero first guess:
    the drift of a step is a function of that step's state only (restart, np 2 = np 1). */
 void Projection::volume_drift(const double *pvol, const double *theta, double h, double share, long step) {
   const std::size_t n = grid_.size();
