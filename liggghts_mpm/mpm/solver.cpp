@@ -144,16 +144,13 @@ void FluidSolver::step() {
   if (opt.coupled) grain_force_.assign(3 * static_cast<std::size_t>(pts.nlocal), 0.0);
   // the volume correction runs on every M-th fluid step (its first sub-step), removing the share
   // min(k M hf, 1) of the volume error each time (Projection::volume_correction_every)
-  vc_interval_ = 0.0;
+  double vc_time = 0.0;
   if (opt.projection && opt.volume_correction > 0.0) {
     const double hf = opt.fluid_every * clock.dt;
     const long every = Projection::volume_correction_every(opt.volume_correction, hf);
-    if ((clock.step / opt.fluid_every) % every == 0) vc_interval_ = every * hf;
+    if ((clock.step / opt.fluid_every) % every == 0) vc_time = every * hf;
   }
-  for (int s = 0; s < state.nsub; ++s) {
-    substep(h);
-    vc_interval_ = 0.0;
-  }
+  for (int s = 0; s < state.nsub; ++s) substep(h, s == 0 ? vc_time : 0.0);
   if (!opt.coupled) return;
   // fluid force on the grains (mean over the sub-steps), for the host's integrator. With every N
   // the grains get the impulse of the N steps, N h F, in this step (force N F): velocity Verlet
@@ -170,7 +167,7 @@ void FluidSolver::step() {
 }
 
 // One sub-step of chapter 8, phase by phase.
-void FluidSolver::substep(double h) {
+void FluidSolver::substep(double h, double vc_time) {
   timed(time_fluid, [&] { compute_shapes(); });
   if (opt.coupled)
     timed(time_couple, [&] {
@@ -180,7 +177,7 @@ void FluidSolver::substep(double h) {
   timed(time_fluid, [&] { particles_to_grid(); });
   if (opt.coupled) timed(time_couple, [&] { couple_fluid_grains(h); });
   timed(time_fluid, [&] {
-    update_grid(h);
+    update_grid(h, vc_time);
     if (opt.projection) interpolate_pressure();
     grid_to_particles();
     if (opt.musl) remap_velocity_musl(h);
@@ -328,7 +325,7 @@ void FluidSolver::outside_patch(const double *x) const {
 }
 
 /* grid momentum update (8-35), velocity (8-36), boundary conditions */
-void FluidSolver::update_grid(double h) {
+void FluidSolver::update_grid(double h, double vc_time) {
   const double mmin = mass_min();
   for_owned_nodes([&](int i, int j, int k, std::size_t n) {
     const double *g = &g_.p2g[P2gRec::N * n];
@@ -350,13 +347,13 @@ void FluidSolver::update_grid(double h) {
     for (int d = 0; d < 3; ++d) gv[VelRec::V_NEW + d] = vnew[d];
   });
   if (opt.projection) {
-    const bool vc = vc_interval_ > 0.0;
+    const bool vc = vc_time > 0.0;
     if (vc) point_volume_to_grid();
     IndexBox work;
     const bool sparse_proj = sparse_ && !opt.coupled && !bc.walls();
     if (sparse_proj) work = projection_work_box();
     proj_->project(g_.vel.data(), g_.p2g.data(), mmin, opt.coupled ? g_.th.data() : nullptr, h,
-                   bc, clock.step, vc ? pvol_.data() : nullptr, sparse_proj ? &work : nullptr, vc_interval_);
+                   bc, clock.step, vc ? pvol_.data() : nullptr, sparse_proj ? &work : nullptr, vc_time);
   }
   grid_.forward(g_.vel.data(), VelRec::N);
 }

@@ -145,7 +145,9 @@ class FluidSolver {
   void refresh_pressure();          // coupling: density and pressure for the new theta
   void particles_to_grid();         // P2G (8-10), (8-19), (8-24), traction (8-23)
   void couple_fluid_grains(double h);  // coupling: pressure fit, drag exchange (8-25)-(8-29)
-  void update_grid(double h);       // (8-35), (8-36), boundary conditions (projection: u*, solve, correction)
+  // (8-35), (8-36), boundary conditions (projection: u*, solve, correction); vc_time > 0: the
+  // volume correction is due and stands for that time (Projection::volume_correction_every)
+  void update_grid(double h, double vc_time = 0.0);
   void interpolate_pressure();      // projection: the points' pressure from the nodes
   void point_volume_to_grid();      // projection + volume_correction: sum S V of the points
   void projection_gradient_to_grains();  // projection + couple: grad p for the grains
@@ -153,7 +155,7 @@ class FluidSolver {
   void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
   void update_stress(double h, bool theta_only = false);  // (7-21)-(7-24)
   void advance_positions(double h); // (8-41), points put back
-  void substep(double h);           // all of them
+  void substep(double h, double vc_time = 0.0);  // all of them
   GridFields &fields() { return g_; }
   const LocalGrid &grid() const { return grid_; }
   // sparse grid (keyword sparse; pure eos fluid): the active blocks of this sub-step, and whether
@@ -270,7 +272,6 @@ class FluidSolver {
   // the pressure solver's time, solves and PCG iterations of the Projections of earlier patches
   double proj_seconds_before_ = 0.0;
   long proj_solves_before_ = 0, proj_iterations_before_ = 0;
-  double vc_interval_ = 0.0;  // volume correction due this sub-step: the time it stands for (else 0)
   std::vector<double> pvol_;          // volume_correction: sum S V of the points per node
   double vmax_ = 0.0;                 // |v|max of the points at the last time-step check
   long last_output_step_ = -1;
