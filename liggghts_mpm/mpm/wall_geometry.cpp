@@ -2,6 +2,8 @@
 // docs/mesh_walls.md.
 #include "mpm/wall_geometry.h"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cstring>
 #include <cmath>
@@ -770,64 +772,43 @@ int WallGeometry::node_side(const double x[3], double reach, double *dist) const
 // u = w - v0, omega solves sum (|r|^2 I - r r^T) omega = sum r x u (exact for a rigid rotation;
 // singular only for nodes on one line, then 0).
 void WallGeometry::fit_rotation() {
+  using Eigen::Matrix3d;
+  using Eigen::Vector3d;
   const std::size_t nw = walls_.size();
   omega_.assign(nw, 0.0);
   for (std::size_t k = 0; k < nw; ++k) {
     if (!(walls_[k].kind == WALL_SHEAR && walls_[k].delta_auto)) continue;
-    double c[3] = {0, 0, 0}, v0[3] = {0, 0, 0};
+    // mean node position c and velocity v0, largest node speed
     long n = 0;
-    for (const Tri &t : tris_)
-      if (t.mesh == static_cast<int>(k))
-        for (int a = 0; a < 3; ++a, ++n)
-          for (int d = 0; d < 3; ++d) {
-            c[d] += t.p[a][d];
-            v0[d] += t.w[a][d];
-          }
-    if (n < 3) continue;
-    for (int d = 0; d < 3; ++d) {
-      c[d] /= n;
-      v0[d] /= n;
+    Vector3d c = Vector3d::Zero(), v0 = Vector3d::Zero();
+    double vmax = 0.0;
+    for (const Tri &t : tris_) {
+      if (t.mesh != static_cast<int>(k)) continue;
+      for (int a = 0; a < 3; ++a, ++n) {
+        c += Vector3d(t.p[a][0], t.p[a][1], t.p[a][2]);
+        const Vector3d w(t.w[a][0], t.w[a][1], t.w[a][2]);
+        v0 += w;
+        vmax = std::max(vmax, w.norm());
+      }
     }
-    double A[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, b[3] = {0, 0, 0};
+    if (n < 3) continue;
+    c /= n;
+    v0 /= n;
+    Matrix3d A = Matrix3d::Zero();
+    Vector3d b = Vector3d::Zero();
     for (const Tri &t : tris_) {
       if (t.mesh != static_cast<int>(k)) continue;
       for (int a = 0; a < 3; ++a) {
-        double r[3], u[3];
-        for (int d = 0; d < 3; ++d) {
-          r[d] = t.p[a][d] - c[d];
-          u[d] = t.w[a][d] - v0[d];
-        }
-        const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-        for (int d = 0; d < 3; ++d)
-          for (int e = 0; e < 3; ++e) A[d][e] += (d == e ? r2 : 0.0) - r[d] * r[e];
-        b[0] += r[1] * u[2] - r[2] * u[1];
-        b[1] += r[2] * u[0] - r[0] * u[2];
-        b[2] += r[0] * u[1] - r[1] * u[0];
+        const Vector3d r = Vector3d(t.p[a][0], t.p[a][1], t.p[a][2]) - c;
+        A += r.squaredNorm() * Matrix3d::Identity() - r * r.transpose();
+        b += r.cross(Vector3d(t.w[a][0], t.w[a][1], t.w[a][2]) - v0);
       }
     }
-    // Cramer's rule on the symmetric 3x3 system
-    auto det3 = [](const double m[3][3]) {
-      return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-             m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    };
-    const double D = det3(A);
-    const double scale = A[0][0] + A[1][1] + A[2][2];
-    if (!(std::fabs(D) > 1e-12 * scale * scale * scale)) continue;
-    double om[3];
-    for (int col = 0; col < 3; ++col) {
-      double M[3][3];
-      for (int d = 0; d < 3; ++d)
-        for (int e = 0; e < 3; ++e) M[d][e] = e == col ? b[d] : A[d][e];
-      om[col] = det3(M) / D;
-    }
+    const double scale = A.trace();  // 2 sum |r|^2
+    if (!(std::fabs(A.determinant()) > 1e-12 * scale * scale * scale)) continue;
+    const double om = A.ldlt().solve(b).norm();
     // a turn below the round-off of the node velocities is none (a translating wall)
-    double vmax = 0.0;
-    for (const Tri &t : tris_)
-      if (t.mesh == static_cast<int>(k))
-        for (int a = 0; a < 3; ++a) vmax = std::max(vmax, std::sqrt(t.w[a][0] * t.w[a][0] + t.w[a][1] * t.w[a][1] + t.w[a][2] * t.w[a][2]));
-    const double w = std::sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);
-    const double rrms = std::sqrt(0.5 * scale / n);  // trace A = 2 sum |r|^2
-    omega_[k] = w * rrms > 1e-12 * vmax ? w : 0.0;
+    omega_[k] = om * std::sqrt(0.5 * scale / n) > 1e-12 * vmax ? om : 0.0;
   }
 }
 
