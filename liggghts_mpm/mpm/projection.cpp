@@ -637,17 +637,18 @@ void Projection::mirror_normal(double *v, int i, int j, int k, const double *p2g
    one). The points' volume on the grid, phi_n = sum_p S_np V_p / (dx^3 volume(n)), is 1 where
    they fill the space evenly (exactly, at rest, for a regular fill); the shares the B-spline gives
    to the padding nodes behind a box wall count at their mirror node inside (as the coupling folds
-   the grains' volume). The continuity target of the solve gets the rate that removes the fraction
-   a = min(k M h, 1) of the error e = phi - 1 on every M-th step (volume_correction_every):
-       D_new + volume(n) d(theta)/dt = volume(n) theta_n a e_n / h,
+   the grains' volume). The source of the correction's own solve (volume_drift) removes the
+   share a = min(k M h, 1) of the error e = phi - 1 (beyond kVolumeBand) on every M-th step
+   (volume_correction_every): the drift w it gives has
+       D(w) = volume(n) theta_n a e_n / h,
    i.e. rhs_n -= volume(n) theta_n a e_n / h^2: crowded points (e > 0) are pushed apart, and gaps
    (e < 0) drawn together, but the latter only where no EMPTY node lies within two nodes
    (deep_inside): under the free surface phi falls from 1 to 0 over 1.5 cells and is no error.
    Measured: correcting compression alone removed it better but opened gaps, the fluid's volume
    on the grid growing by 2-8 % (docs/projection.md). The density-error source of the pressure
    equation of Kugelstadt, Longva, Thuerey & Bender (2021), "Implicit density projection for
-   volume conserving liquids", IEEE TVCG 27(4), here as a relaxation term of the one divergence
-   solve instead of their second, position-based solve. */
+   volume conserving liquids", IEEE TVCG 27(4), applied as they do to the positions, with the
+   projection's operator. */
 void Projection::add_volume_correction(const double *pvol, const double *theta, double h, double a) {
   const GridSpec &gs = opt_.grid;
   vol_.assign(pvol, pvol + grid_.size());
