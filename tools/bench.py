@@ -54,6 +54,7 @@ TOP = os.path.normpath(os.path.join(HERE, ".."))
 sys.path.insert(0, HERE)
 import dambreak_error  # noqa: E402
 import laser_sweep  # noqa: E402
+import mpm_io  # noqa: E402
 from laser_common import run_case  # noqa: E402
 
 # idle ranks yield the core: the machine is shared with other jobs (no effect on an idle machine)
@@ -638,13 +639,7 @@ def main():
         f.write("| metric | value | unit | note |\n| --- | --- | --- | --- |\n")
         for m, v, u, n in RESULTS:
             f.write("| %s | %s | %s | %s |\n" % (m, fmt(v), u, n))
-    keys = []
-    for r in RUNS:
-        keys += [k for k in r if k not in keys]
-    with open(os.path.join(a.out, "runs.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=keys)
-        w.writeheader()
-        w.writerows(RUNS)
+    mpm_io.write_rows(os.path.join(a.out, "runs.csv"), RUNS)
     say("wrote bench-results.csv, %s/results.csv, results.md, runs.csv (%.0f s)" % (a.out, total))
     return 1 if failed else 0
 

@@ -21,6 +21,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mpm_io  # noqa: E402
 from laser_common import find_exe, run_case  # noqa: E402
 
 INTENSITIES = [2.5e10, 5.0e10, 7.5e10, 10.0e10, 12.5e10, 14.3e10, 16.0e10]
@@ -76,13 +77,7 @@ def vary_sweep(a):
             row.update(status="refused" if code == 2 else "error", message=err.splitlines()[-1] if err else "")
         rows.append(row)
         print("%-40s %-12s %s" % (name, row["status"], row.get("message", "")), file=sys.stderr)
-    keys = []
-    for r in rows:
-        keys += [k for k in r if k not in keys]
-    with open(os.path.join(a.out, "sweep.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=keys)
-        w.writeheader()
-        w.writerows(rows)
+    mpm_io.write_rows(os.path.join(a.out, "sweep.csv"), rows)
     print("wrote %s" % os.path.join(a.out, "sweep.csv"))
 
 

@@ -8,12 +8,14 @@
   h5_series(rundir, prefix)           the HDF5 files of one output prefix, by time
   xmf_series(rundir)                  the fix's XDMF indexes (prefix.xmf) of a folder, with their steps
   paired_frames(rundir, prefix)       steps that have both an HDF5 file and a bead dump
+  write_rows(path, rows)              a list of dicts as CSV (columns: every key, in order of first use)
 
 The HDF5 layout (liggghts_mpm/mpm/hdf5_series.cpp, docs/fix_mpm_fluid.md 'Output'):
 prefix_<step, 9 digits>.h5 with root attributes 'time' and 'step', /points/xyz (n, 3) and one data
 set per point field (/points/v (n, 3), /points/p (n), ...); prefix.xmf lists the steps as comment
 blocks '<!-- mpm-step step="S" time="T" file="F" -->' (a restarted run drops the later ones).
 """
+import csv
 import glob
 import html
 import os
@@ -182,3 +184,15 @@ def paired_frames(rundir, prefix, dump_name="beads"):
         if m:
             out.setdefault(int(m.group(1)), [None, None])[1] = p
     return {s: tuple(v) for s, v in out.items() if v[0] and v[1]}
+
+
+def write_rows(path, rows):
+    """rows (dicts) as a CSV file whose columns are every key of any row, in the order of first use;
+    a row without a key leaves its cell empty."""
+    keys = []
+    for r in rows:
+        keys += [k for k in r if k not in keys]
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys)
+        w.writeheader()
+        w.writerows(rows)
