@@ -8,7 +8,7 @@ Checks:
   1. every relative link and image in docs/**/*.md, README.md and CHANGELOG.md names a file that
      exists, and a `#fragment` names a heading of the target page (GitHub's anchors);
   2. every page under docs/ is reachable from docs/index.md by following links;
-  3. every image under docs/img/ is linked or embedded by some page (docs/ or README.md);
+  3. every image under docs/img/ is embedded (![...](...) or <img>) in some page (docs/ or README.md);
   4. no page speaks of lab history: the words and dates that belong in git's log, not in the text.
 Links inside code spans and fenced code blocks are not links and are skipped.
 """
@@ -18,8 +18,8 @@ import sys
 import tempfile
 
 IMAGE_EXT = (".png", ".jpg", ".jpeg", ".svg", ".gif")
-LINK = re.compile(r"!?\[(?:[^\]\[]|\[[^\]]*\])*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
-HTML_SRC = re.compile(r"<(?:img|a)\s[^>]*?(?:src|href)=\"([^\"]+)\"", re.I)
+LINK = re.compile(r"(!?)\[(?:[^\]\[]|\[[^\]]*\])*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
+HTML_SRC = re.compile(r"<(img|a)\s[^>]*?(?:src|href)=\"([^\"]+)\"", re.I)
 HISTORY = re.compile(r"session|issue #|issue [0-9]+|[0-9]+ (november|december) 20"
                      r"|\b[0-9]{1,2} (jan|feb|mar|apr|may|jun|jul|aug|sep|oct|nov|dec)[a-z]* 20[0-9]{2}", re.I)
 
@@ -65,13 +65,13 @@ def anchors(path, cache={}):
 
 
 def links(path):
-    """(line number, target) of every link and image of a Markdown page."""
+    """(line number, target, embedded) of every link and image of a Markdown page."""
     text = strip_code(open(path, encoding="utf-8").read())
     for i, line in enumerate(text.split("\n"), 1):
         for m in LINK.finditer(line):
-            yield i, m.group(1)
+            yield i, m.group(2), m.group(1) == "!"
         for m in HTML_SRC.finditer(line):
-            yield i, m.group(1)
+            yield i, m.group(2), m.group(1).lower() == "img"
 
 
 def check(root):
@@ -79,10 +79,10 @@ def check(root):
     pages = sorted(os.path.join(d, f) for d, _, fs in os.walk(docs) for f in fs if f.endswith(".md"))
     extra = [os.path.join(root, f) for f in ("README.md", "CHANGELOG.md") if os.path.isfile(os.path.join(root, f))]
     rel = lambda p: os.path.relpath(p, root)
-    errors, graph, referenced = [], {}, set()
+    errors, graph, embedded = [], {}, set()
     for page in pages + extra:
         graph[page] = set()
-        for line, target in links(page):
+        for line, target, is_image in links(page):
             if re.match(r"[a-zA-Z][a-zA-Z0-9+.-]*:", target):
                 continue  # http:, https:, mailto:
             path, _, frag = target.partition("#")
@@ -93,7 +93,8 @@ def check(root):
             if frag and dest.endswith(".md") and frag not in anchors(dest):
                 errors.append("%s:%d: link to %s: no heading with anchor '#%s' in %s"
                               % (rel(page), line, target, frag, rel(dest)))
-            referenced.add(dest)
+            if is_image:
+                embedded.add(dest)
             if dest.endswith(".md"):
                 graph[page].add(dest)
     index = os.path.join(docs, "index.md")
@@ -113,8 +114,8 @@ def check(root):
     for d, _, fs in os.walk(img):
         for f in sorted(fs):
             p = os.path.join(d, f)
-            if f.lower().endswith(IMAGE_EXT) and p not in referenced:
-                errors.append("%s: image referenced by no page" % rel(p))
+            if f.lower().endswith(IMAGE_EXT) and p not in embedded:
+                errors.append("%s: image embedded in no page" % rel(p))
     for page in pages + extra:
         for i, line in enumerate(open(page, encoding="utf-8").read().split("\n"), 1):
             m = HISTORY.search(line)
@@ -132,17 +133,20 @@ def self_test():
             open(p, "w", encoding="utf-8").write(text)
         write("README.md", "[docs](docs/index.md)\n")
         write("docs/index.md", "# Index\n[a](guide/a.md) [b](guide/a.md#usage)\n"
-                               "[bad anchor](guide/a.md#nowhere)\n`[not a link](missing.md)`\n")
+                               "[bad anchor](guide/a.md#nowhere)\n`[not a link](missing.md)`\n[b](guide/b.md)\n")
         write("docs/guide/a.md", "# A\n## Usage\n![fig](../img/used.png) [gone](../img/gone.png)\n"
                                  "```\n[in code](nothing.md)\n```\n")
         write("docs/orphan.md", "# Orphan\nwritten in one session\n")
         write("docs/img/used.png", "")
         write("docs/img/unused.png", "")
+        write("docs/img/linked.png", "")
+        write("docs/guide/b.md", "# B\n[only linked](../img/linked.png)\n")
         errors, _ = check(root)
         expect = ["docs/index.md:3: link to guide/a.md#nowhere: no heading",
                   "docs/guide/a.md:3: link to ../img/gone.png: no such file",
                   "docs/orphan.md: not reachable",
-                  "docs/img/unused.png: image referenced by no page",
+                  "docs/img/unused.png: image embedded in no page",
+                  "docs/img/linked.png: image embedded in no page",
                   "docs/orphan.md:2: lab history"]
         missing = [e for e in expect if not any(x.startswith(e) for x in errors)]
         if missing or len(errors) != len(expect):
