@@ -152,31 +152,38 @@ Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) cons
     if (!(e < kNoDecrease * best)) stalled = ++stalls >= 2;
     best = std::min(best, e);
   }
+  Estimate est{dt, companion, ed, ev, runs, steps, stalled, history};
+  report(fine, cfg, est);
+  return fine;
+}
+
+// Records the estimate in the reported run and marks it inaccurate where the
+// estimate is above --tol (with the history when refining stalled).
+void TimeStepPolicy::report(Result& fine, const Config& cfg, const Estimate& est) const {
   StepReport& s = fine.step;
   s.automatic = automatic_;
-  s.companion_dt = companion;
-  s.depth_error = ed;
-  s.volume_error = ev;
-  s.runs = runs;
-  s.steps_total = steps;
+  s.companion_dt = est.companion;
+  s.depth_error = est.ed;
+  s.volume_error = est.ev;
+  s.runs = est.runs;
+  s.steps_total = est.steps;
   s.stable_limit = dt_stable_;
-  s.reason = reason_ + (dt < dt_ ? ", refined to meet --tol" : "");
-  if (std::max(ed, ev) > cfg.tol && (fine.status == "ok" || fine.status == "inaccurate")) {
-    const std::string m = "estimated error of the time step: depth " + fmt(ed, 4) + ", volume " + fmt(ev, 4) +
-                          " (step doubling, dt = " + fmt(dt, 4) + " s against " + fmt(companion, 4) +
+  s.reason = reason_ + (est.dt < dt_ ? ", refined to meet --tol" : "");
+  if (std::max(est.ed, est.ev) > cfg.tol && (fine.status == "ok" || fine.status == "inaccurate")) {
+    const std::string m = "estimated error of the time step: depth " + fmt(est.ed, 4) + ", volume " + fmt(est.ev, 4) +
+                          " (step doubling, dt = " + fmt(est.dt, 4) + " s against " + fmt(est.companion, 4) +
                           " s) above --tol " + fmt(cfg.tol, 4) +
-                          (automatic_ ? (stalled ? "" : " after refining to the step budget")
+                          (automatic_ ? (est.stalled ? "" : " after refining to the step budget")
                                       : "; use a smaller --dt or leave it automatic");
     const std::string stall =
-        stalled ? "; time-step error not decreasing: the estimate did not fall below " + fmt(kNoDecrease, 3) +
-                      " of the smallest one in two halvings (" + history + "): the result does not converge in dt, "
+        est.stalled ? "; time-step error not decreasing: the estimate did not fall below " + fmt(kNoDecrease, 3) +
+                      " of the smallest one in two halvings (" + est.history + "): the result does not converge in dt, "
                       "refining stopped"
                 : "";
     fine.message = fine.status == "ok" ? m + stall : fine.message + "; " + m + stall;
     fine.status = "inaccurate";
-    if (stalled) fine.causes.push_back("time-step error not decreasing");
+    if (est.stalled) fine.causes.push_back("time-step error not decreasing");
   }
-  return fine;
 }
 
 }  // namespace laser
