@@ -465,6 +465,9 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
                     {"companion_dt_s", num(r.step.companion_dt)},
                     {"depth_error_estimate", num(r.step.depth_error)},
                     {"volume_error_estimate", num(r.step.volume_error)},
+                    {"grid_companion_dxi", num(r.step.grid_companion_dxi)},
+                    {"grid_depth_error_estimate", num(r.step.grid_depth_error)},
+                    {"grid_volume_error_estimate", num(r.step.grid_volume_error)},
                     {"tol", num(cfg.tol)},
                     {"runs", r.step.runs},
                     {"steps_total", r.step.steps_total},
@@ -499,6 +502,8 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   // implicit update), and 2/lambda at its largest along the run (thin layers
   // right after onset; the run-time check fires only when g also oscillates)
   j["max_stable_dt_s"] = r.step.stable_limit > 0 ? num(r.step.stable_limit) : nlohmann::ordered_json(nullptr);
+  // the largest --dt accepted with the explicit update (half of the limit above)
+  j["max_accepted_dt_s"] = r.step.accepted_limit > 0 ? num(r.step.accepted_limit) : nlohmann::ordered_json(nullptr);
   j["min_2_over_lambda_seen_s"] = num(r.max_stable_dt);
   j["melt_thickness_clamps"] = r.melt_clamps;
   j["melt_rate_clamps"] = r.melt_rate_clamps;
