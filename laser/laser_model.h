@@ -84,6 +84,7 @@ struct StepReport {
   double depth_error = 0;    // relative, estimated error of the reported run
   double volume_error = 0;
   double grid_companion_dxi = 0;  // d(xi) of the grid companion run (0: none)
+  double grid_companion_dt = 0;   // s, its step (the step-doubling companion's), compared with the run at that step
   double grid_depth_error = 0;    // relative, estimated d(xi) error of the reported run (NaN: no estimate)
   double grid_volume_error = 0;
   int runs = 0;

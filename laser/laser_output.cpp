@@ -466,6 +466,7 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
                     {"depth_error_estimate", num(r.step.depth_error)},
                     {"volume_error_estimate", num(r.step.volume_error)},
                     {"grid_companion_dxi", num(r.step.grid_companion_dxi)},
+                    {"grid_companion_dt_s", num(r.step.grid_companion_dt)},
                     {"grid_depth_error_estimate", num(r.step.grid_depth_error)},
                     {"grid_volume_error_estimate", num(r.step.grid_volume_error)},
                     {"tol", num(cfg.tol)},

@@ -47,9 +47,9 @@ class TimeStepPolicy {
     long steps;
     bool stalled;
     std::string history;
-    double grid_dxi = 0, grid_ed = 0, grid_ev = 0;  // grid companion's d(xi) and the relative error estimates
+    double grid_dxi = 0, grid_dt = 0, grid_ed = 0, grid_ev = 0;  // grid companion's d(xi), step, error estimates
   };
-  void grid_estimate(Result& fine, const Config& cfg, Estimate& est) const;
+  void grid_estimate(Result& fine, const Result& coarse, const Config& cfg, Estimate& est) const;
   void report(Result& fine, const Config& cfg, const Estimate& est) const;
   Result run_at(Config cfg, double dt, const SinkFactory& make_sink, bool reported, long& steps) const;
   void check_work(const Config& cfg) const;
