@@ -130,7 +130,7 @@ def case_lifters_projection(r):
 
 
 def lifters_checks(d, label):
-    """Measured (docs/fix_mpm_fluid.md, "Wall loads and probes"): F_z +3.7 %, T_y -5.0 %. The
+    """Measured (docs/fix_mpm_fluid.md, "Wall loads and probes"): F_z +3.8 %, T_y -5.3 %. The
     acceptance of 1 % is not met; the bounds below hold what was measured (5 %, 8 %) so that a
     change that makes it worse is seen."""
     v = {k: c[0] for k, c in read_csv(os.path.join(d, "wall_force_lifters.csv")).items()}
