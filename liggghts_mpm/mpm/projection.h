@@ -74,6 +74,10 @@ class Projection {
   // positions only, never their velocity or momentum); empty when there is no correction
   const std::vector<double> &volume_drift() const { return drift_; }
   int iterations() const { return last_.iterations; }
+  // FLUID nodes (all ranks) and sets of them that closed faces sealed off from the free surface
+  // in the last solve (PressureResult::sealed, sealed_sets)
+  long sealed_nodes() const { return last_.sealed; }
+  long sealed_sets() const { return last_.sealed_sets; }
   double residual() const { return last_.relative_residual; }
   // since construction, this rank: wall time in the pressure solver (hypre assembly, setup and
   // PCG), number of solves (with the acceleration pressure two per fluid step), PCG iterations

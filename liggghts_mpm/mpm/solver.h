@@ -136,6 +136,10 @@ class FluidSolver {
   double time_pressure_solver() const;
   long pressure_solves() const;
   long pressure_iterations_summed() const;
+  // pressure projection: FLUID nodes (all ranks) and pockets of them sealed off from the free
+  // surface by closed wall faces in the last solve (0 with eos)
+  long pressure_sealed_nodes() const;
+  long pressure_sealed_sets() const;
   std::size_t memory_bytes() const;
 
   // The phases of substep, in order; public so that a test (or another model) can run them one by
