@@ -157,16 +157,69 @@ bool PressureSolver::unknown(const NodeLabels &labels, int i, int j, int k, std:
    on any rank. Returns the number of FLUID nodes in sealed sets on all ranks. Collective. */
 long PressureSolver::seal_components(const NodeLabels &labels) {
   std::vector<double> &c = h_->comp;
-  c.assign(grid_.size(), -1.0);
   const IndexBox &ob = grid_.owned();
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (labels.kind[n] != kFluid) return;
-    c[n] = double(node_key(i, j, k));
+  // First a flood fill from the FLUID nodes next to an EMPTY one (-1: reached; -2: FLUID not yet
+  // reached), across the ranks through the halos until no rank finds a new seed: in the common case
+  // it reaches every FLUID node and that is all the cost.
+  constexpr double kReached = -1.0, kUnreached = -2.0;
+  c.assign(grid_.size(), kReached);
+  std::vector<std::size_t> queue;
+  std::vector<int> qi;  // i, j, k of the queued nodes
+  auto push = [&](int i, int j, int k, std::size_t n) {
+    c[n] = kReached;
+    queue.push_back(n);
+    qi.insert(qi.end(), {i, j, k});
+  };
+  auto next_to = [&](int i, int j, int k, bool empty) {
     for (int d = 0; d < 3; ++d)
       for (int side = -1; side <= 1; side += 2) {
         std::size_t m;
-        if (open_face(grid_, labels, i, j, k, d, side, &m) && labels.kind[m] == kEmpty) c[n] = -1.0;
+        if (!open_face(grid_, labels, i, j, k, d, side, &m)) continue;
+        if (empty ? labels.kind[m] == kEmpty : (labels.kind[m] == kFluid && c[m] == kReached)) return true;
       }
+    return false;
+  };
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    if (labels.kind[n] == kFluid) c[n] = kUnreached;
+  });
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (labels.kind[n] == kFluid && next_to(i, j, k, true)) push(i, j, k, n);
+  });
+  for (;;) {
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const int i = qi[3 * q], j = qi[3 * q + 1], k = qi[3 * q + 2];
+      for (int d = 0; d < 3; ++d)
+        for (int side = -1; side <= 1; side += 2) {
+          std::size_t m;
+          if (!open_face(grid_, labels, i, j, k, d, side, &m) || labels.kind[m] != kFluid || c[m] != kUnreached)
+            continue;
+          int a[3] = {i, j, k};
+          a[d] += side;
+          if (ob.contains(a[0], a[1], a[2])) push(a[0], a[1], a[2], m);
+        }
+    }
+    queue.clear();
+    qi.clear();
+    grid_.forward(c.data(), 1);
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+      if (labels.kind[n] == kFluid && c[n] == kUnreached && next_to(i, j, k, false)) push(i, j, k, n);
+    });
+    long seeds = long(queue.size()), gseeds = 0;
+    MPI_Allreduce(&seeds, &gseeds, 1, MPI_LONG, MPI_SUM, comm_);
+    if (gseeds == 0) break;
+  }
+  long unreached = 0, gunreached = 0;
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    if (labels.kind[n] == kFluid && c[n] == kUnreached) ++unreached;
+  });
+  MPI_Allreduce(&unreached, &gunreached, 1, MPI_LONG, MPI_SUM, comm_);
+  if (gunreached == 0) {
+    c.clear();
+    return 0;
+  }
+  // The nodes left are sealed: each takes the smallest key of its set.
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (labels.kind[n] == kFluid && c[n] == kUnreached) c[n] = double(node_key(i, j, k));
   });
   grid_.forward(c.data(), 1);
   auto relax = [&](int i, int j, int k) {
