@@ -420,8 +420,45 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
         if (open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kFluid) gk[n] = 1.0;
       }
   });
+  // An EMPTY node next to the fluid has from pressure_gradient only the components along its faces
+  // to FLUID nodes: above a level surface the vertical one, and 0 along the surface, so the points
+  // near the surface read an unaccelerated velocity along it from the nodes above them and the
+  // standing wave ran slow (20 cells across: 0.962 of its frequency). The other components are
+  // the mean of the FLUID neighbours' (docs/theory/projection.md, "Free surface: the gradient
+  // along the surface").
+  {
+  std::vector<std::pair<std::size_t, int>> fill;
+  std::vector<double> val;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] != kEmpty || gk[n] == 0.0) return;
+    for (int d = 0; d < 3; ++d) {
+      bool along = false;
+      for (int side = -1; side <= 1; side += 2) {
+        std::size_t m;
+        if (open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kFluid) along = true;
+      }
+      if (along) continue;
+      double sum = 0.0;
+      int cnt = 0;
+      for (int e = 0; e < 3; ++e)
+        for (int side = -1; side <= 1; side += 2) {
+          std::size_t m;
+          if (open_face(grid_, lab_, i, j, k, e, side, &m) && lab_.kind[m] == kFluid) {
+            sum += grad[3 * m + d];
+            ++cnt;
+          }
+        }
+      if (cnt > 0) {
+        fill.emplace_back(n, d);
+        val.push_back(sum / cnt);
+      }
+    }
+  });
+  for (std::size_t q = 0; q < fill.size(); ++q) grad[3 * fill[q].first + fill[q].second] = val[q];
+  }
   grid_.forward(gk.data(), 1);
   grid_.forward(pk.data(), 1);
+  grid_.forward(grad.data(), 3);
   // the nodes that become known in a pass are marked after it (the pass reads the flags before it)
   std::vector<std::size_t> gnew, pnew;
   for (int pass = 0; pass < 3; ++pass) {
