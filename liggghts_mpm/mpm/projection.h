@@ -15,10 +15,9 @@
 #include "mpm/options.h"
 #include "mpm/pressure_solver.h"
 #include "mpm/projection_ops.h"
+#include "mpm/projection_state.h"
 
 namespace mpm {
-
-struct ProjectionState;
 
 class Projection {
  public:
@@ -50,7 +49,7 @@ class Projection {
   // writes from them (the surface's gradient and extrapolation 1, deep_inside 2) and one more
   static constexpr int kWorkMargin = 4;
 
-  // The state of the last solve on this rank's owned nodes (ProjectionState, solver.h).
+  // The state of the last solve on this rank's owned nodes (ProjectionState, projection_state.h).
   void save(ProjectionState &s) const;
   // Takes the state of an earlier solve (s.box must hold every owned node; collective: fills
   // the halos); false (nothing changed) if it does not.
