@@ -83,9 +83,14 @@ struct StepReport {
   double companion_dt = 0;   // s, step of the run the estimate compares with
   double depth_error = 0;    // relative, estimated error of the reported run
   double volume_error = 0;
+  double grid_companion_dxi = 0;  // d(xi) of the grid companion run (0: none)
+  double grid_companion_dt = 0;   // s, its step (the step-doubling companion's), compared with the run at that step
+  double grid_depth_error = 0;    // relative, estimated d(xi) error of the reported run (NaN: no estimate)
+  double grid_volume_error = 0;
   int runs = 0;
   long steps_total = 0;
   double stable_limit = 0;  // s, a-priori explicit limit of (4-14) (0: implicit update or none)
+  double accepted_limit = 0;  // s, largest step accepted with the explicit update (a fraction of stable_limit)
   std::string reason;
 };
 

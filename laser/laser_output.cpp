@@ -387,9 +387,64 @@ void OutputDir::commit(const std::string& summary) {
   staged_.clear();
 }
 
+namespace {
+using nlohmann::ordered_json;
+ordered_json num_json(double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr); }
+
+// summary.json "case": every option that defines the run.
+ordered_json case_json(const Config& cfg) {
+  const auto num = num_json;
+  ordered_json j;
+  j["case"] = {{"intensity_W_per_m2", num(cfg.I0)}, {"pulse_s", num(cfg.tp)},      {"radius_m", num(cfg.R)},
+               {"model", to_string(cfg.model)},     {"m", num(cfg.m)},             {"xi_p", num(cfg.xi_p)},
+               {"Pr", num(cfg.mat.Pr)},             {"solid", to_string(cfg.solid)},
+               {"melt_energy", to_string(cfg.melt_energy)},
+               {"melt_flow", to_string(cfg.melt_flow)},
+               {"melt_heat", cfg.flux_heat() ? "flux" : "ode"},
+               {"recoil_fraction_of_p_sat", num(cfg.recoil)},
+               {"absorptivity", num(cfg.absorptivity)},
+               {"melt_update", cfg.implicit_melt ? "implicit" : "explicit"},
+               {"dxi", num(cfg.dxi)},               {"material", cfg.material}};
+  return j["case"];
+}
+
+// summary.json "groups", "energy_J" and "energy_check".
+void energy_json(ordered_json& j, const Result& r) {
+  const auto num = num_json;
+  const Energy& e = r.energy;
+  const Groups& G = r.groups;
+  j["groups"] = {{"Ste", num(G.Ste)},         {"N_alpha", num(G.Na)},  {"N_c", num(G.Nc)},    {"k", num(G.k)},
+                 {"k_prime", num(G.kprime)},  {"I_prime", num(G.Iprime)}, {"Lambda", num(G.Lambda)},
+                 {"H_lv", num(G.Hlv)},        {"N_i", num(G.Ni)},      {"Psi", num(G.Psi)},
+                 {"theta_i", num(G.theta_i)}, {"theta_m", num(G.theta_m)}, {"t_scale_s", num(G.t_scale)}};
+  const double sum = e.sum();
+  j["energy_J"] = {{"laser_exact", num(e.laser_exact)},
+                   {"laser_nodal", num(e.laser_nodal)},
+                   {"solid_premelt", num(e.solid_premelt)},
+                   {"solid_conduction", num(e.solid_conduction)},
+                   {"solid_preheat_moving_origin", num(e.solid_preheat)},
+                   {"melt_latent", num(e.melt_latent)},
+                   {"melt_sensible_vaporized", num(e.melt_sensible)},
+                   {"vapour_latent", num(e.vapour_latent)},
+                   {"vapour_kinetic", num(e.vapour_kinetic)},
+                   {"flow_advected", num(e.flow_advected)},
+                   {"clamp_defect", num(e.clamp_defect)},
+                   {"sum_of_terms", num(sum)},
+                   {"relative_imbalance", num(e.laser_exact > 0 ? (sum - e.laser_exact) / e.laser_exact : 0.0)}};
+  const PhysicalCheck& pc = r.check;
+  j["energy_check"] = {{"H_J_per_kg", num(pc.H)},
+                       {"T_s_center_K", num(pc.Ts)},
+                       {"removed_rhoH_over_beam", num(pc.removed_over_beam)},
+                       {"melted_and_vaporized_over_beam", num(pc.melt_vap_over_beam)},
+                       {"worst_node_demand_over_absorbed", num(pc.worst_node_ratio)},
+                       {"worst_node_xi", num(pc.worst_node_xi)},
+                       {"centre_velocity_over_bound", num(pc.centre_velocity_ratio)},
+                       {"holds", pc.holds}};
+}
+}  // namespace
+
 std::string summary_json(const Config& cfg, const Result& r, double wall) {
   using nlohmann::ordered_json;
-  const Energy& e = r.energy;
   ordered_json j;
   const auto num = [](double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr); };
   j["status"] = r.status;
@@ -410,6 +465,10 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
                     {"companion_dt_s", num(r.step.companion_dt)},
                     {"depth_error_estimate", num(r.step.depth_error)},
                     {"volume_error_estimate", num(r.step.volume_error)},
+                    {"grid_companion_dxi", num(r.step.grid_companion_dxi)},
+                    {"grid_companion_dt_s", num(r.step.grid_companion_dt)},
+                    {"grid_depth_error_estimate", num(r.step.grid_depth_error)},
+                    {"grid_volume_error_estimate", num(r.step.grid_volume_error)},
                     {"tol", num(cfg.tol)},
                     {"runs", r.step.runs},
                     {"steps_total", r.step.steps_total},
@@ -444,50 +503,16 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   // implicit update), and 2/lambda at its largest along the run (thin layers
   // right after onset; the run-time check fires only when g also oscillates)
   j["max_stable_dt_s"] = r.step.stable_limit > 0 ? num(r.step.stable_limit) : nlohmann::ordered_json(nullptr);
+  // the largest --dt accepted with the explicit update (half of the limit above)
+  j["max_accepted_dt_s"] = r.step.accepted_limit > 0 ? num(r.step.accepted_limit) : nlohmann::ordered_json(nullptr);
   j["min_2_over_lambda_seen_s"] = num(r.max_stable_dt);
   j["melt_thickness_clamps"] = r.melt_clamps;
   j["melt_rate_clamps"] = r.melt_rate_clamps;
   j["curvature_clamps"] = r.curvature_clamps;
   j["b2_limiter_hits"] = r.b2_clamps;
   j["max_interface_residual"] = num(r.max_interface_residual);
-  j["case"] = {{"intensity_W_per_m2", num(cfg.I0)}, {"pulse_s", num(cfg.tp)},      {"radius_m", num(cfg.R)},
-               {"model", to_string(cfg.model)},     {"m", num(cfg.m)},             {"xi_p", num(cfg.xi_p)},
-               {"Pr", num(cfg.mat.Pr)},             {"solid", to_string(cfg.solid)},
-               {"melt_energy", to_string(cfg.melt_energy)},
-               {"melt_flow", to_string(cfg.melt_flow)},
-               {"melt_heat", cfg.flux_heat() ? "flux" : "ode"},
-               {"recoil_fraction_of_p_sat", num(cfg.recoil)},
-               {"absorptivity", num(cfg.absorptivity)},
-               {"melt_update", cfg.implicit_melt ? "implicit" : "explicit"},
-               {"dxi", num(cfg.dxi)},               {"material", cfg.material}};
-  const Groups& G = r.groups;
-  j["groups"] = {{"Ste", num(G.Ste)},         {"N_alpha", num(G.Na)},  {"N_c", num(G.Nc)},    {"k", num(G.k)},
-                 {"k_prime", num(G.kprime)},  {"I_prime", num(G.Iprime)}, {"Lambda", num(G.Lambda)},
-                 {"H_lv", num(G.Hlv)},        {"N_i", num(G.Ni)},      {"Psi", num(G.Psi)},
-                 {"theta_i", num(G.theta_i)}, {"theta_m", num(G.theta_m)}, {"t_scale_s", num(G.t_scale)}};
-  const double sum = e.sum();
-  j["energy_J"] = {{"laser_exact", num(e.laser_exact)},
-                   {"laser_nodal", num(e.laser_nodal)},
-                   {"solid_premelt", num(e.solid_premelt)},
-                   {"solid_conduction", num(e.solid_conduction)},
-                   {"solid_preheat_moving_origin", num(e.solid_preheat)},
-                   {"melt_latent", num(e.melt_latent)},
-                   {"melt_sensible_vaporized", num(e.melt_sensible)},
-                   {"vapour_latent", num(e.vapour_latent)},
-                   {"vapour_kinetic", num(e.vapour_kinetic)},
-                   {"flow_advected", num(e.flow_advected)},
-                   {"clamp_defect", num(e.clamp_defect)},
-                   {"sum_of_terms", num(sum)},
-                   {"relative_imbalance", num(e.laser_exact > 0 ? (sum - e.laser_exact) / e.laser_exact : 0.0)}};
-  const PhysicalCheck& pc = r.check;
-  j["energy_check"] = {{"H_J_per_kg", num(pc.H)},
-                       {"T_s_center_K", num(pc.Ts)},
-                       {"removed_rhoH_over_beam", num(pc.removed_over_beam)},
-                       {"melted_and_vaporized_over_beam", num(pc.melt_vap_over_beam)},
-                       {"worst_node_demand_over_absorbed", num(pc.worst_node_ratio)},
-                       {"worst_node_xi", num(pc.worst_node_xi)},
-                       {"centre_velocity_over_bound", num(pc.centre_velocity_ratio)},
-                       {"holds", pc.holds}};
+  j["case"] = case_json(cfg);
+  energy_json(j, r);
   return j.dump(2) + "\n";
 }
 

@@ -15,33 +15,6 @@
 
 namespace laser {
 
-std::string fmt(double v, int precision) {
-  std::ostringstream o;
-  o.precision(precision);
-  o << v;
-  return o.str();
-}
-
-const char* to_string(FlowModel m) {
-  switch (m) {
-    case FlowModel::Conduction: return "conduction";
-    case FlowModel::Rising: return "rising";
-    case FlowModel::RisingFall: return "risingfall";
-    case FlowModel::Boundary: return "boundary";
-  }
-  return "?";
-}
-const char* to_string(SolidModel m) {
-  switch (m) {
-    case SolidModel::Exact: return "exact";
-    case SolidModel::Shifted: return "shifted";
-    case SolidModel::Stefan: return "stefan";
-  }
-  return "?";
-}
-const char* to_string(MeltEnergy m) { return m == MeltEnergy::Advected ? "advected" : "text"; }
-const char* to_string(MeltFlow m) { return m == MeltFlow::Conservative ? "conservative" : "text"; }
-
 std::vector<std::string> material_presets() { return {"superalloy"}; }
 
 namespace {
@@ -142,43 +115,46 @@ std::string quoted(const std::string& s) {
   return o + "'";
 }
 
-// Checks a value for p and applies it to c; returns the error message or "".
-std::string apply(Config& c, const Param& p, const Value& v) {
-  const auto bad = [&](const std::string& given) {
-    return "expected " + expected_text(p) + ", got " + given;
-  };
-  if (v.node == nullptr) {  // command-line text
-    const std::string& s = v.text;
-    switch (p.kind) {
-      case Kind::Real: {
-        const auto x = strict_real(s);
-        if (!x) return bad(quoted(s));
-        const std::string e = check_range(p, *x, s);
-        if (!e.empty()) return e;
-        p.set_num(c, *x);
-        return "";
-      }
-      case Kind::Int: {
-        const auto x = strict_int(s);
-        if (!x) return bad(quoted(s));
-        const std::string e = check_range(p, double(*x), s);
-        if (!e.empty()) return e;
-        p.set_num(c, double(*x));
-        return "";
-      }
-      case Kind::Choice:
-        for (const auto& ch : p.choices)
-          if (ch == s) { p.set_text(c, s); return ""; }
-        return bad(quoted(s));
-      case Kind::Flag: p.set_flag(c, p.cli_value); return "";
-      case Kind::Text:
-        if (s.empty()) return "expected a non-empty string";
-        p.set_text(c, s);
-        return "";
+std::string bad_value(const Param& p, const std::string& given) {
+  return "expected " + expected_text(p) + ", got " + given;
+}
+
+// A command-line value of p applied to c; returns the error message or "".
+std::string apply_text(Config& c, const Param& p, const std::string& s) {
+  const auto bad = [&](const std::string& given) { return bad_value(p, given); };
+  switch (p.kind) {
+    case Kind::Real: {
+      const auto x = strict_real(s);
+      if (!x) return bad(quoted(s));
+      const std::string e = check_range(p, *x, s);
+      if (!e.empty()) return e;
+      p.set_num(c, *x);
+      return "";
     }
-    return "";
+    case Kind::Int: {
+      const auto x = strict_int(s);
+      if (!x) return bad(quoted(s));
+      const std::string e = check_range(p, double(*x), s);
+      if (!e.empty()) return e;
+      p.set_num(c, double(*x));
+      return "";
+    }
+    case Kind::Choice:
+      for (const auto& ch : p.choices)
+        if (ch == s) { p.set_text(c, s); return ""; }
+      return bad(quoted(s));
+    case Kind::Flag: p.set_flag(c, p.cli_value); return "";
+    case Kind::Text:
+      if (s.empty()) return "expected a non-empty string";
+      p.set_text(c, s);
+      return "";
   }
-  const toml::node& n = *v.node;
+  return "";
+}
+
+// A TOML value of p applied to c; returns the error message or "".
+std::string apply_node(Config& c, const Param& p, const toml::node& n) {
+  const auto bad = [&](const std::string& given) { return bad_value(p, given); };
   std::ostringstream shown;
   n.visit([&](auto&& x) {
     if constexpr (toml::is_string<decltype(x)>) shown << quoted(x.get());
@@ -227,6 +203,11 @@ std::string apply(Config& c, const Param& p, const Value& v) {
   return "";
 }
 
+// Checks a value for p and applies it to c; returns the error message or "".
+std::string apply(Config& c, const Param& p, const Value& v) {
+  return v.node == nullptr ? apply_text(c, p, v.text) : apply_node(c, p, *v.node);
+}
+
 Param real(const std::string& n, const std::string& sec, const std::string& unit, double lo, double hi,
            bool lo_open, const std::string& help, double Config::*field) {
   Param p{n, sec, Kind::Real, unit, lo, hi, lo_open, {}, help, nullptr, nullptr, nullptr, nullptr};
@@ -260,129 +241,149 @@ Param choice(const std::string& n, const std::string& sec, std::vector<std::stri
   return p;
 }
 
+// Options of the beam, in the order of --help.
+void add_laser_params(std::vector<Param>& t) {
+  // [laser]
+  t.push_back(real("intensity", "laser", "W/m2", 1e6, 1e13, false,
+                   "laser intensity at the beam centre, I0 in (3-21)", &Config::I0));
+  t.push_back(real("absorptivity", "laser", "-", 0, 1, true,
+                   "absorbed fraction of the beam (the text absorbs all: 1); the model runs with absorptivity x I0",
+                   &Config::absorptivity));
+  t.push_back(choice(
+      "recoil", "model", {"full", "knight"},
+      "recoil pressure driving the melt flow: full = p_sat(T_s) as in the text, knight = 0.54 p_sat "
+      "(Anisimov/Knight, evaporation through a Knudsen layer)",
+      [](Config& c, const std::string& v) { c.recoil = v == "knight" ? 0.54 : 1.0; },
+      [](const Config& c) { return std::string(c.recoil == 1.0 ? "full" : "knight"); }));
+  t.push_back(real("pulse", "laser", "s", 1e-9, 1e-2, false, "pulse length t_p", &Config::tp));
+  t.push_back(real("radius", "laser", "m", 1e-6, 1e-2, false, "beam radius R in (3-21)", &Config::R));
+}
+
+// Options of [model]: the melt flow and the fronts, in the order of --help.
+void add_model_params(std::vector<Param>& t) {
+  // [model]
+  t.push_back(choice(
+      "model", "model", {"conduction", "rising", "risingfall", "boundary"}, "melt flow model",
+      [](Config& c, const std::string& v) {
+        c.model = v == "conduction" ? FlowModel::Conduction
+                  : v == "rising"   ? FlowModel::Rising
+                  : v == "risingfall" ? FlowModel::RisingFall : FlowModel::Boundary;
+      },
+      [](const Config& c) { return std::string(to_string(c.model)); }));
+  t.push_back(real("m", "model", "-", 1, 100, true, "index of the rising profile u = A zeta xi^(1/m) (4-17)",
+                   &Config::m));
+  t.push_back(real("xi-p", "model", "-", 0, 10, true,
+                   "peak position of the rising-fall profile u = A xi zeta exp(-xi/xi_p) (4-22)", &Config::xi_p));
+  t.push_back(choice(
+      "solid", "model", {"exact", "shifted", "stefan"},
+      "solid conduction after onset: exact = (3-29)-(3-34), shifted = (3-35)/(3-36), stefan = (3-30) alone",
+      [](Config& c, const std::string& v) {
+        c.solid = v == "exact" ? SolidModel::Exact : v == "shifted" ? SolidModel::Shifted : SolidModel::Stefan;
+      },
+      [](const Config& c) { return std::string(to_string(c.solid)); }));
+  t.push_back(choice(
+      "melt-energy", "model", {"advected", "text"},
+      "melt layer energy: advected = quasi-steady advection-diffusion (exponential profile, the vaporized mass "
+      "pays c_pl (T_s - T_m)), text = the dissertation's linear conduction layer",
+      [](Config& c, const std::string& v) { c.melt_energy = v == "text" ? MeltEnergy::Text : MeltEnergy::Advected; },
+      [](const Config& c) { return std::string(to_string(c.melt_energy)); }));
+  t.push_back(choice(
+      "melt-flow", "model", {"conservative", "text"},
+      "surface-normal melt velocity in (4-13): conservative = divergence of the layer's volume flux "
+      "(melt is conserved; includes -u(g) dg/dxi), text = v(xi, g) of (4-22) as printed",
+      [](Config& c, const std::string& v) { c.melt_flow = v == "text" ? MeltFlow::Text : MeltFlow::Conservative; },
+      [](const Config& c) { return std::string(to_string(c.melt_flow)); }));
+  t.push_back(choice(
+      "melt-heat", "model", {"auto", "ode", "flux"},
+      "heat the melt flow carries sideways, b2 of (4-25): ode = the text's integral balance (4-27) marched "
+      "along xi, flux = finite-volume face fluxes of the conservative flow (volume flux x upwind 2 theta_sat/3, "
+      "solved with the surface temperature; what leaves one column enters the next; needs --melt-flow "
+      "conservative), auto = flux with --melt-flow conservative, ode with --melt-flow text",
+      [](Config& c, const std::string& v) {
+        c.melt_heat = v == "flux" ? MeltHeat::Flux : v == "ode" ? MeltHeat::Ode : MeltHeat::Auto;
+      },
+      [](const Config& c) {
+        return std::string(c.melt_heat == MeltHeat::Flux ? "flux" : c.melt_heat == MeltHeat::Ode ? "ode" : "auto");
+      }));
+  t.push_back(real("shift", "model", "tau_m", 0, 10, true,
+                   "backward shift of the Stefan solution for --solid shifted (3-36: 3 tau_0 = 3/(4 pi))",
+                   &Config::shift));
+  t.push_back(flag("no-curvature", "curvature", "model", "switch off the curvature factor (3-37)",
+                   &Config::curvature, false));
+  t.push_back(flag("no-moving-origin", "moving_origin", "model",
+                   "switch off the moving-origin term in (3-39)/(3-40)", &Config::moving_origin, false));
+  t.push_back(choice(
+      "melt-update", "model", {"explicit", "implicit"},
+      "melt thickness update: explicit = (4-14) as in the text, implicit = backward Euler in g",
+      [](Config& c, const std::string& v) { c.implicit_melt = v == "implicit"; },
+      [](const Config& c) { return std::string(c.implicit_melt ? "implicit" : "explicit"); }));
+}
+
+// Options of [numerics] and [output], in the order of --help.
+void add_numerics_params(std::vector<Param>& t) {
+  // [numerics]
+  t.push_back(real("dxi", "numerics", "-", 1e-3, 0.5, false, "radial grid spacing d(xi) = dr/R", &Config::dxi));
+  t.push_back(real("xi-max", "numerics", "-", 0, 10, false,
+                   "outer end of the grid (0: just beyond the last node that melts)", &Config::xi_max));
+  t.push_back(real("dt", "numerics", "s", 1e-13, 1e-3, false,
+                   "time step (default: chosen from pulse, radius and intensity and checked by step doubling)",
+                   &Config::dt));
+  t.push_back(real("dtau", "numerics", "-", 1e-12, 10, false, "time step in tau = t alpha_l / R^2 (overrides --dt)",
+                   &Config::dtau));
+  t.push_back(real("tol", "numerics", "-", 1e-6, 0.5, false,
+                   "relative depth/volume error allowed by the step-doubling estimate", &Config::tol));
+  // [output]
+  {
+    Param p{"frames", "output", Kind::Int, "-", 2, 1e5, false, {}, "number of profile frames in profiles.h5 "
+            "(more than the run's steps + 1 are clipped with a note)", nullptr, nullptr, nullptr, nullptr};
+    p.set_num = [](Config& c, double v) { c.frames = static_cast<int>(v); };
+    p.get = [](const Config& c) { return std::to_string(c.frames); };
+    t.push_back(p);
+  }
+  {
+    Param p{"out", "output", Kind::Text, "", 0, 0, false, {}, "output directory (must be empty or new)",
+            nullptr, nullptr, nullptr, nullptr};
+    p.set_text = [](Config& c, const std::string& v) { c.out = v; };
+    p.get = [](const Config& c) { return c.out; };
+    t.push_back(p);
+  }
+  t.push_back(flag("overwrite", "overwrite", "output",
+                   "remove what an earlier run wrote into --out before running", &Config::overwrite, true));
+  t.push_back(flag("quiet", "quiet", "output", "no progress output on stderr", &Config::quiet, true));
+}
+
+// Options of [material], in the order of --help.
+void add_material_params(std::vector<Param>& t) {
+  // [material]
+  t.push_back(choice(
+      "material", "material", material_presets(), "material preset (Table 5.1); the properties below override it",
+      [](Config& c, const std::string& v) { c.material = v; },
+      [](const Config& c) { return c.material; }));
+  t.push_back(matreal("hls", "J/kg", 1e2, 1e8, "latent heat of melting h_ls", &Material::hls));
+  t.push_back(matreal("hlv", "J/kg", 1e4, 1e9, "latent heat of vaporization h_lv", &Material::hlv));
+  t.push_back(matreal("rho", "kg/m3", 1e2, 1e5, "density (solid and melt)", &Material::rho));
+  t.push_back(matreal("molar-mass", "kg/mol", 1e-3, 1, "vapour molar mass M", &Material::M));
+  t.push_back(matreal("T-initial", "K", 0, 1e4, "initial temperature T_i", &Material::Ti));
+  t.push_back(matreal("T-melt", "K", 0, 1e4, "melting temperature T_m", &Material::Tm));
+  t.push_back(matreal("T-sat0", "K", 0, 2e4, "saturation temperature at p0, T_sat0", &Material::Tsat0));
+  t.push_back(matreal("p0", "Pa", 1, 1e9, "reference pressure of T_sat0", &Material::p0));
+  t.push_back(matreal("k-liquid", "W/(m K)", 1e-2, 1e4, "thermal conductivity of the melt k_l", &Material::kl));
+  t.push_back(matreal("k-solid", "W/(m K)", 1e-2, 1e4, "thermal conductivity of the solid k_s", &Material::ks));
+  t.push_back(matreal("cp-liquid", "J/(kg K)", 1, 1e5, "specific heat of the melt c_pl", &Material::cpl));
+  t.push_back(matreal("cp-solid", "J/(kg K)", 1, 1e5, "specific heat of the solid c_ps", &Material::cps));
+  t.push_back(matreal("T-critical", "K", 0, 1e5,
+                      "critical temperature T_c: a warning above 0.8 T_c, status diverged above T_c",
+                      &Material::Tc));
+  t.push_back(matreal("pr", "-", 1e-6, 1e7, "Prandtl number of the melt nu/alpha_l", &Material::Pr));
+}
+
 const std::vector<Param>& params() {
   static const std::vector<Param> table = [] {
     std::vector<Param> t;
-    // [laser]
-    t.push_back(real("intensity", "laser", "W/m2", 1e6, 1e13, false,
-                     "laser intensity at the beam centre, I0 in (3-21)", &Config::I0));
-    t.push_back(real("absorptivity", "laser", "-", 0, 1, true,
-                     "absorbed fraction of the beam (the text absorbs all: 1); the model runs with absorptivity x I0",
-                     &Config::absorptivity));
-    t.push_back(choice(
-        "recoil", "model", {"full", "knight"},
-        "recoil pressure driving the melt flow: full = p_sat(T_s) as in the text, knight = 0.54 p_sat "
-        "(Anisimov/Knight, evaporation through a Knudsen layer)",
-        [](Config& c, const std::string& v) { c.recoil = v == "knight" ? 0.54 : 1.0; },
-        [](const Config& c) { return std::string(c.recoil == 1.0 ? "full" : "knight"); }));
-    t.push_back(real("pulse", "laser", "s", 1e-9, 1e-2, false, "pulse length t_p", &Config::tp));
-    t.push_back(real("radius", "laser", "m", 1e-6, 1e-2, false, "beam radius R in (3-21)", &Config::R));
-    // [model]
-    t.push_back(choice(
-        "model", "model", {"conduction", "rising", "risingfall", "boundary"}, "melt flow model",
-        [](Config& c, const std::string& v) {
-          c.model = v == "conduction" ? FlowModel::Conduction
-                    : v == "rising"   ? FlowModel::Rising
-                    : v == "risingfall" ? FlowModel::RisingFall : FlowModel::Boundary;
-        },
-        [](const Config& c) { return std::string(to_string(c.model)); }));
-    t.push_back(real("m", "model", "-", 1, 100, true, "index of the rising profile u = A zeta xi^(1/m) (4-17)",
-                     &Config::m));
-    t.push_back(real("xi-p", "model", "-", 0, 10, true,
-                     "peak position of the rising-fall profile u = A xi zeta exp(-xi/xi_p) (4-22)", &Config::xi_p));
-    t.push_back(choice(
-        "solid", "model", {"exact", "shifted", "stefan"},
-        "solid conduction after onset: exact = (3-29)-(3-34), shifted = (3-35)/(3-36), stefan = (3-30) alone",
-        [](Config& c, const std::string& v) {
-          c.solid = v == "exact" ? SolidModel::Exact : v == "shifted" ? SolidModel::Shifted : SolidModel::Stefan;
-        },
-        [](const Config& c) { return std::string(to_string(c.solid)); }));
-    t.push_back(choice(
-        "melt-energy", "model", {"advected", "text"},
-        "melt layer energy: advected = quasi-steady advection-diffusion (exponential profile, the vaporized mass "
-        "pays c_pl (T_s - T_m)), text = the dissertation's linear conduction layer",
-        [](Config& c, const std::string& v) { c.melt_energy = v == "text" ? MeltEnergy::Text : MeltEnergy::Advected; },
-        [](const Config& c) { return std::string(to_string(c.melt_energy)); }));
-    t.push_back(choice(
-        "melt-flow", "model", {"conservative", "text"},
-        "surface-normal melt velocity in (4-13): conservative = divergence of the layer's volume flux "
-        "(melt is conserved; includes -u(g) dg/dxi), text = v(xi, g) of (4-22) as printed",
-        [](Config& c, const std::string& v) { c.melt_flow = v == "text" ? MeltFlow::Text : MeltFlow::Conservative; },
-        [](const Config& c) { return std::string(to_string(c.melt_flow)); }));
-    t.push_back(choice(
-        "melt-heat", "model", {"auto", "ode", "flux"},
-        "heat the melt flow carries sideways, b2 of (4-25): ode = the text's integral balance (4-27) marched "
-        "along xi, flux = finite-volume face fluxes of the conservative flow (volume flux x upwind 2 theta_sat/3, "
-        "solved with the surface temperature; what leaves one column enters the next; needs --melt-flow "
-        "conservative), auto = flux with --melt-flow conservative, ode with --melt-flow text",
-        [](Config& c, const std::string& v) {
-          c.melt_heat = v == "flux" ? MeltHeat::Flux : v == "ode" ? MeltHeat::Ode : MeltHeat::Auto;
-        },
-        [](const Config& c) {
-          return std::string(c.melt_heat == MeltHeat::Flux ? "flux" : c.melt_heat == MeltHeat::Ode ? "ode" : "auto");
-        }));
-    t.push_back(real("shift", "model", "tau_m", 0, 10, true,
-                     "backward shift of the Stefan solution for --solid shifted (3-36: 3 tau_0 = 3/(4 pi))",
-                     &Config::shift));
-    t.push_back(flag("no-curvature", "curvature", "model", "switch off the curvature factor (3-37)",
-                     &Config::curvature, false));
-    t.push_back(flag("no-moving-origin", "moving_origin", "model",
-                     "switch off the moving-origin term in (3-39)/(3-40)", &Config::moving_origin, false));
-    t.push_back(choice(
-        "melt-update", "model", {"explicit", "implicit"},
-        "melt thickness update: explicit = (4-14) as in the text, implicit = backward Euler in g",
-        [](Config& c, const std::string& v) { c.implicit_melt = v == "implicit"; },
-        [](const Config& c) { return std::string(c.implicit_melt ? "implicit" : "explicit"); }));
-    // [numerics]
-    t.push_back(real("dxi", "numerics", "-", 1e-3, 0.5, false, "radial grid spacing d(xi) = dr/R", &Config::dxi));
-    t.push_back(real("xi-max", "numerics", "-", 0, 10, false,
-                     "outer end of the grid (0: just beyond the last node that melts)", &Config::xi_max));
-    t.push_back(real("dt", "numerics", "s", 1e-13, 1e-3, false,
-                     "time step (default: chosen from pulse, radius and intensity and checked by step doubling)",
-                     &Config::dt));
-    t.push_back(real("dtau", "numerics", "-", 1e-12, 10, false, "time step in tau = t alpha_l / R^2 (overrides --dt)",
-                     &Config::dtau));
-    t.push_back(real("tol", "numerics", "-", 1e-6, 0.5, false,
-                     "relative depth/volume error allowed by the step-doubling estimate", &Config::tol));
-    // [output]
-    {
-      Param p{"frames", "output", Kind::Int, "-", 2, 1e5, false, {}, "number of profile frames in profiles.h5 "
-              "(more than the run's steps + 1 are clipped with a note)", nullptr, nullptr, nullptr, nullptr};
-      p.set_num = [](Config& c, double v) { c.frames = static_cast<int>(v); };
-      p.get = [](const Config& c) { return std::to_string(c.frames); };
-      t.push_back(p);
-    }
-    {
-      Param p{"out", "output", Kind::Text, "", 0, 0, false, {}, "output directory (must be empty or new)",
-              nullptr, nullptr, nullptr, nullptr};
-      p.set_text = [](Config& c, const std::string& v) { c.out = v; };
-      p.get = [](const Config& c) { return c.out; };
-      t.push_back(p);
-    }
-    t.push_back(flag("overwrite", "overwrite", "output",
-                     "remove what an earlier run wrote into --out before running", &Config::overwrite, true));
-    t.push_back(flag("quiet", "quiet", "output", "no progress output on stderr", &Config::quiet, true));
-    // [material]
-    t.push_back(choice(
-        "material", "material", material_presets(), "material preset (Table 5.1); the properties below override it",
-        [](Config& c, const std::string& v) { c.material = v; },
-        [](const Config& c) { return c.material; }));
-    t.push_back(matreal("hls", "J/kg", 1e2, 1e8, "latent heat of melting h_ls", &Material::hls));
-    t.push_back(matreal("hlv", "J/kg", 1e4, 1e9, "latent heat of vaporization h_lv", &Material::hlv));
-    t.push_back(matreal("rho", "kg/m3", 1e2, 1e5, "density (solid and melt)", &Material::rho));
-    t.push_back(matreal("molar-mass", "kg/mol", 1e-3, 1, "vapour molar mass M", &Material::M));
-    t.push_back(matreal("T-initial", "K", 0, 1e4, "initial temperature T_i", &Material::Ti));
-    t.push_back(matreal("T-melt", "K", 0, 1e4, "melting temperature T_m", &Material::Tm));
-    t.push_back(matreal("T-sat0", "K", 0, 2e4, "saturation temperature at p0, T_sat0", &Material::Tsat0));
-    t.push_back(matreal("p0", "Pa", 1, 1e9, "reference pressure of T_sat0", &Material::p0));
-    t.push_back(matreal("k-liquid", "W/(m K)", 1e-2, 1e4, "thermal conductivity of the melt k_l", &Material::kl));
-    t.push_back(matreal("k-solid", "W/(m K)", 1e-2, 1e4, "thermal conductivity of the solid k_s", &Material::ks));
-    t.push_back(matreal("cp-liquid", "J/(kg K)", 1, 1e5, "specific heat of the melt c_pl", &Material::cpl));
-    t.push_back(matreal("cp-solid", "J/(kg K)", 1, 1e5, "specific heat of the solid c_ps", &Material::cps));
-    t.push_back(matreal("T-critical", "K", 0, 1e5,
-                        "critical temperature T_c: a warning above 0.8 T_c, status diverged above T_c",
-                        &Material::Tc));
-    t.push_back(matreal("pr", "-", 1e-6, 1e7, "Prandtl number of the melt nu/alpha_l", &Material::Pr));
+    add_laser_params(t);
+    add_model_params(t);
+    add_numerics_params(t);
+    add_material_params(t);
     return t;
   }();
   return table;

@@ -41,6 +41,16 @@ class TimeStepPolicy {
   static constexpr double kMaxNodeSteps = 4e8;
 
  private:
+  struct Estimate {
+    double dt, companion, ed, ev;  // reported step, companion step, relative depth/volume error estimates
+    int runs;
+    long steps;
+    bool stalled;
+    std::string history;
+    double grid_dxi = 0, grid_dt = 0, grid_ed = 0, grid_ev = 0;  // grid companion's d(xi), step, error estimates
+  };
+  void grid_estimate(Result& fine, const Result& coarse, const Config& cfg, Estimate& est) const;
+  void report(Result& fine, const Config& cfg, const Estimate& est) const;
   Result run_at(Config cfg, double dt, const SinkFactory& make_sink, bool reported, long& steps) const;
   void check_work(const Config& cfg) const;
   double dt_ = 0, dt_stable_ = 0;

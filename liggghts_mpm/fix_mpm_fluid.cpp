@@ -66,7 +66,9 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   // the first setup and wipe the points' state; new rows are zeroed in grow_arrays
   time_integrate = 1;  // the fix moves its material points itself
   vector_flag = 1;
-  size_vector = mpm::FluidSolver::kGlobalSize;
+  size_vector = mpm::FluidSolver::global_size(static_cast<int>(mesh_specs.size()),
+                                              static_cast<int>(solver->opt.probes.size()));
+  vector_cache.assign(size_vector, 0.0);
   global_freq = 1;
   extvector = 0;
   peratom_flag = 1;
@@ -368,7 +370,7 @@ void FixMpmFluid::subdomain_changed() {
 double FixMpmFluid::compute_vector(int n) {
   if (n < 0 || n >= size_vector) return 0.0;
   if (vector_step != update->ntimestep) {
-    sync().global_vector(vector_cache);
+    sync().global_vector(vector_cache.data(), static_cast<int>(mesh_specs.size()));
     vector_step = update->ntimestep;
   }
   return vector_cache[n];

@@ -73,7 +73,7 @@ class FixMpmFluid : public Fix {
   int pdata_rows = 0;
   bigint vector_step = -1;   // f_ID[] cached for this step
   bool sealed_noted = false;  // the note on pockets sealed off from the free surface (printed once)
-  double vector_cache[mpm::FluidSolver::kGlobalSize];
+  std::vector<double> vector_cache;  // f_ID[] (FluidSolver::global_size)
 
   int parse_mesh_wall(int narg, char **arg, int iarg);
   void fill_points();

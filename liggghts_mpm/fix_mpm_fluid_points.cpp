@@ -74,14 +74,18 @@ int FixMpmFluid::parse_mesh_wall(int narg, char **arg, int iarg) {
       bad_arg("mesh_wall shear", "a fraction f in [0,1] of the wall's tangential velocity", arg[iarg + 1]);
     iarg += 2;
   } else bad_arg("mesh_wall", "noslip, freeslip, partial f, sticky f or shear delta f", k);
-  if (iarg + 1 < narg && strcmp(arg[iarg], "side") == 0) {
-    const char *sd = arg[iarg + 1];
-    if (strcmp(sd, "auto") == 0) ms.side = mpm::SIDE_AUTO;
-    else if (strcmp(sd, "normal") == 0) ms.side = mpm::SIDE_NORMAL;
-    else if (strcmp(sd, "opposite") == 0) ms.side = mpm::SIDE_OPPOSITE;
-    else if (strcmp(sd, "both") == 0) ms.side = mpm::SIDE_BOTH;
-    else bad_arg("mesh_wall side", "auto, normal, opposite or both", sd);
-    iarg += 2;
+  // optional, in either order: side s, reference_point x y z
+  for (int opt = 0; opt < 2; ++opt) {
+    if (iarg + 1 < narg && strcmp(arg[iarg], "side") == 0) {
+      const char *sd = arg[iarg + 1];
+      if (strcmp(sd, "auto") == 0) ms.side = mpm::SIDE_AUTO;
+      else if (strcmp(sd, "normal") == 0) ms.side = mpm::SIDE_NORMAL;
+      else if (strcmp(sd, "opposite") == 0) ms.side = mpm::SIDE_OPPOSITE;
+      else if (strcmp(sd, "both") == 0) ms.side = mpm::SIDE_BOTH;
+      else bad_arg("mesh_wall side", "auto, normal, opposite or both", sd);
+      iarg += 2;
+    }
+    iarg = mpm::parse_reference_point(narg, arg, iarg, ms.ref);
   }
   mesh_specs.push_back(ms);
   return iarg;

@@ -74,7 +74,10 @@ def vary_sweep(a):
         if s:
             row.update(summary_row(s))
         else:
-            row.update(status="refused" if code == 2 else "error", message=err.splitlines()[-1] if err else "")
+            # exit 2: refused; before computing, or (explicit update) by the run-time check of (4-14)
+            after = "(4-14) unstable at" in err
+            row.update(status=("refused after running" if after else "refused") if code == 2 else "error",
+                       message=err.splitlines()[-1] if err else "")
         rows.append(row)
         print("%-40s %-12s %s" % (name, row["status"], row.get("message", "")), file=sys.stderr)
     mpm_io.write_rows(os.path.join(a.out, "sweep.csv"), rows)

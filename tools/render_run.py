@@ -3,6 +3,7 @@
 
   tools/python tools/render_run.py RUN_DIR [--times T1 T2 ...] [--out FILE.png] [--axis x|y|z]
         [--field p|v] [--prefix PREFIX] [--dump NAME] [--vmax V] [--dpi 150]
+        [--slab LO HI] [--zoom H0 H1 V0 V1]
 
 RUN_DIR is the folder a run wrote its outputs to. The points come from the HDF5 series of fix
 mpm/fluid (`output N PREFIX points ...`: PREFIX.xmf and PREFIX_<step>.h5; with several series,
@@ -19,8 +20,11 @@ The picture is a projection along --axis (default y: x to the right, z up; x: y 
 z: x to the right, y up); what is nearer to the viewer (smaller coordinate along the axis) is drawn
 on top. Points are coloured by the pressure (--field p, kPa; the point field 'p' must be in the
 output) or the speed |v| (--field v, m/s; field 'v'), grains are dark blue discs to scale (radius
-column, else --grain-diameter). The axes span the LIGGGHTS box of the dumps, or the points' extent
-when there are no dumps.
+column, else --grain-diameter). --slab LO HI draws only the points and grains whose coordinate along
+the axis lies in [LO, HI] (a cut through a 3-D scene, so that beads in front do not hide the water).
+The axes span the points and grains drawn (over all panels, after the slab) with a margin of 3 %;
+--zoom H0 H1 V0 V1 sets them instead (picture coordinates: horizontal, then vertical, in m). The
+LIGGGHTS box of the dumps is outlined where it falls inside the axes.
 """
 import argparse
 import os
@@ -91,7 +95,15 @@ def main():
     ap.add_argument("--grain-diameter", type=float, default=None, help="grain size when dumps have no radius")
     ap.add_argument("--vmax", type=float, default=None, help="top of the colour scale (kPa or m/s)")
     ap.add_argument("--dpi", type=int, default=150)
+    ap.add_argument("--slab", type=float, nargs=2, metavar=("LO", "HI"), default=None,
+                    help="draw only what lies in [LO, HI] along the axis (m)")
+    ap.add_argument("--zoom", type=float, nargs=4, metavar=("H0", "H1", "V0", "V1"), default=None,
+                    help="axes limits: horizontal H0..H1, vertical V0..V1 (m)")
     a = ap.parse_args()
+    if a.slab and not a.slab[0] < a.slab[1]:
+        sys.exit("render_run: --slab expects LO < HI (m), got %g %g" % tuple(a.slab))
+    if a.zoom and not (a.zoom[0] < a.zoom[1] and a.zoom[2] < a.zoom[3]):
+        sys.exit("render_run: --zoom expects H0 < H1 and V0 < V1 (m), got %g %g %g %g" % tuple(a.zoom))
     if not os.path.isdir(a.rundir):
         sys.exit("render_run: %s is not a folder" % a.rundir)
 
@@ -113,6 +125,11 @@ def main():
         sys.exit("render_run: no dump series %s_<step>.dump in %s" % (a.dump, a.rundir))
 
     h, v = VIEWS[a.axis]
+    depth = [i for i in range(3) if i not in (h, v)][0]
+
+    def in_slab(q):
+        return np.ones(len(q), bool) if not a.slab else (q[:, depth] >= a.slab[0]) & (q[:, depth] <= a.slab[1])
+
     snaps, box = [], None
     for i in pick:
         step, t, path = frames[i]
@@ -123,6 +140,8 @@ def main():
             sys.exit("render_run: %s has no point field '%s' (add it to the fix's output list, or use --field %s)"
                      % (path, field, "v" if field == "p" else "p"))
         val = vals[field] / 1e3 if field == "p" else np.linalg.norm(vals[field], axis=1)
+        keep = in_slab(xyz)
+        xyz, val = xyz[keep], val[keep]
         grains, notes = [], []
         for name, by_step in sorted(dumps.items()):
             steps = np.array(sorted(by_step))
@@ -142,17 +161,30 @@ def main():
                 rad = np.full(len(g), 0.5 * a.grain_diameter)
             else:
                 sys.exit("render_run: %s has no radius column: give --grain-diameter" % by_step[s])
-            grains.append((g, rad))
+            keep = in_slab(g)
+            grains.append((g[keep], rad[keep]))
             if s != step:
                 notes.append("%s at step %d" % (name, s))
         snaps.append((t, step, xyz, val, grains, notes))
 
-    if box is None:  # no dump: the extent of the points over the drawn frames
-        allp = np.concatenate([s[2] for s in snaps if len(s[2])] or [np.zeros((1, 3))])
-        lo, hi = allp.min(axis=0), allp.max(axis=0)
-        pad = 0.05 * (hi - lo).max() + 1e-12
-        box = np.column_stack((lo - pad, hi + pad))
-    spacing = nearest_spacing(snaps[0][2])
+    # the axes: what is drawn (points and grains of every panel, grains with their radius), or --zoom
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for _, _, xyz, _, grains, _ in snaps:
+        if len(xyz):
+            lo, hi = np.minimum(lo, xyz.min(axis=0)), np.maximum(hi, xyz.max(axis=0))
+        for g, rad in grains:
+            if len(g):
+                lo = np.minimum(lo, (g - rad[:, None]).min(axis=0))
+                hi = np.maximum(hi, (g + rad[:, None]).max(axis=0))
+    if not np.all(np.isfinite(lo)):
+        if box is None:
+            sys.exit("render_run: nothing to draw (no point or grain%s)" % (" in the slab" if a.slab else ""))
+        lo, hi = box[:, 0].copy(), box[:, 1].copy()
+    pad = 0.03 * (hi - lo)[[h, v]].max() + 1e-12
+    view = np.column_stack((lo - pad, hi + pad))
+    if a.zoom:
+        view[h], view[v] = a.zoom[0:2], a.zoom[2:4]
+    spacing = nearest_spacing(snaps[0][2]) if len(snaps[0][2]) > 1 else 1e-3 * (view[h, 1] - view[h, 0])
 
     import matplotlib
     matplotlib.use("Agg")
@@ -165,7 +197,7 @@ def main():
         cmap, label, vmin = "turbo", "|v| (m/s)", 0.0
     vmax = a.vmax or max(max((np.percentile(s[3], 99.5) for s in snaps if len(s[3])), default=1.0), vmin + 1e-9)
 
-    wx, wy = box[h, 1] - box[h, 0], box[v, 1] - box[v, 0]
+    wx, wy = view[h, 1] - view[h, 0], view[v, 1] - view[v, 0]
     n = len(snaps)
     ncol = 1 if n == 1 else 2
     nrow = (n + ncol - 1) // ncol
@@ -175,13 +207,12 @@ def main():
     sc = None
     for k, (t, step, xyz, val, grains, notes) in enumerate(snaps):
         ax = axes[k // ncol][k % ncol]
-        ax.set_xlim(box[h, 0], box[h, 1])
-        ax.set_ylim(box[v, 0], box[v, 1])
+        ax.set_xlim(view[h, 0], view[h, 1])
+        ax.set_ylim(view[v, 0], view[v, 1])
         ax.set_aspect("equal")
         fig.canvas.draw()
         pt_per_m = ax.get_window_extent().width / wx * 72.0 / fig.dpi
         # the farthest along the axis first: nearer points and grains on top
-        depth = [i for i in range(3) if i not in (h, v)][0]
         o = np.argsort(-xyz[:, depth]) if a.axis != "z" else np.argsort(xyz[:, depth])
         sc = ax.scatter(xyz[o, h], xyz[o, v], c=val[o], s=(0.9 * spacing * pt_per_m) ** 2, marker="o",
                         linewidths=0, cmap=cmap, vmin=vmin, vmax=vmax, alpha=0.8, zorder=1, rasterized=True)
@@ -189,8 +220,9 @@ def main():
             og = np.argsort(-g[:, depth]) if a.axis != "z" else np.argsort(g[:, depth])
             ax.scatter(g[og, h], g[og, v], s=(2.0 * rad[og] * pt_per_m) ** 2, c=BEADS, marker="o",
                        linewidths=0, zorder=2, rasterized=True)
-        ax.plot([box[h, 0], box[h, 1], box[h, 1], box[h, 0], box[h, 0]],
-                [box[v, 0], box[v, 0], box[v, 1], box[v, 1], box[v, 0]], color="k", lw=0.8, zorder=3)
+        if box is not None:
+            ax.plot([box[h, 0], box[h, 1], box[h, 1], box[h, 0], box[h, 0]],
+                    [box[v, 0], box[v, 0], box[v, 1], box[v, 1], box[v, 0]], color="k", lw=0.8, zorder=3)
         title = "t = %.4g s (step %d)" % (t, step)
         if notes:
             title += "; " + ", ".join(notes)
@@ -204,12 +236,14 @@ def main():
     cb.set_label(label, fontsize=9)
     name = os.path.basename(os.path.normpath(os.path.abspath(a.rundir)))
     ngr = sum(len(g) for g, _ in snaps[-1][4])
-    fig.suptitle("%s: %d material points%s, seen along %s" % (
-        name, len(snaps[-1][2]), (", %d grains" % ngr) if snaps[-1][4] else "", a.axis), fontsize=11)
+    fig.suptitle("%s: %d material points%s, seen along %s%s" % (
+        name, len(snaps[-1][2]), (", %d grains" % ngr) if snaps[-1][4] else "", a.axis,
+        (", %s in [%g, %g]" % (a.axis, a.slab[0], a.slab[1])) if a.slab else ""), fontsize=11)
     out = a.out or os.path.join(a.rundir, name + ".png")
     fig.savefig(out, dpi=a.dpi)
-    print("wrote %s (%s: %d points, %d grains at the last time drawn; t = %s s)" % (
-        out, prefix, len(snaps[-1][2]), ngr, ", ".join("%.4g" % s[0] for s in snaps)))
+    print("wrote %s (%s: %d points, %d grains at the last time drawn; t = %s s; axes %s [%.6g, %.6g] %s [%.6g, %.6g])" % (
+        out, prefix, len(snaps[-1][2]), ngr, ", ".join("%.4g" % s[0] for s in snaps), NAMES[h], view[h, 0],
+        view[h, 1], NAMES[v], view[v, 0], view[v, 1]))
     return 0
 
 

@@ -109,8 +109,11 @@ struct H5Writer {
     agree(comm, r < 0 ? message(file, what + " failed" + h5_detail()) : std::string());
     return r;
   }
+  // n values; n = 0: one value as a scalar (dataspace H5S_SCALAR: int(f.attrs[name]) in h5py)
   void attr(hid_t loc, const char *name, hid_t ftype, hid_t mtype, hsize_t n, const void *v) const {
-    Handle sp(ok(H5Screate_simple(1, &n, nullptr), std::string("dataspace for attribute ") + name), H5Sclose);
+    Handle sp(ok(n == 0 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr),
+                 std::string("dataspace for attribute ") + name),
+              H5Sclose);
     Handle a(ok(H5Acreate2(loc, name, ftype, sp.get(), H5P_DEFAULT, H5P_DEFAULT),
                 std::string("creating attribute ") + name), H5Aclose);
     ok(H5Awrite(a.get(), mtype, v), std::string("writing attribute ") + name);
@@ -223,8 +226,8 @@ void write_file(const std::string &tmp, const std::string &path, MPI_Comm comm, 
 #endif
   Handle f(w.ok(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.get()), "creating file " + tmp), H5Fclose);
   const long long step64 = step;
-  w.attr(f.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 1, &time);
-  w.attr(f.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, 1, &step64);
+  w.attr(f.get(), "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, 0, &time);
+  w.attr(f.get(), "step", H5T_STD_I64LE, H5T_NATIVE_LLONG, 0, &step64);
   {
     Handle g(w.ok(H5Gcreate2(f.get(), "points", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "creating group /points"),
              H5Gclose);

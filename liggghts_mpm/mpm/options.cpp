@@ -309,6 +309,31 @@ void parse_max_iterations(Options &o, Args &a, const ParseEnv &) {
   a.iarg += 2;
 }
 
+void parse_probe(Options &o, Args &a, const ParseEnv &) {
+  const char *what = "'point x y z' or 'box xlo xhi ylo yhi zlo zhi' (length)";
+  a.need(1, "probe", what);
+  Probe p;
+  if (strcmp(a.at(1), "point") == 0) {
+    a.need(4, "probe point", "three coordinates x y z (length)");
+    for (int d = 0; d < 3; ++d) {
+      if (!parse_double(a.at(2 + d), p.lo[d])) bad_arg("probe point", "a coordinate (length)", a.at(2 + d));
+      p.hi[d] = p.lo[d];
+    }
+    a.iarg += 5;
+  } else if (strcmp(a.at(1), "box") == 0) {
+    p.box = true;
+    a.need(7, "probe box", "six bounds xlo xhi ylo yhi zlo zhi (length)");
+    for (int d = 0; d < 3; ++d) {
+      if (!parse_double(a.at(2 + 2 * d), p.lo[d])) bad_arg("probe box", "a bound (length)", a.at(2 + 2 * d));
+      if (!parse_double(a.at(3 + 2 * d), p.hi[d])) bad_arg("probe box", "a bound (length)", a.at(3 + 2 * d));
+      if (!(p.hi[d] > p.lo[d])) bad_arg("probe box", "hi > lo in every dimension", a.at(3 + 2 * d));
+    }
+    a.iarg += 8;
+  } else
+    bad_arg("probe", what, a.at(1));
+  o.probes.push_back(p);
+}
+
 void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
   if (!env.mesh_wall) bad_arg("mesh_wall", "a LIGGGHTS host", nullptr);
   a.iarg = env.mesh_wall(a.narg, a.arg, a.iarg);
@@ -542,7 +567,11 @@ const std::vector<Keyword> kTable = {
      "'axis wall-axis wall-position'", nullptr, 0, 0, false, false, nullptr, parse_height, false},
     {"output", "N prefix points f ... [grid g ...]", "steps", "N >= 0", "0 (none)",
      "'N prefix points f1 ... [grid g1 ...]'", nullptr, 0, 0, false, false, nullptr, parse_output, false},
-    {"mesh_wall", "fix-ID kind [value] [side s]", "-", "", "none",
+    {"probe", "point x y z | box xlo xhi ylo yhi zlo zhi", "length", "inside the grid; lo < hi", "none",
+     "'point x y z' or 'box xlo xhi ylo yhi zlo zhi' (length)", nullptr, 0, 0, false, false, nullptr, parse_probe, false},
+    {"probe_window", "real", "time", ">= 0", "0 (each fluid step)", "a time window (time) >= 0 of the probes' average",
+     REAL(probe_window), 0.0, kInf, false, true, nullptr, nullptr, false},
+    {"mesh_wall", "fix-ID kind [value] [side s] [reference_point x y z]", "-", "", "none",
      "a fix ID and noslip | freeslip | partial f | sticky f | shear delta f",
      nullptr, 0, 0, false, false, nullptr, parse_mesh_wall, false},
 };
@@ -587,7 +616,7 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
                   "' (see docs/fix_mpm_fluid.md for the keywords)");
     // a keyword given again replaces its value (boundary and mesh_wall: one face or mesh each)
     if (std::find(seen.begin(), seen.end(), kw) != seen.end() && strcmp(kw, "boundary") != 0 &&
-        strcmp(kw, "mesh_wall") != 0)
+        strcmp(kw, "mesh_wall") != 0 && strcmp(kw, "probe") != 0)
       o.warnings.push_back(std::string("Fix mpm/fluid: keyword '") + kw + "' given more than once; the last value is used");
     seen.push_back(kw);
     if (k->real) {
@@ -661,7 +690,28 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
   const Gate &g = o.gate;
   if (g.active && !o.grid.periodic[g.dim] && (g.pos <= o.grid.origin[g.dim] || g.pos >= o.grid.upper(g.dim)))
     throw Error("Fix mpm/fluid: keyword 'gate' expects a position inside the grid");
+  for (const Probe &p : o.probes)
+    for (int d = 0; d < 3; ++d)
+      if (!(p.lo[d] >= o.grid.origin[d] && p.hi[d] <= o.grid.upper(d))) {
+        std::ostringstream os;
+        os << "Fix mpm/fluid: keyword 'probe " << (p.box ? "box" : "point") << "' expects "
+           << (p.box ? "bounds" : "a point") << " inside the grid along " << "xyz"[d] << " [" << o.grid.origin[d]
+           << ", " << o.grid.upper(d) << "], got " << (p.lo[d] < o.grid.origin[d] ? p.lo[d] : p.hi[d]);
+        throw Error(os.str());
+      }
+  if (o.probes.empty() && std::find(seen.begin(), seen.end(), "probe_window") != seen.end())
+    throw Error("Fix mpm/fluid: keyword 'probe_window' (the probes' averaging window) needs keyword 'probe'");
   return o;
+}
+
+int parse_reference_point(int narg, char **arg, int iarg, double ref[3]) {
+  if (iarg >= narg || strcmp(arg[iarg], "reference_point") != 0) return iarg;
+  for (int d = 0; d < 3; ++d) {
+    const char *v = iarg + 1 + d < narg ? arg[iarg + 1 + d] : nullptr;
+    if (!v || !parse_double(v, ref[d]))
+      bad_arg("mesh_wall reference_point", "three coordinates x y z (length) of the torque's reference point", v);
+  }
+  return iarg + 4;
 }
 
 namespace {

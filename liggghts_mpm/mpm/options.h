@@ -34,6 +34,11 @@ struct Gate {
   bool fluid_below = true;   // fluid held on the low-coordinate side
   double release_time = -1;  // simulation time of removal; < 0 = only by fix_modify
 };
+// keyword probe: the pressure at a point (lo) or the mean over the fluid nodes of a box (lo..hi)
+struct Probe {
+  bool box = false;
+  double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.0, 0.0, 0.0};
+};
 enum class Transfer { Apic, Pic, Flip };
 // The coupling's forms (docs/theory): standard, the project's (the grains' pressure force is the
 // gradient the fluid itself feels, its reaction goes through the points that displaced it, the
@@ -105,6 +110,9 @@ struct Options {
   double theta_min = kDragThetaMin;
   double theta_smooth = 0.0;        // standard deviation of the smoothing of the solid fraction (0: none)
   bool cell_check = true;
+  // pressure probes (keyword probe, one each) and the window of their time average (0: every fluid step)
+  std::vector<Probe> probes;
+  double probe_window = 0.0;
   // output
   int out_every = 0;
   std::string out_prefix;
@@ -161,6 +169,10 @@ extern const char *const kGridFields[2];
 
 // fix ID group mpm/fluid keyword value ...: arg[3..narg). Throws mpm::Error.
 Options parse_options(int narg, char **arg, const ParseEnv &env);
+// mesh_wall's optional 'reference_point x y z' at arg[iarg] (the torque's reference point):
+// returns the index after it, or iarg if arg[iarg] is not 'reference_point'. Throws mpm::Error
+// naming the keyword, what it expects and the value given.
+int parse_reference_point(int narg, char **arg, int iarg, double ref[3]);
 // fix_modify keyword value ...: returns the number of words used. Throws mpm::Error for a word
 // fix_modify cannot change (naming it and the keywords it can), a bad value, or a value that another
 // choice makes inert (o unchanged then).

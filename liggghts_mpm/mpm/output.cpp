@@ -10,7 +10,7 @@
 
 namespace mpm {
 
-void FluidSolver::global_vector(double out[kGlobalSize]) {
+void FluidSolver::global_vector(double *out, int walls) {
   const GridSpec &gs = opt.grid;
   double **x = pts.x, **v = pts.v;
   const double *rmass = pts.rmass;
@@ -58,6 +58,11 @@ void FluidSolver::global_vector(double out[kGlobalSize]) {
   out[16] = proj_ ? proj_->residual() : 0.0;
   out[17] = gmx[6];
   out[18] = std::isfinite(gmx[7]) ? gmx[7] : 0.0;
+  // the mesh walls' loads and the probes (wall_loads.cpp): 0 before the first fluid step
+  for (int c = 0; c < 6 * walls; ++c)
+    out[kGlobalSize + c] = c < static_cast<int>(wall_mean_.size()) ? wall_mean_[c] : 0.0;
+  for (std::size_t j = 0; j < opt.probes.size(); ++j)
+    out[kGlobalSize + 6 * walls + j] = j < probe_mean_.size() ? probe_mean_[j] : 0.0;
 }
 
 // since the fix was created: the Projection of each grid patch (a new one at every re-cut) adds

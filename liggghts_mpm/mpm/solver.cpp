@@ -150,7 +150,10 @@ void FluidSolver::step() {
     const long every = Projection::volume_correction_every(opt.volume_correction, hf);
     if ((clock.step / opt.fluid_every) % every == 0) vc_time = every * hf;
   }
+  const bool samples = samples_on();
+  if (samples) begin_samples();
   for (int s = 0; s < state.nsub; ++s) substep(h, s == 0 ? vc_time : 0.0);
+  if (samples) end_samples();
   if (!opt.coupled) return;
   // fluid force on the grains (mean over the sub-steps), for the host's integrator. With every N
   // the grains get the impulse of the N steps, N h F, in this step (force N F): velocity Verlet
@@ -178,6 +181,7 @@ void FluidSolver::substep(double h, double vc_time) {
   if (opt.coupled) timed(time_couple, [&] { couple_fluid_grains(h); });
   timed(time_fluid, [&] {
     update_grid(h, vc_time);
+    if (samples_on()) sample_pressure(h);
     if (opt.projection) interpolate_pressure();
     grid_to_particles();
     if (opt.musl) remap_velocity_musl(h);

@@ -99,7 +99,15 @@ class FluidSolver {
   // iterations and relative residual of the last pressure solve (pressure projection; else 0),
   // wall time in the pressure solver (part of the fluid's)
   static constexpr int kGlobalSize = 19;
-  void global_vector(double out[kGlobalSize]);
+  // then, from index kGlobalSize (f_ID[20] on): per mesh wall k (in the order of the fix command)
+  // the fluid's force on it (3) and its torque about the wall's reference point (3), averaged over
+  // the sub-steps of the last fluid step (wall_loads.cpp); then per probe the pressure averaged
+  // over the last completed probe window. walls: the number of mesh walls of the host.
+  static int global_size(int walls, int probes) { return kGlobalSize + 6 * walls + probes; }
+  void global_vector(double *out, int walls);
+  // wall_loads.cpp: the pressure field the walls and probes read in this sub-step, added to the
+  // mesh walls' loads and the probes' sums with weight h (after update_grid; collective)
+  void sample_pressure(double h);
   // HDF5 + XDMF output of the points (and grid) fields of keyword output (collective).
   void write_output();
   // wall time in write_output on this rank (s, cumulative) and the step files written
@@ -255,6 +263,24 @@ class FluidSolver {
   // the pressure solver's time, solves and PCG iterations of the Projections of earlier patches
   double proj_seconds_before_ = 0.0;
   long proj_solves_before_ = 0, proj_iterations_before_ = 0;
+  // wall_loads.cpp: per node the fluid mass and (pressure eos) mass times the points' pressure,
+  // of this sub-step (owned and halos); the mesh walls' loads (6 per wall) and the probes' sums
+  // (p h, h) summed over this fluid step's sub-steps on this rank, and their time
+  std::vector<double> wmp_;
+  std::vector<double> wall_sum_, wall_mean_;
+  double wall_time_ = 0.0;
+  std::vector<double> probe_sum_, probe_mean_;  // 2 per probe: sum p h (local), sum h
+  double probe_time_ = 0.0;
+  bool samples_on() const { return (bc.walls() && bc.walls()->walls() > 0) || !opt.probes.empty(); }
+  void node_mass_pressure();
+  void surface_pressure();
+  double p_surface_ = 0.0;  // pressure projection: the solve's pressure at the free surface (this sub-step)
+  bool pressure_at(const double *x, double &p, double *vel);
+  bool owns_sample(const double *x) const;
+  void wall_loads(double h);
+  void probe_sums(double h);
+  void begin_samples();
+  void end_samples();
   std::vector<double> pvol_;          // volume_correction: sum S V of the points per node
   double vmax_ = 0.0;                 // |v|max of the points at the last time-step check
   long last_output_step_ = -1;

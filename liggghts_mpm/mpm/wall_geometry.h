@@ -45,6 +45,7 @@ struct WallSpec {
   bool delta_auto = false;  // shear auto: delta = sqrt(2 nu / omega), the Stokes layer of the
                             // mesh's rotation rate omega (fitted to its triangles' velocities)
   int side = SIDE_NORMAL;  // MeshSide
+  double ref[3] = {0.0, 0.0, 0.0};  // reference point of the fluid's torque on the wall (mesh_wall reference_point)
 };
 
 // Checks s (kind and side known, sticky in [0,1], delta > 0 for shear) and forces sticky of the

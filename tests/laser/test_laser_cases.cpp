@@ -398,11 +398,11 @@ TEST(LaserCases, ErrorControlledStepShortPulses) {
   // a user step that is too coarse is reported, not refined
   Config u = c;
   u.tp = 200e-6;
-  u.dt = 5e-6;
+  u.dt = 3e-6;
   const Result ru = TimeStepPolicy(u).run(u, nullptr);
-  std::printf("[ STEP ] 200 us at dt = 5e-6 s: status %s, estimate %.2e / %.2e\n", ru.status.c_str(),
+  std::printf("[ STEP ] 200 us at dt = 3e-6 s: status %s, estimate %.2e / %.2e\n", ru.status.c_str(),
               ru.step.depth_error, ru.step.volume_error);
-  EXPECT_EQ(ru.dt, 5e-6);
+  EXPECT_EQ(ru.dt, 3e-6);
   if (std::max(ru.step.depth_error, ru.step.volume_error) > u.tol) {
     EXPECT_EQ(ru.status, "inaccurate");
     EXPECT_NE(ru.message.find("estimated error"), std::string::npos);

@@ -141,6 +141,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"T_melt_above_sat", "--T-melt 3500", "", {"--T-melt", "--T-sat0", "K"}},
         BadCase{"model_unknown", "--model turbulent", "", {"--model", "conduction, rising, risingfall, boundary"}},
         BadCase{"dt_above_limit", "--dt 5e-5", "", {"--dt", "explicit stability limit", "s"}},
+        // became unstable only after running before (step 16, t = 85 us): now refused up front
+        BadCase{"dt_above_accepted", "--dt 5.3e-6", "", {"--dt", "accepted step", "3.126e-06"}},
+        BadCase{"dt_above_accepted_config", "--config " LASER_INPUTS_DIR "/rising_m2.toml --dt 6.21e-6", "",
+                {"--dt", "accepted step", "3.126e-06"}},
         BadCase{"dt_longer_than_pulse", "--dt 1e-4 --pulse 5e-5 --melt-update implicit", "",
                 {"--dt", "shorter than the pulse"}},
         BadCase{"repeated_option", "--intensity 5e10 --intensity 6e10", "", {"--intensity"}},

@@ -136,6 +136,14 @@ void check_step_file(const std::string &path, long step, double time, const Poin
   ASSERT_GE(f.id, 0) << path;
   EXPECT_EQ(read_attr<double>(f.id, "time", H5T_NATIVE_DOUBLE, 1)[0], time);
   EXPECT_EQ(read_attr<long long>(f.id, "step", H5T_NATIVE_LLONG, 1)[0], step);
+  // time and step are scalars (h5py: int(f.attrs["step"]) works; a 1-element array fails on numpy 2)
+  for (const char *name : {"time", "step"}) {
+    hid_t a = H5Aopen(f.id, name, H5P_DEFAULT);
+    hid_t sp = H5Aget_space(a);
+    EXPECT_EQ(H5Sget_simple_extent_type(sp), H5S_SCALAR) << name;
+    H5Sclose(sp);
+    H5Aclose(a);
+  }
   check_points(f.id, p);
   EXPECT_EQ(H5Lexists(f.id, "grid", H5P_DEFAULT) > 0, g != nullptr);
   if (!g) return;

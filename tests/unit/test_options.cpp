@@ -97,6 +97,62 @@ TEST(Options, ErrorsNameKeywordExpectationAndValue) {
   EXPECT_EQ(error_of(kBase + "viscosity 1e-3 couple grains theta_smooth 0"), "");
 }
 
+// probe, probe_window and mesh_wall's reference_point: values, and refusals that name the keyword,
+// what it expects and the value given
+TEST(Options, ProbesAndReferencePoint) {
+  const mpm::Options o = parse(kBase + "probe point 1 1 0.5 probe box 0 2 0 2 0.25 0.75 probe_window 0.1");
+  ASSERT_EQ(o.probes.size(), 2u);
+  EXPECT_FALSE(o.probes[0].box);
+  EXPECT_DOUBLE_EQ(o.probes[0].lo[2], 0.5);
+  EXPECT_TRUE(o.probes[1].box);
+  EXPECT_DOUBLE_EQ(o.probes[1].hi[2], 0.75);
+  EXPECT_DOUBLE_EQ(o.probe_window, 0.1);
+  EXPECT_TRUE(o.warnings.empty());  // probe repeats, one probe each
+  EXPECT_EQ(error_of(kBase + "probe line 0 0 0"),
+            "Fix mpm/fluid: keyword 'probe' expects 'point x y z' or 'box xlo xhi ylo yhi zlo zhi' (length), got 'line'");
+  EXPECT_EQ(error_of(kBase + "probe point 1 1"),
+            "Fix mpm/fluid: keyword 'probe point' expects three coordinates x y z (length), got nothing");
+  EXPECT_EQ(error_of(kBase + "probe point 1 y 1"), "Fix mpm/fluid: keyword 'probe point' expects a coordinate (length), got 'y'");
+  EXPECT_EQ(error_of(kBase + "probe box 0 1 0 1 0.6 0.4"),
+            "Fix mpm/fluid: keyword 'probe box' expects hi > lo in every dimension, got '0.4'");
+  EXPECT_EQ(error_of(kBase + "probe point 1 1 2.5"),
+            "Fix mpm/fluid: keyword 'probe point' expects a point inside the grid along z [0, 2], got 2.5");
+  EXPECT_EQ(error_of(kBase + "probe box -1 1 0 1 0 1"),
+            "Fix mpm/fluid: keyword 'probe box' expects bounds inside the grid along x [0, 2], got -1");
+  EXPECT_EQ(error_of(kBase + "probe point 1 1 1 probe_window -1"),
+            "Fix mpm/fluid: keyword 'probe_window' expects a time window (time) >= 0 of the probes' average, got '-1'");
+  EXPECT_NE(error_of(kBase + "probe_window 1").find("'probe_window' (the probes' averaging window) needs keyword 'probe'"),
+            std::string::npos);
+  // mesh_wall ... reference_point x y z (parsed for the adapter)
+  std::vector<std::string> w = {"reference_point", "1", "2.5", "-3", "side"};
+  std::vector<char *> a;
+  for (auto &x : w) a.push_back(&x[0]);
+  double ref[3] = {0, 0, 0};
+  EXPECT_EQ(mpm::parse_reference_point(5, a.data(), 0, ref), 4);
+  EXPECT_DOUBLE_EQ(ref[1], 2.5);
+  EXPECT_DOUBLE_EQ(ref[2], -3.0);
+  EXPECT_EQ(mpm::parse_reference_point(5, a.data(), 4, ref), 4);  // not the keyword: nothing read
+  w = {"reference_point", "1", "x", "0"};
+  a.clear();
+  for (auto &x : w) a.push_back(&x[0]);
+  try {
+    mpm::parse_reference_point(4, a.data(), 0, ref);
+    ADD_FAILURE() << "reference_point 1 x 0 accepted";
+  } catch (const mpm::Error &e) {
+    EXPECT_EQ(std::string(e.what()), "Fix mpm/fluid: keyword 'mesh_wall reference_point' expects three coordinates x y z "
+                                     "(length) of the torque's reference point, got 'x'");
+  }
+  w = {"reference_point", "1", "2"};
+  a.clear();
+  for (auto &x : w) a.push_back(&x[0]);
+  try {
+    mpm::parse_reference_point(3, a.data(), 0, ref);
+    ADD_FAILURE() << "reference_point with two values accepted";
+  } catch (const mpm::Error &e) {
+    EXPECT_NE(std::string(e.what()).find("got nothing"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Options, FixModifyTakesTheModifiableRowsOnly) {
   mpm::Options o = parse(kBase);
   std::vector<std::string> w = {"damping", "5"};
