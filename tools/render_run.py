@@ -3,7 +3,7 @@
 
   tools/python tools/render_run.py RUN_DIR [--times T1 T2 ...] [--out FILE.png] [--axis x|y|z]
         [--field p|v] [--prefix PREFIX] [--dump NAME] [--vmax V] [--dpi 150]
-        [--slab LO HI] [--zoom H0 H1 V0 V1]
+        [--slab LO HI] [--zoom H0 H1 V0 V1] [--title TEXT] [--labels L1 L2 ...]
 
 RUN_DIR is the folder a run wrote its outputs to. The points come from the HDF5 series of fix
 mpm/fluid (`output N PREFIX points ...`: PREFIX.xmf and PREFIX_<step>.h5; with several series,
@@ -24,7 +24,9 @@ column, else --grain-diameter). --slab LO HI draws only the points and grains wh
 the axis lies in [LO, HI] (a cut through a 3-D scene, so that beads in front do not hide the water).
 The axes span the points and grains drawn (over all panels, after the slab) with a margin of 3 %;
 --zoom H0 H1 V0 V1 sets them instead (picture coordinates: horizontal, then vertical, in m). The
-LIGGGHTS box of the dumps is outlined where it falls inside the axes.
+LIGGGHTS box of the dumps is outlined where it falls inside the axes. --title TEXT heads the figure
+(above the line that counts what is drawn; default: the folder's name); --labels gives one text per
+--times entry, put before that panel's time (e.g. "before release").
 """
 import argparse
 import os
@@ -99,7 +101,12 @@ def main():
                     help="draw only what lies in [LO, HI] along the axis (m)")
     ap.add_argument("--zoom", type=float, nargs=4, metavar=("H0", "H1", "V0", "V1"), default=None,
                     help="axes limits: horizontal H0..H1, vertical V0..V1 (m)")
+    ap.add_argument("--title", default=None, help="figure title (default: the run folder's name)")
+    ap.add_argument("--labels", nargs="+", default=None, help="one text per --times entry, in the panel titles")
     a = ap.parse_args()
+    if a.labels and (not a.times or len(a.labels) != len(a.times)):
+        sys.exit("render_run: --labels expects one text per --times entry (%d times, %d labels)"
+                 % (len(a.times or []), len(a.labels)))
     if a.slab and not a.slab[0] < a.slab[1]:
         sys.exit("render_run: --slab expects LO < HI (m), got %g %g" % tuple(a.slab))
     if a.zoom and not (a.zoom[0] < a.zoom[1] and a.zoom[2] < a.zoom[3]):
@@ -111,12 +118,15 @@ def main():
     if not frames:
         sys.exit("render_run: the HDF5 series '%s' in %s has no frame" % (prefix, a.rundir))
     times = np.array([f[1] for f in frames])
+    labels = {}
     if a.times:
         pick = []
-        for t in a.times:
+        for k, t in enumerate(a.times):
             i = int(np.argmin(np.abs(times - t)))
             if i not in pick:
                 pick.append(i)
+                if a.labels:
+                    labels[i] = a.labels[k]
     else:
         pick = sorted({int(round(k)) for k in np.linspace(0, len(frames) - 1, min(4, len(frames)))})
 
@@ -165,11 +175,11 @@ def main():
             grains.append((g[keep], rad[keep]))
             if s != step:
                 notes.append("%s at step %d" % (name, s))
-        snaps.append((t, step, xyz, val, grains, notes))
+        snaps.append((t, step, xyz, val, grains, notes, labels.get(i)))
 
     # the axes: what is drawn (points and grains of every panel, grains with their radius), or --zoom
     lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
-    for _, _, xyz, _, grains, _ in snaps:
+    for _, _, xyz, _, grains, _, _ in snaps:
         if len(xyz):
             lo, hi = np.minimum(lo, xyz.min(axis=0)), np.maximum(hi, xyz.max(axis=0))
         for g, rad in grains:
@@ -205,7 +215,7 @@ def main():
     fig, axes = plt.subplots(nrow, ncol, figsize=(panel_w * ncol + 1.2, nrow * (panel_w * wy / wx + 0.7) + 0.5),
                              squeeze=False, layout="constrained")
     sc = None
-    for k, (t, step, xyz, val, grains, notes) in enumerate(snaps):
+    for k, (t, step, xyz, val, grains, notes, plabel) in enumerate(snaps):
         ax = axes[k // ncol][k % ncol]
         ax.set_xlim(view[h, 0], view[h, 1])
         ax.set_ylim(view[v, 0], view[v, 1])
@@ -223,7 +233,7 @@ def main():
         if box is not None:
             ax.plot([box[h, 0], box[h, 1], box[h, 1], box[h, 0], box[h, 0]],
                     [box[v, 0], box[v, 0], box[v, 1], box[v, 1], box[v, 0]], color="k", lw=0.8, zorder=3)
-        title = "t = %.4g s (step %d)" % (t, step)
+        title = ("%s: " % plabel if plabel else "") + "t = %.4g s (step %d)" % (t, step)
         if notes:
             title += "; " + ", ".join(notes)
         ax.set_title(title, fontsize=9)
@@ -236,8 +246,8 @@ def main():
     cb.set_label(label, fontsize=9)
     name = os.path.basename(os.path.normpath(os.path.abspath(a.rundir)))
     ngr = sum(len(g) for g, _ in snaps[-1][4])
-    fig.suptitle("%s: %d material points%s, seen along %s%s" % (
-        name, len(snaps[-1][2]), (", %d grains" % ngr) if snaps[-1][4] else "", a.axis,
+    fig.suptitle("%s%s%d material points%s, seen along %s%s" % (
+        a.title or name, "\n" if a.title else ": ", len(snaps[-1][2]), (", %d grains" % ngr) if snaps[-1][4] else "", a.axis,
         (", %s in [%g, %g]" % (a.axis, a.slab[0], a.slab[1])) if a.slab else ""), fontsize=11)
     out = a.out or os.path.join(a.rundir, name + ".png")
     fig.savefig(out, dpi=a.dpi)
