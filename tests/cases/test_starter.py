@@ -88,9 +88,9 @@ def main():
     # cell-mean pressure, between 0 and it
     g = 9.81
     bound = 5.0 * (RHO * g * HWATER + RHO * 2.0 * g * HWATER)
-    pmax = max(row[h.index("c_ppoint")] for h, rows in blocks[1:] for row in rows)
+    pmax = max(row[h.index("ppoint")] for h, rows in blocks[1:] for row in rows)
     check(0.0 < pmax < bound, f"largest point pressure {pmax:.4g} Pa below 5 (rho g h + rho U^2) = {bound:.4g} Pa")
-    cell_ok = all(row[h.index("fluid[10")] <= row[h.index("c_ppoint")] for h, rows in blocks[1:] for row in rows)
+    cell_ok = all(row[h.index("fluid[10")] <= row[h.index("ppoint")] for h, rows in blocks[1:] for row in rows)
     check(cell_ok, "f_fluid[10] (largest cell-mean pressure) at most the largest single point pressure in every line")
     front = [row[fh.index("fluid[4]")] for row in fl]
     check(front[-1] > front[0], f"the water front moves after the gate opens ({front[0]:.4f} -> {front[-1]:.4f} m)")
