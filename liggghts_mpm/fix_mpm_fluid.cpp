@@ -345,6 +345,15 @@ void FixMpmFluid::pre_final_integrate() {
   guarded([&] { print(s.check_timestep(false)); });
   refresh_walls();
   guarded([&] { s.step(); });
+  if (!sealed_noted && s.pressure_sealed_nodes() > 0) {
+    sealed_noted = true;
+    std::ostringstream os;
+    os << "fix mpm/fluid: at step " << update->ntimestep << " " << s.pressure_sealed_nodes()
+       << " fluid nodes in " << s.pressure_sealed_sets()
+       << " pocket(s) are sealed off from the free surface by closed wall faces: each pocket's pressure is "
+          "solved with its own mean (the water in it cannot be compressed; noted once)\n";
+    print(os.str());
+  }
   if (s.opt.coupled && fix_dragforce)
     for (int k = 0; k < atom->nlocal; ++k)
       if (atom->mask[k] & couple_groupbit)

@@ -72,6 +72,7 @@ class FixMpmFluid : public Fix {
   double **pdata = nullptr;  // per-point state rows (mpm::Column)
   int pdata_rows = 0;
   bigint vector_step = -1;   // f_ID[] cached for this step
+  bool sealed_noted = false;  // the note on pockets sealed off from the free surface (printed once)
   std::vector<double> vector_cache;  // f_ID[] (FluidSolver::global_size)
 
   int parse_mesh_wall(int narg, char **arg, int iarg);

@@ -82,6 +82,9 @@ long FluidSolver::pressure_iterations_summed() const {
   return proj_iterations_before_ + (proj_ ? proj_->iterations_summed() : 0);
 }
 
+long FluidSolver::pressure_sealed_nodes() const { return proj_ ? proj_->sealed_nodes() : 0; }
+long FluidSolver::pressure_sealed_sets() const { return proj_ ? proj_->sealed_sets() : 0; }
+
 namespace {
 int point_field_size(const std::string &f) { return f == "v" ? 3 : f == "tau" ? 6 : f == "affine" ? 9 : 1; }
 }  // namespace

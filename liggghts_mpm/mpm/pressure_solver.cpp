@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <vector>
 
@@ -50,7 +51,10 @@ struct PressureSolver::Hypre {
   std::vector<double> values;  // kEntries per owned node, box order (i fastest)
   bool valid_values = false;
   std::vector<double> bbuf, xbuf;
-  long pin = -1;  // all-Neumann: global key of the FLUID node held at p = 0, else -1
+  // sealed components (seal_components): per patch node the smallest global key of the FLUID
+  // nodes its open faces connect it to, -1 where that set reaches an EMPTY node; the node whose
+  // own key it is (one per sealed component) is held at p = 0. Empty: no sealed component.
+  std::vector<double> comp;
 
   void destroy_solver(PressureSettings::Preconditioner kind) {
     if (pcg) HYPRE_StructPCGDestroy(pcg);
@@ -137,7 +141,151 @@ long PressureSolver::node_key(int i, int j, int k) const {
 }
 
 bool PressureSolver::unknown(const NodeLabels &labels, int i, int j, int k, std::size_t n) const {
-  return labels.kind[n] == kFluid && (h_->pin < 0 || node_key(i, j, k) != h_->pin);
+  if (labels.kind[n] != kFluid) return false;
+  const std::vector<double> &c = h_->comp;
+  return c.empty() || c[n] < 0.0 || long(c[n]) != node_key(i, j, k);
+}
+
+/* Sealed components: the FLUID nodes that open faces connect into one set without reaching an
+   EMPTY node (a pocket closed off by mesh-wall or gate faces, or all the fluid when no node is
+   EMPTY). Their block of the operator has the constants as null space, and the moving wall faces
+   around such a pocket (a lifter bar turning through the grid: its staircase of closed faces
+   changes the pocket's volume from step to step) give it a right-hand side that sums to a
+   nonzero value: no solution, and PCG diverges (docs/projection.md, "Sealed pockets"). Labels
+   each FLUID node with the smallest global key of its set (-1 if the set reaches an EMPTY node)
+   by sweeps forward and backward over the owned nodes and halo exchanges until nothing changes
+   on any rank. Returns the number of FLUID nodes in sealed sets on all ranks. Collective. */
+long PressureSolver::seal_components(const NodeLabels &labels) {
+  std::vector<double> &c = h_->comp;
+  const IndexBox &ob = grid_.owned();
+  // First a flood fill from the FLUID nodes next to an EMPTY one (-1: reached; -2: FLUID not yet
+  // reached), across the ranks through the halos until no rank finds a new seed: in the common case
+  // it reaches every FLUID node and that is all the cost.
+  constexpr double kReached = -1.0, kUnreached = -2.0;
+  c.assign(grid_.size(), kReached);
+  std::vector<std::size_t> queue;
+  std::vector<int> qi;  // i, j, k of the queued nodes
+  auto push = [&](int i, int j, int k, std::size_t n) {
+    c[n] = kReached;
+    queue.push_back(n);
+    qi.insert(qi.end(), {i, j, k});
+  };
+  auto next_to = [&](int i, int j, int k, bool empty) {
+    for (int d = 0; d < 3; ++d)
+      for (int side = -1; side <= 1; side += 2) {
+        std::size_t m;
+        if (!open_face(grid_, labels, i, j, k, d, side, &m)) continue;
+        if (empty ? labels.kind[m] == kEmpty : (labels.kind[m] == kFluid && c[m] == kReached)) return true;
+      }
+    return false;
+  };
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    if (labels.kind[n] == kFluid) c[n] = kUnreached;
+  });
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (labels.kind[n] == kFluid && next_to(i, j, k, true)) push(i, j, k, n);
+  });
+  for (;;) {
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const int i = qi[3 * q], j = qi[3 * q + 1], k = qi[3 * q + 2];
+      for (int d = 0; d < 3; ++d)
+        for (int side = -1; side <= 1; side += 2) {
+          std::size_t m;
+          if (!open_face(grid_, labels, i, j, k, d, side, &m) || labels.kind[m] != kFluid || c[m] != kUnreached)
+            continue;
+          int a[3] = {i, j, k};
+          a[d] += side;
+          if (ob.contains(a[0], a[1], a[2])) push(a[0], a[1], a[2], m);
+        }
+    }
+    queue.clear();
+    qi.clear();
+    grid_.forward(c.data(), 1);
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+      if (labels.kind[n] == kFluid && c[n] == kUnreached && next_to(i, j, k, false)) push(i, j, k, n);
+    });
+    long seeds = long(queue.size()), gseeds = 0;
+    MPI_Allreduce(&seeds, &gseeds, 1, MPI_LONG, MPI_SUM, comm_);
+    if (gseeds == 0) break;
+  }
+  long unreached = 0, gunreached = 0;
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    if (labels.kind[n] == kFluid && c[n] == kUnreached) ++unreached;
+  });
+  MPI_Allreduce(&unreached, &gunreached, 1, MPI_LONG, MPI_SUM, comm_);
+  if (gunreached == 0) {
+    c.clear();
+    return 0;
+  }
+  // The nodes left are sealed: each takes the smallest key of its set.
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (labels.kind[n] == kFluid && c[n] == kUnreached) c[n] = double(node_key(i, j, k));
+  });
+  grid_.forward(c.data(), 1);
+  auto relax = [&](int i, int j, int k) {
+    const std::size_t n = grid_.index(i, j, k);
+    if (labels.kind[n] != kFluid || c[n] < 0.0) return false;
+    double low = c[n];
+    for (int d = 0; d < 3; ++d)
+      for (int side = -1; side <= 1; side += 2) {
+        std::size_t m;
+        if (open_face(grid_, labels, i, j, k, d, side, &m) && labels.kind[m] == kFluid) low = std::min(low, c[m]);
+      }
+    if (!(low < c[n])) return false;
+    c[n] = low;
+    return true;
+  };
+  for (;;) {
+    bool changed = false, pass = true;
+    while (pass) {
+      pass = false;
+      for (int k = ob.lo[2]; k <= ob.hi[2]; ++k)
+        for (int j = ob.lo[1]; j <= ob.hi[1]; ++j)
+          for (int i = ob.lo[0]; i <= ob.hi[0]; ++i) pass = relax(i, j, k) || pass;
+      for (int k = ob.hi[2]; k >= ob.lo[2]; --k)
+        for (int j = ob.hi[1]; j >= ob.lo[1]; --j)
+          for (int i = ob.hi[0]; i >= ob.lo[0]; --i) pass = relax(i, j, k) || pass;
+      changed = changed || pass;
+    }
+    grid_.forward(c.data(), 1);
+    int mine = changed ? 1 : 0, any = 0;
+    MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, comm_);
+    if (!any) break;
+  }
+  long sealed = 0, gsealed = 0;
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    if (labels.kind[n] == kFluid && c[n] >= 0.0) ++sealed;
+  });
+  MPI_Allreduce(&sealed, &gsealed, 1, MPI_LONG, MPI_SUM, comm_);
+  if (gsealed == 0) c.clear();
+  return gsealed;
+}
+
+/* Per sealed component (key -> sum, count) of values at its owned FLUID nodes, summed over the
+   ranks. Collective. */
+std::map<long, std::pair<double, long>> PressureSolver::component_sums(
+    const std::map<long, std::pair<double, long>> &mine) const {
+  std::vector<double> out;
+  for (const auto &e : mine) {
+    out.push_back(double(e.first));
+    out.push_back(e.second.first);
+    out.push_back(double(e.second.second));
+  }
+  int size = 0;
+  MPI_Comm_size(comm_, &size);
+  int len = int(out.size());
+  std::vector<int> lens(size), offs(size, 0);
+  MPI_Allgather(&len, 1, MPI_INT, lens.data(), 1, MPI_INT, comm_);
+  for (int r = 1; r < size; ++r) offs[r] = offs[r - 1] + lens[r - 1];
+  std::vector<double> all(std::size_t(offs[size - 1] + lens[size - 1]));
+  MPI_Allgatherv(out.data(), len, MPI_DOUBLE, all.data(), lens.data(), offs.data(), MPI_DOUBLE, comm_);
+  std::map<long, std::pair<double, long>> sums;
+  for (std::size_t q = 0; q + 2 < all.size(); q += 3) {
+    auto &e = sums[long(all[q])];
+    e.first += all[q + 1];
+    e.second += long(all[q + 2]);
+  }
+  return sums;
 }
 
 bool PressureSolver::assemble_values(const NodeLabels &labels, const double *beta) {
@@ -292,18 +440,18 @@ PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *
   if (any_moved) build_grid(want);
   const IndexBox &ab = h.box;
 
-  // Without any EMPTY node the constants are the operator's null space: the rhs is made
-  // compatible (mean removed) and the FLUID node of smallest global key is held at 0,
-  // which keeps the matrix definite (PCG + PFMG stalls on the semidefinite one) without
-  // changing the solution of the compatible system up to its constant.
-  long counts[2] = {0, 0}, gcounts[2];  // EMPTY nodes, FLUID nodes
-  long first = -1;
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+  // Without any EMPTY node the constants are the operator's null space, and so they are for
+  // every set of FLUID nodes that closed faces seal off from the EMPTY ones (seal_components,
+  // sought only where closed faces or no EMPTY node exist): per sealed set the rhs is made
+  // compatible (its mean removed) and its FLUID node of smallest global key is held at 0, which
+  // keeps the matrix definite (PCG + PFMG stalls on the semidefinite one) without changing the
+  // solution of the compatible system up to its constant; p is returned with zero mean per set.
+  long counts[3] = {0, 0, 0}, gcounts[3];  // EMPTY nodes, FLUID nodes, FLUID nodes with a closed face
+  grid_.for_owned([&](int, int, int, std::size_t n) {
     if (labels.kind[n] == kEmpty) ++counts[0];
     if (labels.kind[n] != kFluid) return;
     ++counts[1];
-    const long key = node_key(i, j, k);
-    if (first < 0 || key < first) first = key;
+    if (labels.closed[n]) ++counts[2];
   });
   // the projection's work box (pure fluid, no mesh walls): the owned nodes outside it are EMPTY,
   // but the padding behind the box walls, which is SOLID
@@ -311,13 +459,10 @@ PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *
     const GridSpec &g = grid_.spec();
     counts[0] += g.interior(ob).count() - g.interior(ob.cut(grid_.work())).count();
   }
-  MPI_Allreduce(counts, gcounts, 2, MPI_LONG, MPI_SUM, comm_);
+  MPI_Allreduce(counts, gcounts, 3, MPI_LONG, MPI_SUM, comm_);
   res.singular = gcounts[0] == 0 && gcounts[1] > 0;
-  h.pin = -1;
-  if (res.singular) {
-    long mine = first < 0 ? LONG_MAX : first;
-    MPI_Allreduce(&mine, &h.pin, 1, MPI_LONG, MPI_MIN, comm_);
-  }
+  h.comp.clear();
+  if (res.singular || gcounts[2] > 0) res.sealed = seal_components(labels);
   if (assemble_values(labels, beta) || !h.pcg) {
     setup_solver();
     res.rebuilt = true;
@@ -326,7 +471,7 @@ PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *
 
   // Right-hand side of -dx^2 L p = -dx^2 rhs, EMPTY neighbours' values moved over.
   const double dx2 = grid_.spec().dx * grid_.spec().dx;
-  double bsum = 0.0;
+  std::map<long, std::pair<double, long>> bsums;  // sealed sets: rhs sum and count
   std::size_t row = 0;
   for_box(grid_, ab, [&](int i, int j, int k, std::size_t n) {
     double &b = h.bbuf[row];
@@ -342,22 +487,29 @@ PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *
           if (open_face(grid_, labels, i, j, k, d, side, &m) && labels.kind[m] == kEmpty)
             b += geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]) * surface_scale(labels, n, m) * p_empty[m];
         }
-    bsum += b;
+    if (!h.comp.empty() && h.comp[n] >= 0.0) {
+      auto &e = bsums[long(h.comp[n])];
+      e.first += b;
+      ++e.second;
+    }
     x = p[n];
   });
-  if (res.singular) {
-    double gsum = 0.0;
-    MPI_Allreduce(&bsum, &gsum, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    const double mean = gsum / double(gcounts[1]);
+  if (!h.comp.empty()) {
+    const auto sums = component_sums(bsums);
     row = 0;
     for_box(grid_, ab, [&](int i, int j, int k, std::size_t n) {
       double &b = h.bbuf[row], &x = h.xbuf[row];
       ++row;
-      if (labels.kind[n] != kFluid) return;
-      b -= mean;
+      if (labels.kind[n] != kFluid || h.comp[n] < 0.0) return;
+      const auto &e = sums.at(long(h.comp[n]));
+      b -= e.first / double(e.second);
       if (!unknown(labels, i, j, k, n)) b = x = 0.0;  // the pinned node
     });
-    res.rhs_mean_removed = -mean / dx2;  // in the units of rhs
+    double removed = 0.0;
+    for (const auto &e : sums) removed += std::fabs(e.second.first);
+    res.rhs_mean_removed = res.singular ? -sums.begin()->second.first / double(sums.begin()->second.second) / dx2
+                                        : removed / dx2;
+    res.sealed_sets = long(sums.size());
   }
 
   if (!ab.empty()) {
@@ -398,7 +550,7 @@ PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *
     throw PressureSolveError(os.str(), res.iterations, res.relative_residual);
   }
 
-  double psum = 0.0;
+  std::map<long, std::pair<double, long>> psums;  // sealed sets: p sum and count
   grid_.for_owned([&](int, int, int, std::size_t n) {
     if (labels.kind[n] != kFluid) p[n] = (labels.kind[n] == kEmpty && p_empty) ? p_empty[n] : 0.0;
   });
@@ -407,15 +559,19 @@ PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *
     const double x = h.xbuf[row++];
     if (labels.kind[n] == kFluid) {
       p[n] = x;
-      psum += x;
+      if (!h.comp.empty() && h.comp[n] >= 0.0) {
+        auto &e = psums[long(h.comp[n])];
+        e.first += x;
+        ++e.second;
+      }
     }
   });
-  if (res.singular) {
-    double gsum = 0.0;
-    MPI_Allreduce(&psum, &gsum, 1, MPI_DOUBLE, MPI_SUM, comm_);
-    const double mean = gsum / double(gcounts[1]);
+  if (!h.comp.empty()) {
+    const auto sums = component_sums(psums);
     grid_.for_owned([&](int, int, int, std::size_t n) {
-      if (labels.kind[n] == kFluid) p[n] -= mean;
+      if (labels.kind[n] != kFluid || h.comp[n] < 0.0) return;
+      const auto &e = sums.at(long(h.comp[n]));
+      p[n] -= e.first / double(e.second);
     });
   }
   grid_.forward(p, 1);

@@ -9,6 +9,7 @@
 #pragma once
 #include <mpi.h>
 
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -34,7 +35,10 @@ struct PressureResult {
   double relative_residual = 0.0;
   bool rebuilt = false;        // matrix assembled and preconditioner set up in this call
   bool singular = false;       // no EMPTY node anywhere: p fixed to zero mean over the FLUID nodes
-  double rhs_mean_removed = 0.0;  // singular only: the mean of the rhs made compatible (see solve)
+  double rhs_mean_removed = 0.0;  // singular: the mean of the rhs made compatible (see solve); with
+                                  // sealed sets only: the sum of |rhs sum| over the sets
+  long sealed = 0;             // FLUID nodes (all ranks) in sets sealed off from every EMPTY node
+  long sealed_sets = 0;        // the number of such sets (each made compatible, one node held at 0)
   double setup_seconds = 0.0;  // matrix assembly + preconditioner setup (rebuilt only)
   double solve_seconds = 0.0;  // PCG
   long enclosed = 0;           // FLUID nodes of this rank without an open face, solved as SOLID (p = 0)
@@ -81,6 +85,8 @@ class PressureSolver {
   void setup_solver();
   bool any_periodic() const;
   long node_key(int i, int j, int k) const;
+  long seal_components(const NodeLabels &labels);
+  std::map<long, std::pair<double, long>> component_sums(const std::map<long, std::pair<double, long>> &mine) const;
   bool unknown(const NodeLabels &labels, int i, int j, int k, std::size_t n) const;
 
   LocalGrid &grid_;

@@ -15,10 +15,9 @@
 #include "mpm/options.h"
 #include "mpm/pressure_solver.h"
 #include "mpm/projection_ops.h"
+#include "mpm/projection_state.h"
 
 namespace mpm {
-
-struct ProjectionState;
 
 class Projection {
  public:
@@ -50,7 +49,7 @@ class Projection {
   // writes from them (the surface's gradient and extrapolation 1, deep_inside 2) and one more
   static constexpr int kWorkMargin = 4;
 
-  // The state of the last solve on this rank's owned nodes (ProjectionState, solver.h).
+  // The state of the last solve on this rank's owned nodes (ProjectionState, projection_state.h).
   void save(ProjectionState &s) const;
   // Takes the state of an earlier solve (s.box must hold every owned node; collective: fills
   // the halos); false (nothing changed) if it does not.
@@ -74,6 +73,10 @@ class Projection {
   // positions only, never their velocity or momentum); empty when there is no correction
   const std::vector<double> &volume_drift() const { return drift_; }
   int iterations() const { return last_.iterations; }
+  // FLUID nodes (all ranks) and sets of them that closed faces sealed off from the free surface
+  // in the last solve (PressureResult::sealed, sealed_sets)
+  long sealed_nodes() const { return last_.sealed; }
+  long sealed_sets() const { return last_.sealed_sets; }
   double residual() const { return last_.relative_residual; }
   // since construction, this rank: wall time in the pressure solver (hypre assembly, setup and
   // PCG), number of solves (with the acceleration pressure two per fluid step), PCG iterations

@@ -894,13 +894,20 @@ def run_cases(table, name, runner):
     return 1 if FAILURES else 0
 
 
+def exit_status():
+    """Prints the number of failed checks and returns the exit status of a driver (1 if any)."""
+    print(f"{len(FAILURES)} check(s) failed" if FAILURES else "all checks passed")
+    return 1 if FAILURES else 0
+
+
 def driver_main(namespace):
-    """main() of a case driver: CASE --exe --inputs --work [--mpirun]; runs namespace's case_CASE
-    and returns the exit status (1 if a check failed, 2 for an unknown case)."""
+    """main() of a case driver: CASE --exe [--inputs] --work [--mpirun]; runs namespace's case_CASE
+    (with the driver's class Runner if it defines one) and returns the exit status (1 if a check
+    failed, 2 for an unknown case)."""
     ap = argparse.ArgumentParser()
     ap.add_argument("case")
     ap.add_argument("--exe", required=True)
-    ap.add_argument("--inputs", required=True)
+    ap.add_argument("--inputs", default=None)
     ap.add_argument("--work", required=True)
     ap.add_argument("--mpirun", default="mpirun --allow-run-as-root --oversubscribe")
     a = ap.parse_args()
@@ -908,7 +915,7 @@ def driver_main(namespace):
     if fn is None:
         print("unknown case " + a.case)
         return 2
-    fn(Runner(a))
+    fn(namespace.get("Runner", Runner)(a))  # a driver's own Runner subclass, if it has one
     print(f"{a.case}: {len(FAILURES)} failed check(s)")
     return 1 if FAILURES else 0
 

@@ -184,7 +184,8 @@ def case_wave(r):
     f = sloshing.fit(os.path.join(d, "wave.csv"))
     print(f"  20 cells: w / w_exact {f['w_ratio']:.4f}, growth over {f['t_end']:.2f} s {f['amp_ratio_end']:.4f}, "
           f"initial amplitude / theory {f['b_ratio']:.4f}")
-    check(abs(f["w_ratio"] - 1) <= 0.04, "frequency within 4 % of the dispersion relation (target 2 %, not met at 20 cells)")
+    check(abs(f["w_ratio"] - 1) <= 0.035, "frequency within 3.5 % of the dispersion relation (target 2 %, not met at "
+          "20 cells: 0.970 measured)")
     check(abs(f["amp_ratio_end"] - 1) <= 0.05, "amplitude within 5 % over three periods")
     check(abs(f["b_ratio"] - 1) <= 0.05, "amplitude within 5 % of linear theory's for the initial velocity")
 
@@ -204,8 +205,9 @@ def case_slosh_volume(r):
     column half the tank long and twice the mean depth h released at the left wall sloshes for
     10 s, then grid damping brings it to rest; with a flat surface the points' centre of mass
     stands at half the depth, so 2 zc / h is the water's volume over its initial one (a bound from
-    the inputs alone: crowded points lower it, gaps raise it). Within 1 %; measured 1.009 (0.74
-    without the volume correction: the points compact)."""
+    the inputs alone: crowded points lower it, gaps raise it). Within 1 %; measured 1.0003, and
+    1.0037 / 0.9999 / 1.0033 with the sloshing stopped at 9.5 / 10.5 / 11 s (0.74 without the
+    volume correction: the points compact)."""
     d, _ = r.run("projection_slosh_volume/c20", os.path.join(r.inputs, "sloshing", "in.slosh"),
                  {"cells": 20, "tend": 10.0, "trest": 3.0})
     s = read_csv(os.path.join(d, "slosh.csv"))
@@ -362,14 +364,15 @@ def case_volume_correction(r):
         res[rate] = (exc[-1], area[-1])
         print(f"  F2 MPM16 apic, volume_correction {rate}, t = {t[-1]:.2f} s: overlapping share {exc[-1]:.4f}, volume on "
               f"the grid / held {area[-1]:.3f}, points per interior cell {ppc[-1]:.3f}; front {ef:.3f} a, height {eh:.3f} a")
-    # measured with the energy-stable surface: 0.0322 / 1.013 without, 0.0174 / 1.024 with (before it,
-    # 0.0506 / 0.966 and 0.0269 / 0.993). The uncorrected fluid now keeps its volume on the grid to
-    # 1.3 % over these 2 s and the correction overshoots it by 2.4 %: the correction's gap term is
-    # not yet consistent with the surface's new flux (docs/projection.md, "Volume drift"); until it
-    # is, the case guards 3 % (it was 2 %, nearer than without).
-    check(res[10][0] < 0.7 * res[0][0], "the overlapping share falls by at least 30 %")
-    check(abs(res[10][1] - 1) < 0.03 and abs(res[0][1] - 1) < 0.03,
-          "the fluid's volume on the grid within 3 % of the held one, with and without the correction")
+    # measured: 0.0309 / 1.009 without, 0.0268 / 1.001 with. The correction closes gaps from one
+    # node below an EMPTY node on (Projection::deep_inside), which keeps the volume of a coarse
+    # sloshing tank within 0.4 % (mpm_case.projection_slosh_volume) and pulls the points together
+    # there: the overlapping share falls by 13 % (by 34 % when gaps were closed from two nodes
+    # below, with the volume on the grid 1.5 % off), and the volume on the grid is nearer the held one.
+    check(res[10][0] < 0.9 * res[0][0], "the overlapping share falls by at least 10 %")
+    check(abs(res[10][1] - 1) < abs(res[0][1] - 1) and abs(res[10][1] - 1) < 0.005,
+          "the fluid's volume on the grid nearer the held one with the correction than without, and within 0.5 %")
+    check(abs(res[0][1] - 1) < 0.03, "the fluid's volume on the grid within 3 % of the held one without the correction")
 
 
 def case_drift_table(r):

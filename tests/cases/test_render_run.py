@@ -113,11 +113,8 @@ def main():
     rc, out = tool(os.path.join(TOOLS, "render_run.py"), d, "--out", png, "--zoom", "0", "1", "1", "0")
     check(rc != 0 and "--zoom expects H0 < H1 and V0 < V1" in out, "a reversed --zoom is refused")
     shutil.rmtree(old, ignore_errors=True)
-    if cases.FAILURES:
-        print(f"{len(cases.FAILURES)} check(s) failed")
-        sys.exit(1)
-    print("all checks passed")
+    return cases.exit_status()
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -19,7 +19,6 @@ The references come from the water's mass distribution alone (momentum balance a
     H = M / (rho W xp) (projection, within 1 %); eos within 2 % of the same (measured +1.01 %; the
     column's own compression would lower the exact value by about 0.3 %).
 """
-import argparse
 import math
 import os
 import subprocess
@@ -243,23 +242,5 @@ def case_bad_input(r):
         r.expect_error(f"bad_{case}", BASE + fix + words + "\nrun 1\n", ["ERROR", "Fix mpm/fluid"] + needles, case)
 
 
-CASES = {k[5:]: v for k, v in globals().items() if k.startswith("case_")}
-
-
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("case", choices=sorted(CASES))
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--inputs", default=None)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--mpirun", default="mpirun")
-    a = ap.parse_args()
-    CASES[a.case](Runner(a))
-    if cases.FAILURES:
-        print(f"{len(cases.FAILURES)} check(s) failed")
-        sys.exit(1)
-    print("all checks passed")
-
-
 if __name__ == "__main__":
-    main()
+    sys.exit(cases.driver_main(globals()))

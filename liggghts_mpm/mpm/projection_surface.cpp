@@ -1,0 +1,438 @@
+// The pressure projection's free surface and walls (docs/theory/projection.md): the node labels
+// from the node mass (the ghost surface's level), the mesh walls' closed faces and the nodes
+// behind them, the padding nodes behind the box walls, and the pressure and its gradient continued
+// above the surface for the points.
+#include "mpm/projection.h"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "mpm/error.h"
+#include "mpm/grid_fields.h"
+
+namespace mpm {
+
+namespace {
+// A node is EMPTY (p = 0) when it holds less than this fraction of the fluid mass of a full dual
+// cell. The B-spline spreads a point's mass 1.5 cells: with the mass threshold alone the surface
+// (p = 0) sits ~1.5 cells outside the fluid. Measured (docs/projection.md): F1 pressure error
+// 0.43 / 0.22 (threshold only), 0.22 / 0.11 (0.25), 0.009 / 0.007 (0.5) at 8 / 16 cells, but 0.5
+// leaves the column moving (0.07 m/s after 1 s) and the MPM16 dam-break front 0.39 a off; 0.25:
+// at rest to 1e-12 m/s, front 0.037 a (apic).
+constexpr double kSurfaceFill = 0.25;
+// Ghost surface: a node is FLUID when level_is_fluid(level) (projection_ops.h, kLevelTie). A fluid
+// filled up to a node plane gives its nodes a level of exactly 0 up to round-off; with 0 as the
+// bound they flipped between EMPTY and FLUID from step to step (F1 at rest: 2.6e-4 m/s after 1 s).
+
+// The signed distance (units of dx, positive inside) from a node to a plane free surface whose
+// fluid gives the node the fill f: the inverse of the fill F(s) = int_{-inf}^{s} N(x) dx of the
+// shape function N across the surface (uniform fluid up to the plane at s cells above the node;
+// docs/projection.md, "Free surface: energy and stiffness"). With fill - 1/2 as the level instead,
+// the ghost surface moved 1 / N(0) = 4/3 (quadratic B-spline) times as far as the water near a
+// node and the surface was too stiff: the standing wave ran fast.
+double surface_distance(double f, ShapeKind shape) {
+  if (shape == ShapeKind::Linear) {  // hat: F = (1 + s)^2 / 2 (s < 0), 1 - (1 - s)^2 / 2
+    if (f <= 0.0) return -1.0;
+    if (f >= 1.0) return 1.0;
+    return f < 0.5 ? std::sqrt(2.0 * f) - 1.0 : 1.0 - std::sqrt(2.0 * (1.0 - f));
+  }
+  // quadratic B-spline: F = (s + 3/2)^3 / 6 on [-3/2, -1/2], 1 - (3/2 - s)^3 / 6 on [1/2, 3/2],
+  // 1/2 + 3 s / 4 - s^3 / 3 between
+  if (f <= 0.0) return -1.5;
+  if (f >= 1.0) return 1.5;
+  if (f <= 1.0 / 6.0) return std::cbrt(6.0 * f) - 1.5;
+  if (f >= 5.0 / 6.0) return 1.5 - std::cbrt(6.0 * (1.0 - f));
+  double x = (f - 0.5) / 0.75;  // Newton on the middle branch (F' = 3/4 - s^2 >= 1/2 there)
+  for (int it = 0; it < 30; ++it) {
+    const double r = 0.5 + 0.75 * x - x * x * x / 3.0 - f;
+    x -= r / (0.75 - x * x);
+    if (std::fabs(r) < 1e-15) break;
+  }
+  return x;
+}
+}  // namespace
+
+
+/* FLUID where the node holds fluid (mass above the threshold and kSurfaceFill of a full cell),
+   EMPTY elsewhere (the free surface: p = 0), SOLID padding behind the box walls (NodeLabels::reset). The closed gate is a
+   wall at rest: the face between the last node on the fluid side and the next one (a gate through
+   a node plane leaves that node on the fluid side, like a box wall through its nodes). */
+void Projection::make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls) {
+  const bool sparse = grid_.restricted();
+  lab_.reset(grid_, sparse ? &work_ : nullptr);
+  mesh_ = walls != nullptr;
+  if (mesh_) mesh_wall_labels(*walls);
+  const double dx = opt_.grid.dx, full = opt_.rho0 * dx * dx * dx;
+  if (opt_.surface_ghost) {
+    // with a work box: outside it the level is never read (it enters only the faces of FLUID
+    // nodes) and fold_mass_ is 0 (retire)
+    zero_for_sweep(lab_.level);
+    zero_for_sweep(fold_mass_);
+    grid_.for_owned([&](int, int, int, std::size_t n) { fold_mass_[n] = p2g[P2gRec::N * n + P2gRec::M]; });
+    grid_.forward(fold_mass_.data(), 1);
+  }
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] == kSolid) return;
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    const double th = theta ? theta[n] : 1.0;
+    const double cut = mesh_ ? frac_[n] : 1.0;
+    const double fill = (opt_.surface_ghost ? folded_mass(i, j, k) : m) / (th * full * geo_.volume(i, j, k) * cut);
+    if (opt_.surface_ghost) {
+      // level set: the fill of a node whose dual cell the surface halves is 1/2 (a symmetric
+      // kernel), so fill - 1/2 changes sign at the surface; FLUID where it is positive
+      lab_.level[n] = surface_distance(fill, opt_.shape);
+      if (m <= mmin || m <= 0.0 || !level_is_fluid(lab_.level[n])) lab_.kind[n] = kEmpty;
+    } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
+      lab_.kind[n] = kEmpty;
+    }
+  });
+  if (opt_.surface_ghost) {
+    // the EMPTY nodes holding fluid: their velocity enters the surface faces' flux (surface_weight)
+    lab_.wet.assign(grid_.size(), 0);
+    grid_.for_owned([&](int, int, int, std::size_t n) {
+      const double m = p2g[P2gRec::N * n + P2gRec::M];
+      if (lab_.kind[n] == kEmpty && m > mmin && m > 0.0) lab_.wet[n] = 1;
+    });
+  }
+  const Gate &g = opt_.gate;
+  if (g.active) {
+    const GridSpec &gs = opt_.grid;
+    const double xi = (g.pos - gs.origin[g.dim]) / gs.dx;
+    const long r = std::lround(xi);
+    const bool on_plane = std::fabs(xi - r) < 1e-9;
+    // lower node of the closed face
+    const int lo = on_plane ? static_cast<int>(g.fluid_below ? r : r - 1) : static_cast<int>(std::floor(xi));
+    // the plane of those nodes in the patch
+    IndexBox plane = grid_.patch();
+    plane.lo[g.dim] = std::max(plane.lo[g.dim], lo);
+    plane.hi[g.dim] = std::min(plane.hi[g.dim], lo);
+    grid_.for_box(plane, [&](int i, int j, int k, std::size_t) { lab_.close_face(grid_, i, j, k, g.dim); });
+  }
+  lab_.exchange(grid_, comm_);
+}
+
+/* The node mass with the mass of its mirror images behind the box walls added (the padding nodes
+   the B-spline gives part of the wall-side points' mass): the mass a fluid continued by
+   reflection at the walls would give. Without it the nodes next to a wall read a fill 1-3 % low,
+   the ghost surface sits lower there and a column at rest starts to circulate (F1: 0.02 m/s after
+   1 s, docs/projection.md). Reads fold_mass_ on the owned nodes and halos. */
+double Projection::folded_mass(int i, int j, int k) const { return mirror_sum(fold_mass_, i, j, k); }
+
+/* a at node (i, j, k) plus a at its mirror images behind the box walls (reflected at each
+   non-periodic grid face, corners too), those of them that lie in the patch: the share a
+   B-spline gave to the padding nodes, counted at the node inside. a: owned values and halos. */
+double Projection::mirror_sum(const std::vector<double> &a, int i, int j, int k) const {
+  const GridSpec &gs = opt_.grid;
+  const int idx[3] = {i, j, k};
+  int img[3][3], cnt[3];  // per direction: the node's index and its mirror images in the padding
+  for (int d = 0; d < 3; ++d) {
+    img[d][0] = idx[d];
+    cnt[d] = 1;
+    if (gs.periodic[d]) continue;
+    if (idx[d] > 0 && -idx[d] >= gs.node_lo(d)) img[d][cnt[d]++] = -idx[d];
+    if (idx[d] < gs.ncell[d] && 2 * gs.ncell[d] - idx[d] <= gs.node_hi(d)) img[d][cnt[d]++] = 2 * gs.ncell[d] - idx[d];
+  }
+  double sum = 0.0;
+  for (int c = 0; c < cnt[2]; ++c)
+    for (int b = 0; b < cnt[1]; ++b)
+      for (int q = 0; q < cnt[0]; ++q)
+        if (grid_.in_patch(img[0][q], img[1][b], img[2][c])) sum += a[grid_.index(img[0][q], img[1][b], img[2][c])];
+  return sum;
+}
+
+/* Mesh walls (docs/projection.md, "Mesh walls"). A grid face whose segment between its two nodes
+   crosses a triangle is a wall moving with the triangle's velocity along the face normal (zero
+   relative flux, like the gate; a wall through a node leaves that node on the fluid side). The
+   nodes up to 2 cells behind a one-sided wall are SOLID: they take part in no solve (no spurious
+   p = 0 or pocket of fluid behind the wall) and get the values of the fluid nodes in front
+   (extend_behind). A node in front at distance s < dx/2 of the wall holds the fluid of only
+   part of its dual cell: its surface threshold uses the share 1/2 + s/dx (as the half cells of
+   the box walls). */
+void Projection::mesh_wall_labels(const WallGeometry &walls) {
+  const GridSpec &gs = opt_.grid;
+  const double dx = gs.dx;
+  frac_.assign(grid_.size(), 1.0);
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] == kSolid) return;
+    const double x[3] = {gs.origin[0] + i * dx, gs.origin[1] + j * dx, gs.origin[2] + k * dx};
+    // faces first: a face from a node behind the wall carries the wall's velocity too
+    for (int d = 0; d < 3; ++d) {
+      if (!gs.periodic[d] && (d == 0 ? i : d == 1 ? j : k) >= gs.ncell[d]) continue;
+      double w = 0.0;
+      if (walls.crosses(x, d, dx, &w)) lab_.close_face(grid_, i, j, k, d, w);
+    }
+    double dist;
+    const int side = walls.node_side(x, 2.0 * dx, &dist);
+    if (side < 0) lab_.kind[n] = kSolid;
+    if (side > 0) frac_[n] = std::min(1.0, 0.5 + dist / dx);
+  });
+}
+
+/* A node of the box (not a padding node) made SOLID by mesh_wall_labels. */
+bool Projection::behind_mesh(int i, int j, int k, std::size_t n) const {
+  if (!mesh_ || lab_.kind[n] != kSolid) return false;
+  const GridSpec &gs = opt_.grid;
+  const int idx[3] = {i, j, k};
+  for (int d = 0; d < 3; ++d)
+    if (!gs.periodic[d] && (idx[d] < 0 || idx[d] > gs.ncell[d])) return false;
+  return true;
+}
+
+/* Next to mesh walls a node can have no pressure information along a direction: an EMPTY node of
+   the surface layer whose neighbours along d are the wall and EMPTY nodes, or a FLUID node between
+   two closed faces. pressure_gradient gives it 0 there, and the node would fall freely along the
+   wall (measured: the surface corner on a wall inclined 30 degrees from the vertical slid down it
+   at 0.15 m/s). Such a component (nodes touching a mesh wall only) takes the mean of that component
+   at the face neighbours that have it. */
+void Projection::fill_wall_gradient(std::vector<double> &grad) {
+  const std::size_t sz = grid_.size();
+  std::vector<double> info(3 * sz, 0.0);
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] == kSolid) return;
+    for (int d = 0; d < 3; ++d)
+      for (int side = -1; side <= 1; side += 2) {
+        std::size_t m;
+        if (open_face(grid_, lab_, i, j, k, d, side, &m) && !(lab_.kind[n] == kEmpty && lab_.kind[m] == kEmpty))
+          info[3 * n + d] = 1.0;
+      }
+  });
+  grid_.forward(info.data(), 3);
+  const IndexBox &pb = grid_.patch();
+  std::vector<double> g = grad;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] == kSolid) return;
+    if (info[3 * n] != 0.0 && info[3 * n + 1] != 0.0 && info[3 * n + 2] != 0.0) return;
+    // touches a mesh wall: a closed face or a neighbour behind one
+    bool touch = lab_.closed[n] != 0;
+    std::size_t nb[6];
+    bool in[6];
+    for (int d = 0; d < 3; ++d)
+      for (int s = 0; s < 2; ++s) {
+        int q[3] = {i, j, k};
+        q[d] += s ? 1 : -1;
+        const int f = 2 * d + s;
+        in[f] = q[d] >= pb.lo[d] && q[d] <= pb.hi[d];
+        if (!in[f]) continue;
+        nb[f] = grid_.index(q[0], q[1], q[2]);
+        if (behind_mesh(q[0], q[1], q[2], nb[f]) || (!s && ((lab_.closed[nb[f]] >> d) & 1u))) touch = true;
+      }
+    if (!touch) return;
+    for (int d = 0; d < 3; ++d) {
+      if (info[3 * n + d] != 0.0) continue;
+      double sum = 0.0;
+      int cnt = 0;
+      for (int f = 0; f < 6; ++f) {
+        if (!in[f] || lab_.kind[nb[f]] == kSolid || info[3 * nb[f] + d] == 0.0) continue;
+        sum += grad[3 * nb[f] + d];
+        ++cnt;
+      }
+      if (cnt) g[3 * n + d] = sum / cnt;
+    }
+  });
+  grad.swap(g);
+  grid_.forward(grad.data(), 3);
+}
+
+void Projection::extend_behind(std::vector<double> &a, int stride, const double *p2g, double mmin,
+                               const std::vector<double> *grad) {
+  // sources: decided on the owned nodes (their node mass is complete), then forwarded
+  std::vector<double> have(grid_.size(), 0.0);
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    have[n] = lab_.kind[n] != kSolid ? 1.0 : 0.0;
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    if (!(m > mmin && m > 0.0)) have[n] = 0.0;
+  });
+  grid_.forward(have.data(), 1);
+  const IndexBox &pb = grid_.patch();
+  for (int pass = 0; pass < 3; ++pass) {
+    std::vector<double> next = have;
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+      if (have[n] != 0.0 || !behind_mesh(i, j, k, n)) return;
+      double sum[3] = {0.0, 0.0, 0.0};
+      int cnt = 0;
+      for (int d = 0; d < 3; ++d)
+        for (int side = -1; side <= 1; side += 2) {
+          int q[3] = {i, j, k};
+          q[d] += side;
+          if (q[d] < pb.lo[d] || q[d] > pb.hi[d]) continue;
+          const std::size_t m = grid_.index(q[0], q[1], q[2]);
+          if (have[m] == 0.0) continue;
+          // linear extrapolation with grad (x_n - x_m = -side dx e_d)
+          const double lin = grad ? -side * opt_.grid.dx * (*grad)[3 * m + d] : 0.0;
+          for (int e = 0; e < stride; ++e) sum[e] += a[stride * m + e] + lin;
+          ++cnt;
+        }
+      if (cnt == 0) return;
+      for (int e = 0; e < stride; ++e) a[stride * n + e] = sum[e] / cnt;
+      next[n] = 1.0;
+    });
+    have.swap(next);
+    grid_.forward(a.data(), stride);
+    grid_.forward(have.data(), 1);
+  }
+}
+
+/* The node of the box (indices clamped to 0..ncell in non-periodic dimensions) in front of a
+   padding node (itself if that node is outside the patch). */
+std::size_t Projection::wall_node(int i, int j, int k) const {
+  const GridSpec &gs = opt_.grid;
+  int q[3] = {i, j, k};
+  for (int d = 0; d < 3; ++d)
+    if (!gs.periodic[d]) q[d] = std::min(std::max(q[d], 0), gs.ncell[d]);
+  return grid_.in_patch(q[0], q[1], q[2]) ? grid_.index(q[0], q[1], q[2]) : grid_.index(i, j, k);
+}
+
+void Projection::mirror_to_padding(const std::vector<double> &a, std::vector<double> &out) const {
+  const GridSpec &gs = opt_.grid;
+  const IndexBox &pb = grid_.restricted() ? work_ : grid_.patch();
+  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
+    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
+        const std::size_t n = grid_.index(i, j, k);
+        if (lab_.kind[n] != kSolid) continue;
+        const int q[3] = {gs.mirror(i, 0), gs.mirror(j, 1), gs.mirror(k, 2)};
+        if (!grid_.in_patch(q[0], q[1], q[2])) continue;
+        const std::size_t m = grid_.index(q[0], q[1], q[2]);
+        if (lab_.kind[m] == kSolid) continue;
+        for (int e = 0; e < 3; ++e) out[3 * n + e] = a[3 * m + e];
+      }
+}
+
+void Projection::extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const {
+  // sparse sweeps: the work box only (outside it both hold 0, retire)
+  const bool sparse = grid_.restricted();
+  const IndexBox &pb = sparse ? work_ : grid_.patch();
+  if (sparse)
+    grid_.for_box(pb, [&](int, int, int, std::size_t n) {
+      for (int e = 0; e < stride; ++e) out[stride * n + e] = a[stride * n + e];
+    });
+  else
+    out = a;
+  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
+    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
+        const std::size_t n = grid_.index(i, j, k);
+        if (lab_.kind[n] != kSolid) continue;
+        const std::size_t c = wall_node(i, j, k);
+        for (int e = 0; e < stride; ++e) out[stride * n + e] = a[stride * c + e];
+      }
+}
+
+// The nodes of box a that are not in box b, as up to 6 boxes (slabs along z, then y, then x).
+
+/* Ghost-fluid surface: the EMPTY nodes that hold fluid mass (the B-spline spreads the points'
+   mass up to 1.5 cells beyond the surface) need a pressure gradient for their velocity and a
+   pressure for the points' interpolation. A node next to a FLUID one has the one-sided gradient of
+   the surface face (pressure_gradient); the next layer takes the mean gradient of its neighbours
+   that have one, layer by layer (two layers reach 1.5 cells). The pressure of such a node is the
+   linear continuation p_k + (x_n - x_k) . grad_n from those neighbours k (for the first layer the
+   ghost value p_k (1 - 1 / s_f)): a hydrostatic column then stays at rest and its points read the
+   hydrostatic pressure at their height, also in the top layer. The solve's EMPTY values (0) are
+   not changed: p holds the extrapolated values only after the solve. with_p false: the gradient
+   alone (the grains' gradient of the acceleration pressure, whose p the points read unextended). */
+void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::vector<double> &p,
+                                           std::vector<double> &grad, bool with_p) {
+  const double dx = opt_.grid.dx;
+  // per node: 1 if its gradient (gk) / pressure (pk) is known: FLUID nodes, and EMPTY nodes next
+  // to a FLUID one for the gradient (pressure_gradient's one-sided surface face)
+  std::vector<double> &gk = gk_, &pk = pk_;
+  zero_for_sweep(gk);
+  zero_for_sweep(pk);
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] == kFluid) {
+      gk[n] = pk[n] = 1.0;
+      return;
+    }
+    if (lab_.kind[n] != kEmpty) return;
+    for (int d = 0; d < 3; ++d)
+      for (int side = -1; side <= 1; side += 2) {
+        std::size_t m;
+        if (open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kFluid) gk[n] = 1.0;
+      }
+  });
+  // An EMPTY node next to the fluid has from pressure_gradient only the components along its faces
+  // to FLUID nodes: above a level surface the vertical one, and 0 along the surface, so the points
+  // near the surface read an unaccelerated velocity along it from the nodes above them and the
+  // standing wave ran slow (20 cells across: 0.962 of its frequency). The other components are
+  // the mean of the FLUID neighbours' (docs/theory/projection.md, "Free surface: the gradient
+  // along the surface").
+  {
+  std::vector<std::pair<std::size_t, int>> fill;
+  std::vector<double> val;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] != kEmpty || gk[n] == 0.0) return;
+    for (int d = 0; d < 3; ++d) {
+      bool along = false;
+      for (int side = -1; side <= 1; side += 2) {
+        std::size_t m;
+        if (open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kFluid) along = true;
+      }
+      if (along) continue;
+      double sum = 0.0;
+      int cnt = 0;
+      for (int e = 0; e < 3; ++e)
+        for (int side = -1; side <= 1; side += 2) {
+          std::size_t m;
+          if (open_face(grid_, lab_, i, j, k, e, side, &m) && lab_.kind[m] == kFluid) {
+            sum += grad[3 * m + d];
+            ++cnt;
+          }
+        }
+      if (cnt > 0) {
+        fill.emplace_back(n, d);
+        val.push_back(sum / cnt);
+      }
+    }
+  });
+  for (std::size_t q = 0; q < fill.size(); ++q) grad[3 * fill[q].first + fill[q].second] = val[q];
+  }
+  grid_.forward(gk.data(), 1);
+  grid_.forward(pk.data(), 1);
+  grid_.forward(grad.data(), 3);
+  // the nodes that become known in a pass are marked after it (the pass reads the flags before it)
+  std::vector<std::size_t> gnew, pnew;
+  for (int pass = 0; pass < 3; ++pass) {
+    gnew.clear();
+    pnew.clear();
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+      if (lab_.kind[n] != kEmpty) return;
+      const double m = p2g[P2gRec::N * n + P2gRec::M];
+      if (!(m > mmin && m > 0.0)) return;
+      double g[3] = {0, 0, 0}, psum = 0.0;
+      int ng = 0, np = 0;
+      for (int d = 0; d < 3; ++d)
+        for (int side = -1; side <= 1; side += 2) {
+          std::size_t q;
+          if (!open_face(grid_, lab_, i, j, k, d, side, &q)) continue;
+          if (gk[q] != 0.0) {
+            for (int e = 0; e < 3; ++e) g[e] += grad[3 * q + e];
+            ++ng;
+          }
+          // x_n - x_q = -side dx e_d
+          if (with_p && gk[n] != 0.0 && pk[q] != 0.0) {
+            psum += p[q] - side * dx * grad[3 * n + d];
+            ++np;
+          }
+        }
+      if (gk[n] == 0.0 && ng > 0) {
+        for (int e = 0; e < 3; ++e) grad[3 * n + e] = g[e] / ng;
+        gnew.push_back(n);
+      }
+      if (pk[n] == 0.0 && np > 0) {
+        p[n] = psum / np;
+        pnew.push_back(n);
+      }
+    });
+    for (const std::size_t n : gnew) gk[n] = 1.0;
+    for (const std::size_t n : pnew) pk[n] = 1.0;
+    grid_.forward(gk.data(), 1);
+    grid_.forward(pk.data(), 1);
+    grid_.forward(grad.data(), 3);
+    if (with_p) grid_.forward(p.data(), 1);
+  }
+}
+
+}  // namespace mpm
