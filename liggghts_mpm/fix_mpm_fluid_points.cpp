@@ -33,6 +33,7 @@
 #include "update.h"
 
 #include "mpm/error.h"
+#include "mesh_fill_host.h"
 #include "fix_mpm_fluid_guarded.h"
 
 using namespace LAMMPS_NS;
@@ -203,6 +204,21 @@ void FixMpmFluid::fill_points() {
     hi[d] = std::min(gs.ncell[d] - 1, static_cast<int>(std::floor((domain->subhi[d] - gs.origin[d]) / dx)) + 1);
   }
   check_fill_memory(region, lo, hi);
+  // fill ... inside/outside meshes: the lattice points at least half a point spacing from their
+  // triangles, inside the container and outside the others (mesh_fill_host.h)
+  const bool meshes = !o.fill_inside.empty() || !o.fill_outside.empty();
+  mpm::FillLattice lat;
+  std::vector<char> keep;
+  if (meshes) {
+    for (int d = 0; d < 3; ++d) {
+      lat.first[d] = gs.origin[d] + 0.5 * spacing[d];
+      lat.s[d] = spacing[d];
+      lat.lo[d] = lo[d] * o.fill_ppc[d];
+      lat.hi[d] = (hi[d] + 1) * o.fill_ppc[d] - 1;
+    }
+    const double gap = 0.5 * std::min(spacing[0], std::min(spacing[1], spacing[2]));
+    guarded([&] { keep = mpm::fill_mesh_mask(lmp, o, lat, gap); });
+  }
   double x[3];
   for (int k = lo[2]; k <= hi[2]; ++k)
     for (int j = lo[1]; j <= hi[1]; ++j)
@@ -213,6 +229,8 @@ void FixMpmFluid::fill_points() {
               const int cell[3] = {i, j, k}, sub[3] = {a, b, c};
               for (int d = 0; d < 3; ++d) x[d] = gs.origin[d] + cell[d] * dx + (sub[d] + 0.5) * spacing[d];
               if (!region->match(x[0], x[1], x[2])) continue;
+              if (meshes && !keep[lat.index(i * o.fill_ppc[0] + a, j * o.fill_ppc[1] + b, k * o.fill_ppc[2] + c)])
+                continue;
               bool mine = true;
               for (int d = 0; d < 3; ++d) mine = mine && x[d] >= domain->sublo[d] && x[d] < domain->subhi[d];
               if (!mine) continue;

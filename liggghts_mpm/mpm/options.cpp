@@ -219,6 +219,23 @@ void parse_fill(Options &o, Args &a, const ParseEnv &env) {
   if (!parse_int(a.at(6), o.fill_type) || o.fill_type < 1 || o.fill_type > env.ntypes)
     bad_arg("fill type", "an existing atom type", a.at(6));
   a.iarg += 7;
+  // optional: inside mesh-ID (once), outside mesh-ID (repeated); the meshes are checked at the fill
+  o.fill_inside.clear();
+  o.fill_outside.clear();
+  while (a.iarg < a.narg && (strcmp(a.at(0), "inside") == 0 || strcmp(a.at(0), "outside") == 0)) {
+    const bool in = strcmp(a.at(0), "inside") == 0;
+    const char *kw = in ? "fill inside" : "fill outside";
+    a.need(1, kw, "the ID of a closed fix mesh/surface");
+    const std::string id = a.at(1);
+    if (in && !o.fill_inside.empty()) bad_arg(kw, "one container mesh ('inside' given once)", a.at(1));
+    if (id == o.fill_inside || std::find(o.fill_outside.begin(), o.fill_outside.end(), id) != o.fill_outside.end())
+      bad_arg(kw, "a mesh not named before in this fill", a.at(1));
+    if (in)
+      o.fill_inside = id;
+    else
+      o.fill_outside.push_back(id);
+    a.iarg += 2;
+  }
 }
 
 void parse_hydrostatic(Options &o, Args &a, const ParseEnv &) {
@@ -544,8 +561,8 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_grain_pressure, false},
     {"pressure_average", "real", "time", ">= 0", "0", "a time constant (time) >= 0 of the averaged pressure f_ID[19]",
      REAL(pressure_average), 0.0, kInf, false, true, nullptr, nullptr, false},
-    {"fill", "region nx ny nz type T", "-", "1..8 points per cell per direction", "required (not after read_restart)",
-     "'region-ID nx ny nz type T'", nullptr, 0, 0, false, false, nullptr, parse_fill, false},
+    {"fill", "region nx ny nz type T [inside mesh-ID] [outside mesh-ID ...]", "-", "1..8 points per cell per direction",
+     "required (not after read_restart)", "'region-ID nx ny nz type T [inside mesh-ID] [outside mesh-ID ...]'", nullptr, 0, 0, false, false, nullptr, parse_fill, false},
     {"hydrostatic", "axis surface g", "length, acceleration", "g >= 0", "none",
      "'axis surface g' (initial pressure rho g (surface - coordinate))",
      nullptr, 0, 0, false, false, nullptr, parse_hydrostatic, false},

@@ -98,6 +98,8 @@ struct Options {
   std::string fill_region;
   int fill_ppc[3] = {2, 2, 2};
   int fill_type = 1;
+  std::string fill_inside;                // fill ... inside mesh-ID (mesh_fill.h)
+  std::vector<std::string> fill_outside;  // fill ... outside mesh-ID, one per 'outside'
   bool hydrostatic = false;
   int hydro_axis = 2;
   double hydro_surface = 0.0, hydro_g = 9.81;

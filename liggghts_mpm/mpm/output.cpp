@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mpm/cell_pressure.h"
 #include "mpm/error.h"
 #include "mpm/hdf5_series.h"
 #include "mpm/projection.h"
@@ -20,8 +21,12 @@ void FluidSolver::global_vector(double *out, int walls) {
   // (slowest rank), largest averaged nodal pressure (f_ID[19])
   double mx[8] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, time_fluid, time_couple, time_pressure_solver(),
                   proj_ ? proj_->largest_average_pressure() : -HUGE_VAL};
+  std::vector<long long> cell;  // the grid cell of each point and its pressure (f_ID[10])
+  std::vector<double> pcell;
   for (int i = 0; i < pts.nlocal; ++i) {
     if (!is_point(i)) continue;
+    cell.push_back(cell_key(gs, x[i]));
+    pcell.push_back(pts.state[i][C_P]);
     const double v2 = v[i][0] * v[i][0] + v[i][1] * v[i][1] + v[i][2] * v[i][2];
     sum[0] += rmass[i];
     sum[1] += 0.5 * rmass[i] * v2;
@@ -30,8 +35,10 @@ void FluidSolver::global_vector(double *out, int walls) {
     mx[1] = std::max(mx[1], x[i][opt.front_axis] + 0.5 * spacing[opt.front_axis]);
     if (std::fabs(x[i][opt.wall_axis] - opt.wall_pos) < gs.dx)
       mx[2] = std::max(mx[2], x[i][opt.height_axis] + 0.5 * spacing[opt.height_axis]);
-    mx[3] = std::max(mx[3], pts.state[i][C_P]);
   }
+  // f_ID[10]: the largest cell-mean point pressure (cell_pressure.h); the largest single point's is
+  // compute reduce max f_ID[3] of the input
+  mx[3] = largest_cell_mean(comm_, cell, pcell);
   double fg[3] = {0, 0, 0}, gfg[3];
   if (opt.coupled)
     for (int k = 0; k < pts.nlocal; ++k)

@@ -97,6 +97,27 @@ TEST(Options, ErrorsNameKeywordExpectationAndValue) {
   EXPECT_EQ(error_of(kBase + "viscosity 1e-3 couple grains theta_smooth 0"), "");
 }
 
+// fill ... inside mesh-ID [outside mesh-ID ...]: values, and refusals that name the keyword, what it
+// expects and the value (the meshes themselves are checked when the points are created)
+TEST(Options, FillInsideOutsideMeshes) {
+  const std::string fill = "cell 0.5 density 1000 fill col 2 2 2 type 1 ";
+  const mpm::Options o = parse(fill + "inside drum outside bar1 outside bar2 viscosity 1e-3");
+  EXPECT_EQ(o.fill_inside, "drum");
+  EXPECT_EQ(o.fill_outside, (std::vector<std::string>{"bar1", "bar2"}));
+  EXPECT_DOUBLE_EQ(o.viscosity, 1e-3);  // the next keyword ends the fill
+  EXPECT_EQ(parse(fill + "outside rock").fill_inside, "");
+  // a fill given again replaces the meshes too
+  EXPECT_EQ(parse(fill + "inside drum fill col 2 2 2 type 1").fill_inside, "");
+  EXPECT_EQ(error_of(fill + "inside"),
+            "Fix mpm/fluid: keyword 'fill inside' expects the ID of a closed fix mesh/surface, got nothing");
+  EXPECT_EQ(error_of(fill + "inside drum inside jar"),
+            "Fix mpm/fluid: keyword 'fill inside' expects one container mesh ('inside' given once), got 'jar'");
+  EXPECT_EQ(error_of(fill + "inside drum outside drum"),
+            "Fix mpm/fluid: keyword 'fill outside' expects a mesh not named before in this fill, got 'drum'");
+  EXPECT_EQ(error_of(fill + "outside bar outside bar"),
+            "Fix mpm/fluid: keyword 'fill outside' expects a mesh not named before in this fill, got 'bar'");
+}
+
 // probe, probe_window and mesh_wall's reference_point: values, and refusals that name the keyword,
 // what it expects and the value given
 TEST(Options, ProbesAndReferencePoint) {
