@@ -77,18 +77,26 @@ int WallGeometry::collect(const double x[3], double reach_fluid, double reach_be
   const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
   const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
   const double r2 = reach * reach, rf2 = reach_fluid * reach_fluid, rb2 = reach_behind * reach_behind;
-
-  // Candidates by a lower bound of their distance (plane, bounding box), nearest first. One wall direction is one
-  // constraint: of the hits of a mesh whose directions (face normal, or the direction from an
-  // edge/vertex) lie within 30 degrees of each other only the nearest is kept. A finely
-  // tessellated curved wall (a jar) thus constrains a node once, along its nearest facet, and not
-  // dozens of times along normals up to tens of degrees off (which would also take away the
-  // tangential velocity that a free-slip or partial wall keeps); distinct walls meeting at an
-  // edge or corner (a box) still act together. A candidate whose plane is farther than a kept
-  // hit of a similar direction cannot be nearer, so its closest point is not computed.
-  constexpr int kCand = 512, kMax = 16;
-  constexpr double kCos = 0.8660;  // 30 degrees
   std::pair<double, int> cl[kCand];
+  const int ncl = nearest_candidates(x, reach, cand, ncand, cl);
+  if (near) *near = ncl > 0 || !cand;
+  if (ncl == 0) return 0;
+  KeptHits kept;
+  keep_hits(x, reach, r2, cl, ncl, kept);
+  if (kept.nh == 0) return 0;
+  return constraints(kept, reach, reach_fluid, rf2, rb2, out);
+}
+
+// Candidates by a lower bound of their distance (plane, bounding box), nearest first. One wall direction is one
+// constraint: of the hits of a mesh whose directions (face normal, or the direction from an
+// edge/vertex) lie within 30 degrees of each other only the nearest is kept. A finely
+// tessellated curved wall (a jar) thus constrains a node once, along its nearest facet, and not
+// dozens of times along normals up to tens of degrees off (which would also take away the
+// tangential velocity that a free-slip or partial wall keeps); distinct walls meeting at an
+// edge or corner (a box) still act together. A candidate whose plane is farther than a kept
+// hit of a similar direction cannot be nearer, so its closest point is not computed.
+int WallGeometry::nearest_candidates(const double x[3], double reach, const std::vector<int> *cand, int ncand,
+                                     std::pair<double, int> *cl) const {
   int ncl = 0;
   for (int c = 0; c < ncand && ncl < kCand; ++c) {
     const int i = cand ? (*cand)[c] : c;
@@ -106,15 +114,19 @@ int WallGeometry::collect(const double x[3], double reach_fluid, double reach_be
     if (lb > reach) continue;
     cl[ncl++] = {lb, i};
   }
-  if (near) *near = ncl > 0 || !cand;
-  if (ncl == 0) return 0;
   std::sort(cl, cl + ncl);
-  int idx[kMax];
-  Hit hits[kMax];
-  double dd[kMax][3];   // x - closest point
-  double dir[kMax][3];  // direction of the hit (unsigned for faces)
-  bool back[kMax];      // behind the triangle's plane (one-sided meshes)
-  int nh = 0;
+  return ncl;
+}
+
+// collect's hits at x of the candidates cl (nearest first): one per wall direction of a mesh.
+void WallGeometry::keep_hits(const double x[3], double reach, double r2, const std::pair<double, int> *cl, int ncl,
+                             KeptHits &kept) const {
+  int *const idx = kept.idx;
+  Hit *const hits = kept.hits;
+  double(*const dd)[3] = kept.dd;
+  double(*const dir)[3] = kept.dir;
+  bool *const back = kept.back;
+  int &nh = kept.nh;
   for (int c = 0; c < ncl; ++c) {
     const int i = cl[c].second;
     const Tri &t = tris_[i];
@@ -167,8 +179,16 @@ int WallGeometry::collect(const double x[3], double reach_fluid, double reach_be
     idx[slot] = i;
     if (slot == nh) ++nh;
   }
-  if (nh == 0) return 0;
+}
 
+// collect's constraints from the kept hits (at most kMaxConstraints in out); returns their number.
+int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_fluid, double rf2, double rb2,
+                              WallConstraint *out) const {
+  const int *const idx = kept.idx;
+  const Hit *const hits = kept.hits;
+  const double(*const dd)[3] = kept.dd;
+  const bool *const back = kept.back;
+  const int nh = kept.nh;
   int nout = 0;
   for (size_t k = 0; k < walls_.size(); ++k) {
     // Face-region hits of a mesh take precedence over its edge/vertex hits, so that the internal
@@ -277,137 +297,152 @@ bool WallGeometry::push_back(double x[3], double v[3], double reach, const doubl
   // (a) crossings of the segment x_old -> x
   if (x_old) {
     for (int iter = 0; iter < 4; ++iter) {
-      double seg[3];
-      sub3(x, x_old, seg);
-      const double len = std::sqrt(dot3(seg, seg));
-      if (len == 0.0) break;
-      const std::vector<int> *cand = (len <= margin_) ? candidates(x) : nullptr;
-      const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
-      double best = 2.0, bq[3] = {0, 0, 0}, bn[3] = {0, 0, 0}, bb[3] = {0, 0, 0};
-      int bi = -1;
-      for (int c = 0; c < ncand; ++c) {
-        const int i = cand ? (*cand)[c] : c;
-        const Tri &t = tris_[i];
-        bool out = false;
-        for (int d = 0; d < 3 && !out; ++d)
-          out = std::max(x[d], x_old[d]) < t.lo[d] || std::min(x[d], x_old[d]) > t.hi[d];
-        if (out) continue;
-        double a0[3], a1[3];
-        sub3(x_old, t.p[0], a0);
-        sub3(x, t.p[0], a1);
-        const double sa = dot3(a0, t.n), sb = dot3(a1, t.n);
-        const int side = walls_[t.mesh].side;
-        double sg;
-        if (side == SIDE_NORMAL) sg = 1.0;
-        else if (side == SIDE_OPPOSITE) sg = -1.0;
-        else if (sa != 0.0) sg = sa > 0.0 ? 1.0 : -1.0;
-        else sg = sb >= 0.0 ? 1.0 : -1.0;  // two-sided, starting on the plane: leaving it is fine
-        // only a move from the fluid side (or the plane) to the other side counts
-        if (!(sg * sa >= 0.0 && sg * sb < 0.0)) continue;
-        const double f = sa / (sa - sb);
-        if (f >= best) continue;
-        double q[3];
-        for (int d = 0; d < 3; ++d) q[d] = x_old[d] + f * seg[d];
-        Hit h;
-        closest_point(t, q, h);
-        const double tol = 1e-10 * (len + std::sqrt(dot3(a0, a0)));
-        if (h.dist2 > tol * tol) continue;  // q lies outside the triangle
-        best = f;
-        bi = i;
-        for (int d = 0; d < 3; ++d) {
-          bq[d] = q[d];
-          bn[d] = sg * t.n[d];
-          bb[d] = h.b[d];
-        }
-      }
-      if (bi < 0) break;
-      double w[3];
-      wall_velocity(tris_[bi], bb, w);
-      // back to the fluid side, 'off' from the plane
-      for (int d = 0; d < 3; ++d) x[d] = bq[d] + off * bn[d];
-      double r[3];
-      sub3(v, w, r);
-      const double rn = dot3(r, bn);
-      for (int d = 0; d < 3; ++d) v[d] -= rn * bn[d];
+      if (!push_across(x, v, x_old, off)) break;
       moved = true;
     }
   }
 
-  // (b) one-sided meshes: a point behind the mesh, less than 'reach' deep. Behind = behind the
-  // planes of all the triangles whose closest point is the nearest one (one triangle in its face
-  // region, or the triangles sharing the nearest edge or vertex); the point goes to the nearest
-  // point of the mesh plus 'off' towards the fluid.
+  // (b) one-sided meshes: a point behind the mesh (push_from_behind)
   for (int iter = 0; iter < 4; ++iter) {
-    const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
-    const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
-    const double r2 = reach * reach;
-    // Behind the nearest triangles means behind (or on) their planes, and x - q . n is the plane
-    // distance for any point q of a triangle: if x is in front of the plane of every one-sided
-    // triangle within reach (inside a closed convex mesh: always), nothing is to be done.
-    bool any_behind = false;
-    for (int c = 0; c < ncand && !any_behind; ++c) {
-      const Tri &t = tris_[cand ? (*cand)[c] : c];
-      const int side = walls_[t.mesh].side;
-      if (side != SIDE_NORMAL && side != SIDE_OPPOSITE) continue;
-      double a[3];
-      sub3(x, t.p[0], a);
-      const double pd = side * dot3(a, t.n);
-      any_behind = pd < 1e-12 * reach && pd > -reach;
-    }
-    if (!any_behind) break;
-    constexpr int kMax = 64;
-    int idx[kMax];
-    Hit hits[kMax];
-    int nh = 0;
-    double dmin = r2;
-    for (int c = 0; c < ncand && nh < kMax; ++c) {
-      const int i = cand ? (*cand)[c] : c;
-      const Tri &t = tris_[i];
-      const int side = walls_[t.mesh].side;
-      if (side != SIDE_NORMAL && side != SIDE_OPPOSITE) continue;
-      if (beyond_box(t, x, reach)) continue;
-      double a[3];
-      sub3(x, t.p[0], a);
-      const double pd = dot3(a, t.n);
-      if (pd * pd > dmin + 1e-12 * r2) continue;  // its plane is farther than the nearest hit
-      closest_point(t, x, hits[nh]);
-      if (hits[nh].dist2 >= r2) continue;
-      dmin = std::min(dmin, hits[nh].dist2);
-      idx[nh++] = i;
-    }
-    if (nh == 0) break;
-    const double tie = dmin + 1e-12 * r2;
-    bool behind = true;
-    int first = -1;
-    for (int h = 0; h < nh && behind; ++h) {
-      if (hits[h].dist2 > tie) continue;
-      const Tri &t = tris_[idx[h]];
-      double d[3];
-      sub3(x, hits[h].p, d);
-      if (walls_[t.mesh].side * dot3(d, t.n) >= 0.0) behind = false;
-      if (first < 0) first = h;
-    }
-    if (!behind || first < 0) break;
-    const Tri &t = tris_[idx[first]];
-    const Hit &bh = hits[first];
-    double d[3], bn[3];
-    sub3(x, bh.p, d);
-    const double dl = std::sqrt(bh.dist2);
-    if (bh.face || dl <= 1e-12 * reach) {
-      for (int q = 0; q < 3; ++q) bn[q] = walls_[t.mesh].side * t.n[q];
-    } else {
-      for (int q = 0; q < 3; ++q) bn[q] = -d[q] / dl;
-    }
-    double w[3];
-    wall_velocity(t, bh.b, w);
-    for (int q = 0; q < 3; ++q) x[q] = bh.p[q] + off * bn[q];
-    double r[3];
-    sub3(v, w, r);
-    const double rn = dot3(r, bn);
-    for (int q = 0; q < 3; ++q) v[q] -= rn * bn[q];
+    if (!push_from_behind(x, v, reach, off)) break;
     moved = true;
   }
   return moved;
+}
+
+// push_back (a), one crossing: the first crossing of the segment x_old -> x from the fluid side
+// of a triangle; x goes back to the fluid side, 'off' from the plane, and v loses its normal
+// velocity relative to the wall. Returns false if there is none.
+bool WallGeometry::push_across(double x[3], double v[3], const double *x_old, double off) const {
+  double seg[3];
+  sub3(x, x_old, seg);
+  const double len = std::sqrt(dot3(seg, seg));
+  if (len == 0.0) return false;
+  const std::vector<int> *cand = (len <= margin_) ? candidates(x) : nullptr;
+  const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+  double best = 2.0, bq[3] = {0, 0, 0}, bn[3] = {0, 0, 0}, bb[3] = {0, 0, 0};
+  int bi = -1;
+  for (int c = 0; c < ncand; ++c) {
+    const int i = cand ? (*cand)[c] : c;
+    const Tri &t = tris_[i];
+    bool out = false;
+    for (int d = 0; d < 3 && !out; ++d)
+      out = std::max(x[d], x_old[d]) < t.lo[d] || std::min(x[d], x_old[d]) > t.hi[d];
+    if (out) continue;
+    double a0[3], a1[3];
+    sub3(x_old, t.p[0], a0);
+    sub3(x, t.p[0], a1);
+    const double sa = dot3(a0, t.n), sb = dot3(a1, t.n);
+    const int side = walls_[t.mesh].side;
+    double sg;
+    if (side == SIDE_NORMAL) sg = 1.0;
+    else if (side == SIDE_OPPOSITE) sg = -1.0;
+    else if (sa != 0.0) sg = sa > 0.0 ? 1.0 : -1.0;
+    else sg = sb >= 0.0 ? 1.0 : -1.0;  // two-sided, starting on the plane: leaving it is fine
+    // only a move from the fluid side (or the plane) to the other side counts
+    if (!(sg * sa >= 0.0 && sg * sb < 0.0)) continue;
+    const double f = sa / (sa - sb);
+    if (f >= best) continue;
+    double q[3];
+    for (int d = 0; d < 3; ++d) q[d] = x_old[d] + f * seg[d];
+    Hit h;
+    closest_point(t, q, h);
+    const double tol = 1e-10 * (len + std::sqrt(dot3(a0, a0)));
+    if (h.dist2 > tol * tol) continue;  // q lies outside the triangle
+    best = f;
+    bi = i;
+    for (int d = 0; d < 3; ++d) {
+      bq[d] = q[d];
+      bn[d] = sg * t.n[d];
+      bb[d] = h.b[d];
+    }
+  }
+  if (bi < 0) return false;
+  double w[3];
+  wall_velocity(tris_[bi], bb, w);
+  // back to the fluid side, 'off' from the plane
+  for (int d = 0; d < 3; ++d) x[d] = bq[d] + off * bn[d];
+  double r[3];
+  sub3(v, w, r);
+  const double rn = dot3(r, bn);
+  for (int d = 0; d < 3; ++d) v[d] -= rn * bn[d];
+  return true;
+}
+
+// push_back (b), one step, for one-sided meshes: a point behind the mesh, less than 'reach' deep.
+// Behind = behind the planes of all the triangles whose closest point is the nearest one (one
+// triangle in its face region, or the triangles sharing the nearest edge or vertex); the point
+// goes to the nearest point of the mesh plus 'off' towards the fluid. Returns false if x is not
+// behind such a mesh.
+bool WallGeometry::push_from_behind(double x[3], double v[3], double reach, double off) const {
+  const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
+  const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+  const double r2 = reach * reach;
+  // Behind the nearest triangles means behind (or on) their planes, and x - q . n is the plane
+  // distance for any point q of a triangle: if x is in front of the plane of every one-sided
+  // triangle within reach (inside a closed convex mesh: always), nothing is to be done.
+  bool any_behind = false;
+  for (int c = 0; c < ncand && !any_behind; ++c) {
+    const Tri &t = tris_[cand ? (*cand)[c] : c];
+    const int side = walls_[t.mesh].side;
+    if (side != SIDE_NORMAL && side != SIDE_OPPOSITE) continue;
+    double a[3];
+    sub3(x, t.p[0], a);
+    const double pd = side * dot3(a, t.n);
+    any_behind = pd < 1e-12 * reach && pd > -reach;
+  }
+  if (!any_behind) return false;
+  constexpr int kMax = 64;
+  int idx[kMax];
+  Hit hits[kMax];
+  int nh = 0;
+  double dmin = r2;
+  for (int c = 0; c < ncand && nh < kMax; ++c) {
+    const int i = cand ? (*cand)[c] : c;
+    const Tri &t = tris_[i];
+    const int side = walls_[t.mesh].side;
+    if (side != SIDE_NORMAL && side != SIDE_OPPOSITE) continue;
+    if (beyond_box(t, x, reach)) continue;
+    double a[3];
+    sub3(x, t.p[0], a);
+    const double pd = dot3(a, t.n);
+    if (pd * pd > dmin + 1e-12 * r2) continue;  // its plane is farther than the nearest hit
+    closest_point(t, x, hits[nh]);
+    if (hits[nh].dist2 >= r2) continue;
+    dmin = std::min(dmin, hits[nh].dist2);
+    idx[nh++] = i;
+  }
+  if (nh == 0) return false;
+  const double tie = dmin + 1e-12 * r2;
+  bool behind = true;
+  int first = -1;
+  for (int h = 0; h < nh && behind; ++h) {
+    if (hits[h].dist2 > tie) continue;
+    const Tri &t = tris_[idx[h]];
+    double d[3];
+    sub3(x, hits[h].p, d);
+    if (walls_[t.mesh].side * dot3(d, t.n) >= 0.0) behind = false;
+    if (first < 0) first = h;
+  }
+  if (!behind || first < 0) return false;
+  const Tri &t = tris_[idx[first]];
+  const Hit &bh = hits[first];
+  double d[3], bn[3];
+  sub3(x, bh.p, d);
+  const double dl = std::sqrt(bh.dist2);
+  if (bh.face || dl <= 1e-12 * reach) {
+    for (int q = 0; q < 3; ++q) bn[q] = walls_[t.mesh].side * t.n[q];
+  } else {
+    for (int q = 0; q < 3; ++q) bn[q] = -d[q] / dl;
+  }
+  double w[3];
+  wall_velocity(t, bh.b, w);
+  for (int q = 0; q < 3; ++q) x[q] = bh.p[q] + off * bn[q];
+  double r[3];
+  sub3(v, w, r);
+  const double rn = dot3(r, bn);
+  for (int q = 0; q < 3; ++q) v[q] -= rn * bn[q];
+  return true;
 }
 
 }  // namespace mpm
