@@ -223,6 +223,8 @@ class FluidSolver {
   double solid_node_volume(int i, int j, int k) const;
   void init_theta();
   double stable_dt();
+  void coupled_limits(const double *glob);  // stable_dt: the pore-pressure wave limits
+  std::string projection_limit(double dt, double dt_sub, const char *what, bool at_setup);  // check_timestep
   bool is_point(int i) const { return (pts.mask[i] & pts.point_bit) != 0; }
   bool is_grain(int i) const { return opt.coupled && (pts.mask[i] & pts.grain_bit) != 0; }
   double mass_min() const { return opt.mass_threshold * state.point_mass_ref; }
