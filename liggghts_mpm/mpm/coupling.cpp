@@ -112,21 +112,11 @@ void FluidSolver::couple_fluid_grains(double h) {
   with_stencil(opt.shape, [&](auto ns) { couple_kernel<decltype(ns)::value>(h); });
 }
 
+// couple_kernel's first step: the pressure the grains feel, at the nodes (projection: the last
+// solve's gradient; grad_p weak: the fluid's own weak gradient; else the points' pressure moments
+// for the nodal fit).
 template <int NS>
-void FluidSolver::couple_kernel(double h) {
-  const int nlocal = pts.nlocal;
-  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  const double *const gst = g_.st.data();
-  double *const gdr = g_.dr.data();
-  double **v = pts.v;
-  const double *radius = pts.radius, *rmass = pts.rmass;
-  const int nsub = state.nsub;
-  if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
-
-  // projection: the grains feel the nodal gradient of the last solve (the one the fluid felt),
-  // and the fluid gets no pressure reaction (its share -theta grad p is in the projection)
-  const bool proj = opt.projection;
-  const bool weak = opt.grad_p == GradP::Weak || proj;
+void FluidSolver::grain_pressure_inputs(bool proj, bool weak) {
   if (!proj && weak) point_sums<NS>();
   if (proj) {
     projection_gradient_to_grains();
@@ -136,7 +126,7 @@ void FluidSolver::couple_kernel(double h) {
   } else {
     // pressure at the nodes for the force on the grains (fit_linear_pressure); reaction points:
     // the points' volume at the nodes (rq[3 n], folded) in the same pass over the points. pfit is
-    // 0 here (see the end of this function)
+    // 0 here (see the end of couple_kernel)
     if (opt.reaction_points) {
       std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
       pressure_moments<NS, true>();
@@ -147,24 +137,14 @@ void FluidSolver::couple_kernel(double h) {
     }
     grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
   }
+}
 
-  // the box of the grains' stencils (fluid_fraction found them for this sub-step)
-  const IndexBox gbox = stencil_box(grain_base_lo_, grain_base_hi_, NS, grid_.patch());
-  const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
-  // What the grains read (st) is read only at their stencils, here and, through the forward, at
-  // the owned nodes of the exchanged boxes, and by the drag exchange below in the same box: st is
-  // set only at the owned nodes of the bounding box of those (the rest keeps stale values nobody
-  // reads). dr is 0 outside that box after the reverse sum.
-  const IndexBox dbox = bounding_box(gbox, xboxes);
-  IndexBox sbox = grid_.owned().cut(dbox);
-  if (grid_.restricted()) sbox = sbox.cut(grid_.work());
-  // pfit is 0 outside the points' stencils and the exchanged boxes (with grad_p weak and the
-  // projection everywhere): there the node reads a record of zeros, not the array
-  const IndexBox pbox = stencil_box(base_lo_, base_hi_, NS, grid_.patch());
-  const IndexBox rbox = !proj && !weak ? bounding_box(pbox, xboxes) : IndexBox();
+// couple_kernel: what the grains read at the owned nodes of sbox (StRec: fluid fraction,
+// pressure, fitted gradient, mass, velocity); rbox: the nodes whose pfit record is summed.
+void FluidSolver::grain_node_state(const IndexBox &sbox, const IndexBox &rbox, bool weak) {
   static const double kZeroPfit[PfitRec::N] = {};
   const double mmin = mass_min();
-  if (!sbox.empty()) grid_.for_box(sbox, [&](int i, int j, int k, std::size_t n) {
+  grid_.for_box(sbox, [&](int i, int j, int k, std::size_t n) {
     const double *c = rbox.contains(i, j, k) ? &g_.pfit[PfitRec::N * n] : kZeroPfit;
     const double *g = &g_.p2g[P2gRec::N * n];
     double *st = &g_.st[StRec::N * n];
@@ -183,7 +163,7 @@ void FluidSolver::couple_kernel(double h) {
       st[StRec::U + 3] = 1.0;
     }
   });
-  grid_.forward(g_.st.data(), StRec::N);
+}
 
   // Drag, exchanged node by node. Each grain k has the coefficient K_k (frozen over the sub-step)
   // and touches node j with weight S_jk. At every node the fluid (mass M_j, velocity u_j) and the
@@ -194,9 +174,18 @@ void FluidSolver::couple_kernel(double h) {
   // keeps the right terminal slip (see mpm::drag_implicit_impulse). Grain k receives the share
   // S_jk K_k / K_j of J_j. The pressure-gradient force (7-15) is explicit (not stiff); its
   // reaction goes to the nodes too.
+// couple_kernel, per grain: Kgrain[k], the pressure force (grain_force_) and the grain's shares
+// of K, K v, mass, pressure reaction and K a at the nodes of its stencil (dr).
+template <int NS>
+void FluidSolver::grain_drag_sums(std::vector<double> &Kgrain, bool proj, bool weak) {
+  const int nlocal = pts.nlocal;
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const double *const gst = g_.st.data();
+  double *const gdr = g_.dr.data();
+  double **v = pts.v;
+  const double *radius = pts.radius, *rmass = pts.rmass;
+  const int nsub = state.nsub;
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
-  std::vector<double> Kgrain(static_cast<std::size_t>(nlocal), 0.0);
-  // dr is 0 here (see the end of this function)
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
     const Stencil &ps = grain_shapes_[k];
@@ -259,19 +248,12 @@ void FluidSolver::couple_kernel(double h) {
       row4(q + DrRec::KA) += w * r2;
     });
   }
-  // the grains wrote dr in gbox only (0 elsewhere until the reverse sum)
-  if (opt.reaction_points && !proj) {
-    // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
-    std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
-    if (!gbox.empty())
-      grid_.for_box(gbox, [&](int, int, int, std::size_t n) {
-        for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
-      });
-    fold_to_mirror(g_.rp, 3);
-    grid_.reverse_sum(g_.rp.data(), 3);
-  }
-  grid_.reverse_sum(g_.dr.data(), DrRec::N);
+}
 
+// couple_kernel: the drag impulse of each owned node inside dbox over h (drag_implicit_impulse),
+// the force on the fluid (rx) and the impulse per unit K for the grains (dr).
+void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
+  const double mmin = mass_min();
   // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned
   // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -298,8 +280,16 @@ void FluidSolver::couple_kernel(double h) {
       q[DrRec::J + d] = q[DrRec::K] > 0.0 ? J[d] / q[DrRec::K] : 0.0;  // impulse per unit K, to the grains
     }
   });
-  if (opt.reaction_points && !proj) route_reaction<NS>();
-  grid_.forward(g_.dr.data(), DrRec::N);
+}
+
+// couple_kernel's last step: each grain's share of its nodes' drag impulses, as a force averaged
+// over the sub-steps (grain_force_).
+template <int NS>
+void FluidSolver::grain_drag_forces(const std::vector<double> &Kgrain, double h) {
+  const int nlocal = pts.nlocal;
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const double *const gdr = g_.dr.data();
+  const int nsub = state.nsub;
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
     const Stencil &ps = grain_shapes_[k];
@@ -310,6 +300,58 @@ void FluidSolver::couple_kernel(double h) {
     for (int d = 0; d < 3; ++d)
       grain_force_[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
   }
+}
+
+template <int NS>
+void FluidSolver::couple_kernel(double h) {
+  const int nlocal = pts.nlocal;
+  double *const gdr = g_.dr.data();
+  if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
+
+  // projection: the grains feel the nodal gradient of the last solve (the one the fluid felt),
+  // and the fluid gets no pressure reaction (its share -theta grad p is in the projection)
+  const bool proj = opt.projection;
+  const bool weak = opt.grad_p == GradP::Weak || proj;
+  grain_pressure_inputs<NS>(proj, weak);
+
+  // the box of the grains' stencils (fluid_fraction found them for this sub-step)
+  const IndexBox gbox = stencil_box(grain_base_lo_, grain_base_hi_, NS, grid_.patch());
+  const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
+  // What the grains read (st) is read only at their stencils, here and, through the forward, at
+  // the owned nodes of the exchanged boxes, and by the drag exchange below in the same box: st is
+  // set only at the owned nodes of the bounding box of those (the rest keeps stale values nobody
+  // reads). dr is 0 outside that box after the reverse sum.
+  const IndexBox dbox = bounding_box(gbox, xboxes);
+  IndexBox sbox = grid_.owned().cut(dbox);
+  if (grid_.restricted()) sbox = sbox.cut(grid_.work());
+  // pfit is 0 outside the points' stencils and the exchanged boxes (with grad_p weak and the
+  // projection everywhere): there the node reads a record of zeros, not the array
+  const IndexBox pbox = stencil_box(base_lo_, base_hi_, NS, grid_.patch());
+  const IndexBox rbox = !proj && !weak ? bounding_box(pbox, xboxes) : IndexBox();
+  if (!sbox.empty()) grain_node_state(sbox, rbox, weak);
+  grid_.forward(g_.st.data(), StRec::N);
+
+  // the drag coefficients, pressure forces and the grains' shares at the nodes (dr is 0 here: see
+  // the end of this function)
+  std::vector<double> Kgrain(static_cast<std::size_t>(nlocal), 0.0);
+  grain_drag_sums<NS>(Kgrain, proj, weak);
+  // the grains wrote dr in gbox only (0 elsewhere until the reverse sum)
+  if (opt.reaction_points && !proj) {
+    // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
+    std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
+    if (!gbox.empty())
+      grid_.for_box(gbox, [&](int, int, int, std::size_t n) {
+        for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
+      });
+    fold_to_mirror(g_.rp, 3);
+    grid_.reverse_sum(g_.rp.data(), 3);
+  }
+  grid_.reverse_sum(g_.dr.data(), DrRec::N);
+
+  drag_exchange(dbox, h);
+  if (opt.reaction_points && !proj) route_reaction<NS>();
+  grid_.forward(g_.dr.data(), DrRec::N);
+  grain_drag_forces<NS>(Kgrain, h);
   // pfit and dr are 0 at the next call (they are allocated 0 and no other code writes them): only
   // the nodes written are cleared, the stencils of the points (pfit) and of the grains (dr) and
   // the halo and owner boxes of the exchanges; the drag exchange above wrote +0 to dr at the

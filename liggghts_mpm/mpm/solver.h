@@ -182,6 +182,12 @@ class FluidSolver {
   template <int NS> void musl_gradient();
   template <int NS, bool VOL> void pressure_moments();  // VOL: also the points' volume (rq)
   template <int NS> void couple_kernel(double h);
+  // couple_kernel's steps (coupling.cpp)
+  template <int NS> void grain_pressure_inputs(bool proj, bool weak);
+  void grain_node_state(const IndexBox &sbox, const IndexBox &rbox, bool weak);
+  template <int NS> void grain_drag_sums(std::vector<double> &Kgrain, bool proj, bool weak);
+  void drag_exchange(const IndexBox &dbox, double h);
+  template <int NS> void grain_drag_forces(const std::vector<double> &Kgrain, double h);
   template <int NS> void point_sums();             // grad_p weak: WkRec (reaction points: rq)
   void weak_pressure_gradient();                   // grad_p weak
   void weak_face_copy();                           // grad_p weak: face and padding nodes
@@ -223,6 +229,8 @@ class FluidSolver {
   double solid_node_volume(int i, int j, int k) const;
   void init_theta();
   double stable_dt();
+  void coupled_limits(const double *glob);  // stable_dt: the pore-pressure wave limits
+  std::string projection_limit(double dt, double dt_sub, const char *what, bool at_setup);  // check_timestep
   void coupled_limits(const double *glob);  // stable_dt: the pore-pressure wave limits
   std::string projection_limit(double dt, double dt_sub, const char *what, bool at_setup);  // check_timestep
   bool is_point(int i) const { return (pts.mask[i] & pts.point_bit) != 0; }
