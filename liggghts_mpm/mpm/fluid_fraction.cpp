@@ -210,6 +210,42 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
   const int passes = smoothing_passes(opt.theta_smooth, gs.dx);
   if (passes <= 0) return;
   const std::size_t N = grid_.size();
+  const std::vector<double> &vol = node_volumes();
+  // phi and phi_new take turns (each pass writes the other and they swap): both are 0 outside the
+  // box of the pass, which only grows, so the nodes a pass does not write hold the same in both
+  std::vector<double> &phi = g_.phi, &phi_new = g_.phi_new;
+  phi.assign(stride * N, 0.0);
+  phi_new.assign(stride * N, 0.0);
+  IndexBox nzb;  // the nodes with a nonzero fraction, grown by the passes
+  smoothing_start(a, stride, nzb);
+  int *const lo = nzb.lo, *const hi = nzb.hi;
+  const bool any = !nzb.empty();
+  grid_.forward(phi.data(), stride);
+  const IndexBox &ob = grid_.owned();
+  const double *const V = vol.data();
+  IndexBox b = ob.cut(nzb);  // owned nodes inside the box
+  for (int pass = 0; pass < passes && any; ++pass)
+    for (int d = 0; d < 3; ++d) {
+      if (!gs.periodic[d] && gs.ncell[d] < 2) continue;
+      if (!gs.periodic[d]) {
+        --lo[d];
+        ++hi[d];
+      }
+      b = ob.cut(nzb);
+      smoothing_sweep(d, stride, b, V);
+      phi.swap(phi_new);
+      grid_.forward(phi.data(), stride);
+    }
+  if (!any) return;  // a is +-0 at every owned node with a volume, 0 on the others: as phi V
+  // outside the last box phi is 0 and a was +-0 (or set 0 above): only the box is written back
+  grid_.for_box(b, [&](int, int, int, std::size_t n) {
+    for (int c = 0; c < stride; ++c) a[stride * n + c] = phi[stride * n + c] * V[n];
+  });
+}
+
+// smooth_node_volume: the node volumes of the patch (solid_node_volume), computed once.
+const std::vector<double> &FluidSolver::node_volumes() {
+  const std::size_t N = grid_.size();
   // the node volumes of the patch (owned, forwarded to the halo; 0 on padding nodes) do not change
   // with the grid's patch: computed once after setup_grid
   std::vector<double> &vol = g_.vnode;
@@ -219,11 +255,15 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
     grid_.for_owned([&](int i, int j, int k, std::size_t n) { vol[n] = solid_node_volume(i, j, k); });
     grid_.forward(vol.data(), 1);
   }
-  // phi and phi_new take turns (each pass writes the other and they swap): both are 0 outside the
-  // box of the pass, which only grows, so the nodes a pass does not write hold the same in both
-  std::vector<double> &phi = g_.phi, &phi_new = g_.phi_new;
-  phi.assign(stride * N, 0.0);
-  phi_new.assign(stride * N, 0.0);
+  return vol;
+}
+
+// smooth_node_volume's start: phi = a / V at the owned nodes (a set 0 on owned padding nodes) and
+// nzb, the box of the nodes with a nonzero fraction.
+void FluidSolver::smoothing_start(std::vector<double> &a, int stride, IndexBox &nzb) {
+  const GridSpec &gs = opt.grid;
+  const std::vector<double> &vol = g_.vnode;
+  std::vector<double> &phi = g_.phi;
   // the box (global node indices, over all ranks) of the nodes with a nonzero fraction: a pass
   // along d changes no node farther than one node along d from it, so the passes sweep only that
   // box, grown by one node along d before each pass along d; everywhere else phi stays 0, as the
@@ -248,7 +288,6 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
     }
   });
   MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_INT, MPI_MIN, comm_);
-  IndexBox nzb;  // the nodes with a nonzero fraction, grown by the passes
   int *const lo = nzb.lo, *const hi = nzb.hi;
   for (int d = 0; d < 3; ++d) {
     lo[d] = box[d];
@@ -258,69 +297,52 @@ void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
       hi[d] = INT_MAX / 2;
     }
   }
-  const bool any = !nzb.empty();
-  grid_.forward(phi.data(), stride);
-  const IndexBox &ob = grid_.owned();
+}
+
+// One pass of smooth_node_volume along d over the owned nodes of box b: phi_new from phi.
+void FluidSolver::smoothing_sweep(int d, int stride, const IndexBox &b, const double *V) {
   const IndexBox &pb = grid_.patch();
   const std::size_t step[3] = {1, grid_.stride_y(), grid_.stride_z()};
-  const double *const V = vol.data();
-  IndexBox b = ob.cut(nzb);  // owned nodes inside the box
-  for (int pass = 0; pass < passes && any; ++pass)
-    for (int d = 0; d < 3; ++d) {
-      if (!gs.periodic[d] && gs.ncell[d] < 2) continue;
-      if (!gs.periodic[d]) {
-        --lo[d];
-        ++hi[d];
-      }
-      b = ob.cut(nzb);
-      const double *const p = phi.data();
-      double *const q = phi_new.data();
-      const std::size_t sd = step[d];
-      // row by row along x: along y and z a row's neighbours exist or not as a whole, along x
-      // they do except at the patch's ends
-      auto one = [&](std::size_t n, int id) {  // any node: the neighbours that exist
-        const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
-        const std::size_t m[2] = {has[0] ? n - sd : 0, has[1] ? n + sd : 0};
-        const double Vn[2] = {has[0] ? V[m[0]] : 0.0, has[1] ? V[m[1]] : 0.0};
-        for (int c = 0; c < stride; ++c) {
-          const double phin[2] = {has[0] ? p[stride * m[0] + c] : 0.0, has[1] ? p[stride * m[1] + c] : 0.0};
-          q[stride * n + c] = smoothing_step(V[n], p[stride * n + c], Vn, phin, has);
-        }
-      };
-      auto row = [&](std::size_t n0, int len) {  // nodes n0 .. n0 + len - 1 with both neighbours
-        if (len <= 0) return;
-        if (stride == 1)
-          smooth_row<1>(p, q, V, n0, len, sd);
-        else if (stride == 3)
-          smooth_row<3>(p, q, V, n0, len, sd);
-        else
-          for (int t = 0; t < len; ++t) one(n0 + static_cast<std::size_t>(t), pb.lo[d] + 1);
-      };
-      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-        for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
-          const std::size_t n0 = grid_.index(b.lo[0], j, k);
-          if (d != 0) {
-            const int jk = d == 1 ? j : k;
-            if (jk - 1 >= pb.lo[d] && jk + 1 <= pb.hi[d]) {
-              row(n0, b.hi[0] - b.lo[0] + 1);
-            } else {
-              for (int i = b.lo[0]; i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), jk);
-            }
-            continue;
-          }
-          const int ilo = std::max(b.lo[0], pb.lo[0] + 1), ihi = std::min(b.hi[0], pb.hi[0] - 1);
-          for (int i = b.lo[0]; i <= b.hi[0] && i < ilo; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
-          row(n0 + static_cast<std::size_t>(ilo - b.lo[0]), ihi - ilo + 1);
-          for (int i = std::max(ihi + 1, b.lo[0]); i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
-        }
-      phi.swap(phi_new);
-      grid_.forward(phi.data(), stride);
+  const double *const p = g_.phi.data();
+  double *const q = g_.phi_new.data();
+  const std::size_t sd = step[d];
+  // row by row along x: along y and z a row's neighbours exist or not as a whole, along x
+  // they do except at the patch's ends
+  auto one = [&](std::size_t n, int id) {  // any node: the neighbours that exist
+    const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
+    const std::size_t m[2] = {has[0] ? n - sd : 0, has[1] ? n + sd : 0};
+    const double Vn[2] = {has[0] ? V[m[0]] : 0.0, has[1] ? V[m[1]] : 0.0};
+    for (int c = 0; c < stride; ++c) {
+      const double phin[2] = {has[0] ? p[stride * m[0] + c] : 0.0, has[1] ? p[stride * m[1] + c] : 0.0};
+      q[stride * n + c] = smoothing_step(V[n], p[stride * n + c], Vn, phin, has);
     }
-  if (!any) return;  // a is +-0 at every owned node with a volume, 0 on the others: as phi V
-  // outside the last box phi is 0 and a was +-0 (or set 0 above): only the box is written back
-  grid_.for_box(b, [&](int, int, int, std::size_t n) {
-    for (int c = 0; c < stride; ++c) a[stride * n + c] = phi[stride * n + c] * V[n];
-  });
+  };
+  auto row = [&](std::size_t n0, int len) {  // nodes n0 .. n0 + len - 1 with both neighbours
+    if (len <= 0) return;
+    if (stride == 1)
+      smooth_row<1>(p, q, V, n0, len, sd);
+    else if (stride == 3)
+      smooth_row<3>(p, q, V, n0, len, sd);
+    else
+      for (int t = 0; t < len; ++t) one(n0 + static_cast<std::size_t>(t), pb.lo[d] + 1);
+  };
+  for (int k = b.lo[2]; k <= b.hi[2]; ++k)
+    for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
+      const std::size_t n0 = grid_.index(b.lo[0], j, k);
+      if (d != 0) {
+        const int jk = d == 1 ? j : k;
+        if (jk - 1 >= pb.lo[d] && jk + 1 <= pb.hi[d]) {
+          row(n0, b.hi[0] - b.lo[0] + 1);
+        } else {
+          for (int i = b.lo[0]; i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), jk);
+        }
+        continue;
+      }
+      const int ilo = std::max(b.lo[0], pb.lo[0] + 1), ihi = std::min(b.hi[0], pb.hi[0] - 1);
+      for (int i = b.lo[0]; i <= b.hi[0] && i < ilo; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
+      row(n0 + static_cast<std::size_t>(ilo - b.lo[0]), ihi - ilo + 1);
+      for (int i = std::max(ihi + 1, b.lo[0]); i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
+    }
 }
 
 }  // namespace mpm

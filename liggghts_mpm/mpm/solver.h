@@ -226,11 +226,13 @@ class FluidSolver {
   // gradient L (9, row-major); stores pcell_[i]
   void sum_cell(int i, const double *L);
   void smooth_solid_volume();
+  // smooth_node_volume's steps (fluid_fraction.cpp)
+  const std::vector<double> &node_volumes();
+  void smoothing_start(std::vector<double> &a, int stride, IndexBox &nzb);
+  void smoothing_sweep(int d, int stride, const IndexBox &b, const double *V);
   double solid_node_volume(int i, int j, int k) const;
   void init_theta();
   double stable_dt();
-  void coupled_limits(const double *glob);  // stable_dt: the pore-pressure wave limits
-  std::string projection_limit(double dt, double dt_sub, const char *what, bool at_setup);  // check_timestep
   void coupled_limits(const double *glob);  // stable_dt: the pore-pressure wave limits
   std::string projection_limit(double dt, double dt_sub, const char *what, bool at_setup);  // check_timestep
   bool is_point(int i) const { return (pts.mask[i] & pts.point_bit) != 0; }
