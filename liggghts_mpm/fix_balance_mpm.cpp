@@ -196,6 +196,37 @@ double FixBalanceMpm::imbalance() const {
 }
 
 /* ----------------------------------------------------------------------
+   find_cuts' last step: cut k+1 (k = 0..P-2) from the bisection's upper
+   bracket b[k], the plane c[k] that crosses the target, the weights below and
+   including it (w2g[2k], w2g[2k+1]) and the planes before and after it (prev,
+   next); then strictly increasing, inside the box [lo, hi].
+------------------------------------------------------------------------- */
+
+static void place_cuts(std::vector<double> &cut, const std::vector<double> &b, const std::vector<double> &c,
+                       const std::vector<double> &w2g, const std::vector<double> &prev,
+                       const std::vector<double> &next, double total, bool volume, double lo, double hi) {
+  const int P = static_cast<int>(cut.size()) - 1, nc = P - 1;
+  const double len = hi - lo;
+  for (int k = 0; k < nc; ++k) {
+    const double target = total * (k + 1) / P;
+    double x;
+    if (!std::isfinite(c[k])) {
+      x = b[k];
+    } else if (volume && b[k] - c[k] > 1e-6 * len) {
+      x = b[k];  // the target is crossed by the volume's weight between two planes of atoms
+    } else if (std::fabs(w2g[2 * k] - target) <= std::fabs(w2g[2 * k + 1] - target)) {
+      x = 0.5 * ((std::isfinite(prev[k]) ? prev[k] : lo) + c[k]);  // plane goes to the upper slab
+    } else {
+      x = 0.5 * (c[k] + (std::isfinite(next[k]) ? next[k] : hi));  // plane stays in the lower slab
+    }
+    cut[k + 1] = x;
+  }
+  // strictly increasing, inside the box
+  const double minw = 1e-6 * len;
+  for (int k = 1; k < P; ++k) cut[k] = std::min(std::max(cut[k], cut[k - 1] + minw), hi - (P - k) * minw);
+}
+
+/* ----------------------------------------------------------------------
    Cut k (1..P-1) goes where the weight below it is k/P of the total. The
    weight below a coordinate is a step function (atoms sit on planes, e.g. the
    lattice of material points), so the target is bracketed by bisection on
@@ -273,23 +304,7 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
   for (int k = 0; k < nc; ++k) loc[k] = first_at(b[k]);
   MPI_Allreduce(loc.data(), next.data(), nc, MPI_DOUBLE, MPI_MIN, world);
 
-  for (int k = 0; k < nc; ++k) {
-    const double target = total * (k + 1) / P;
-    double x;
-    if (!std::isfinite(c[k])) {
-      x = b[k];
-    } else if (wvol_ > 0.0 && b[k] - c[k] > 1e-6 * len) {
-      x = b[k];  // the target is crossed by the volume's weight between two planes of atoms
-    } else if (std::fabs(w2g[2 * k] - target) <= std::fabs(w2g[2 * k + 1] - target)) {
-      x = 0.5 * ((std::isfinite(prev[k]) ? prev[k] : lo) + c[k]);  // plane goes to the upper slab
-    } else {
-      x = 0.5 * (c[k] + (std::isfinite(next[k]) ? next[k] : hi));  // plane stays in the lower slab
-    }
-    cut[k + 1] = x;
-  }
-  // strictly increasing, inside the box
-  const double minw = 1e-6 * len;
-  for (int k = 1; k < P; ++k) cut[k] = std::min(std::max(cut[k], cut[k - 1] + minw), hi - (P - k) * minw);
+  place_cuts(cut, b, c, w2g, prev, next, total, wvol_ > 0.0, lo, hi);
 }
 
 /* ----------------------------------------------------------------------

@@ -73,6 +73,58 @@ void *MeshWalls::resolve(int k) const {
 // ---------------------------------------------------------------------------------------------
 // Gathering
 
+namespace {
+
+// A triangle's record rec (bounds lo, hi) appended to out[q] for every rank q whose box (boxes,
+// 6 per rank; empty if lo > hi) it or one of its periodic images (shifts per direction) touches,
+// shifted by the image, with the image's index in rec[20].
+void pack_for_ranks(const double *rec, const double lo[3], const double hi[3], const std::vector<double> &boxes,
+                    const std::vector<double> shifts[3], std::vector<std::vector<double>> &out) {
+  const int nprocs = static_cast<int>(out.size());
+  for (int q = 0; q < nprocs; ++q) {
+    const double *bx = &boxes[6 * q];
+    if (bx[0] > bx[3] || bx[1] > bx[4] || bx[2] > bx[5]) continue;
+    for (size_t ix = 0; ix < shifts[0].size(); ++ix)
+      for (size_t iy = 0; iy < shifts[1].size(); ++iy)
+        for (size_t iz = 0; iz < shifts[2].size(); ++iz) {
+          const double s[3] = {shifts[0][ix], shifts[1][iy], shifts[2][iz]};
+          bool hit = true;
+          for (int d = 0; d < 3 && hit; ++d)
+            hit = lo[d] + s[d] <= bx[3 + d] && hi[d] + s[d] >= bx[d];
+          if (!hit) continue;
+          std::vector<double> &o = out[q];
+          const size_t at = o.size();
+          o.insert(o.end(), rec, rec + kPack);
+          for (int j = 0; j < 3; ++j)
+            for (int d = 0; d < 3; ++d) o[at + 3 * j + d] += s[d];
+          o[at + 20] = static_cast<double>(9 * ix + 3 * iy + iz);
+        }
+  }
+}
+
+// The records out[q] sent to each rank q, those of all ranks received (rtot values, in rank order).
+std::vector<double> exchange_records(MPI_Comm world, const std::vector<std::vector<double>> &out, int &rtot) {
+  const int nprocs = static_cast<int>(out.size());
+  std::vector<int> scount(nprocs), rcount(nprocs), sdisp(nprocs), rdisp(nprocs);
+  for (int q = 0; q < nprocs; ++q) scount[q] = static_cast<int>(out[q].size());
+  MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, world);
+  int stot = 0;
+  rtot = 0;
+  for (int q = 0; q < nprocs; ++q) {
+    sdisp[q] = stot;
+    rdisp[q] = rtot;
+    stot += scount[q];
+    rtot += rcount[q];
+  }
+  std::vector<double> sbuf(std::max(stot, 1)), rbuf(std::max(rtot, 1));
+  for (int q = 0; q < nprocs; ++q) std::copy(out[q].begin(), out[q].end(), sbuf.begin() + sdisp[q]);
+  MPI_Alltoallv(sbuf.data(), scount.data(), sdisp.data(), MPI_DOUBLE, rbuf.data(), rcount.data(),
+                rdisp.data(), MPI_DOUBLE, world);
+  return rbuf;
+}
+
+}  // namespace
+
 bool MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], double margin) {
   MPI_Comm world = lmp_->world;
   int me = 0, nprocs = 1;
@@ -126,43 +178,13 @@ bool MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
         lo[d] = std::min({rec[d], rec[3 + d], rec[6 + d]});
         hi[d] = std::max({rec[d], rec[3 + d], rec[6 + d]});
       }
-      for (int q = 0; q < nprocs; ++q) {
-        const double *bx = &boxes[6 * q];
-        if (bx[0] > bx[3] || bx[1] > bx[4] || bx[2] > bx[5]) continue;
-        for (size_t ix = 0; ix < shifts[0].size(); ++ix)
-          for (size_t iy = 0; iy < shifts[1].size(); ++iy)
-            for (size_t iz = 0; iz < shifts[2].size(); ++iz) {
-              const double s[3] = {shifts[0][ix], shifts[1][iy], shifts[2][iz]};
-              bool hit = true;
-              for (int d = 0; d < 3 && hit; ++d)
-                hit = lo[d] + s[d] <= bx[3 + d] && hi[d] + s[d] >= bx[d];
-              if (!hit) continue;
-              std::vector<double> &o = out[q];
-              const size_t at = o.size();
-              o.insert(o.end(), rec, rec + kPack);
-              for (int j = 0; j < 3; ++j)
-                for (int d = 0; d < 3; ++d) o[at + 3 * j + d] += s[d];
-              o[at + 20] = static_cast<double>(9 * ix + 3 * iy + iz);
-            }
-      }
+      pack_for_ranks(rec, lo, hi, boxes, shifts, out);
     }
   }
 
   // exchange
-  std::vector<int> scount(nprocs), rcount(nprocs), sdisp(nprocs), rdisp(nprocs);
-  for (int q = 0; q < nprocs; ++q) scount[q] = static_cast<int>(out[q].size());
-  MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, world);
-  int stot = 0, rtot = 0;
-  for (int q = 0; q < nprocs; ++q) {
-    sdisp[q] = stot;
-    rdisp[q] = rtot;
-    stot += scount[q];
-    rtot += rcount[q];
-  }
-  std::vector<double> sbuf(std::max(stot, 1)), rbuf(std::max(rtot, 1));
-  for (int q = 0; q < nprocs; ++q) std::copy(out[q].begin(), out[q].end(), sbuf.begin() + sdisp[q]);
-  MPI_Alltoallv(sbuf.data(), scount.data(), sdisp.data(), MPI_DOUBLE, rbuf.data(), rcount.data(),
-                rdisp.data(), MPI_DOUBLE, world);
+  int rtot = 0;
+  const std::vector<double> rbuf = exchange_records(world, out, rtot);
 
   // unpack
   std::vector<WallGeometry::Tri> tris;

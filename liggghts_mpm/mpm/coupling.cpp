@@ -1,5 +1,6 @@
-// The coupling phases of the solver (chapter 7.2, 8.1-8.2): fluid fraction, its smoothing, the
-// pressure fit at the nodes and the drag exchange with the grains (solver.h, coupling.h).
+// The coupling phases of the solver (chapter 7.2, 8.2): the pressure fit at the nodes, the drag
+// and pressure exchange with the grains and its reaction on the fluid (solver.h, coupling.h); the
+// fluid fraction and its smoothing are in fluid_fraction.cpp.
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -29,318 +30,6 @@ bool fit_linear_pressure(const double *c, double dx, double out[4]) {
     return false;
   for (int q = 0; q < 4; ++q) out[q] = sol[q];
   return true;
-}
-
-// One pass of smooth_node_volume along a row of len nodes from n0 whose neighbours along the
-// pass's direction (n -+ sd) all exist: smoothing_step's arithmetic (the same operations in the
-// same order), free of the per-node tests; the division is done before the test V > 0 and the
-// function is compiled without trapping math (it changes no value: it lets the compiler treat the
-// comparisons and the division as free of side effects), so that the loop is vectorized
-#if defined(__GNUC__) && !defined(__clang__)
-#define MPM_NO_TRAPPING_MATH __attribute__((optimize("no-trapping-math")))
-#else
-#define MPM_NO_TRAPPING_MATH
-#endif
-template <int ST>
-MPM_NO_TRAPPING_MATH static void smooth_row(const double *p, double *q, const double *V, std::size_t n0, int len, std::size_t sd) {
-  for (int t = 0; t < len; ++t) {
-    const std::size_t n = n0 + static_cast<std::size_t>(t);
-    const double v = V[n], v0 = V[n - sd], v1 = V[n + sd];
-    for (int c = 0; c < ST; ++c) {
-      const double ph = p[ST * n + c];
-      double S = ph * v;
-      S += 0.25 * (v < v0 ? v : v0) * (p[ST * (n - sd) + c] - ph);
-      S += 0.25 * (v < v1 ? v : v1) * (p[ST * (n + sd) + c] - ph);
-      const double r = S / v;
-      q[ST * n + c] = v > 0.0 ? r : 0.0;
-    }
-  }
-}
-
-int smoothing_passes(double L, double dx) { return static_cast<int>(std::ceil(2.0 * L * L / (dx * dx) - 1e-9)); }
-
-// fn(n, w) for the nodes a stencil reaches (the solver's shape functions)
-template <class Fn>
-void FluidSolver::for_nodes(const Stencil &ps, Fn &&fn) const {
-  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  auto body = [&](std::size_t n, int, int, int, double w, double, double, double) { fn(n, w); };
-  if (opt.shape == ShapeKind::QuadraticBSpline)
-    for_stencil<3>(ps, sy, sz, body);
-  else
-    for_stencil<2>(ps, sy, sz, body);
-}
-
-// Node volume for the grains' volume fraction (8-13) with shape functions reflected at the grid
-// faces: half a cell on a wall, a full cell inside, none outside (the text's (8-13) integrates
-// the unreflected shape function over the inside, which leaves the padding node 1/48 of a cell).
-double FluidSolver::solid_node_volume(int i, int j, int k) const {
-  const GridSpec &gs = opt.grid;
-  const int idx[3] = {i, j, k};
-  double v = gs.dx * gs.dx * gs.dx;
-  for (int d = 0; d < 3; ++d) {
-    if (gs.periodic[d]) continue;
-    if (idx[d] < 0 || idx[d] > gs.ncell[d]) return 0.0;
-    if (idx[d] == 0 || idx[d] == gs.ncell[d]) v *= 0.5;
-  }
-  return v;
-}
-
-void FluidSolver::setup_coupling() {
-  if (!opt.coupled) return;
-  if (!state.theta_initialized) init_theta();
-}
-
-// At the first run with grains: the fluid present in a point's volume is theta of it, so its
-// mass is reduced once to theta rho0 V (8-3): otherwise the grains' volume would be counted as
-// compressed fluid.
-void FluidSolver::init_theta() {
-  compute_shapes();
-  fluid_fraction();
-  for (int i = 0; i < pts.nlocal; ++i) {
-    if (!is_point(i)) continue;
-    double *s = pts.state[i];
-    pts.rmass[i] *= s[C_THETA];
-    s[C_RHO] = pts.rmass[i] / (s[C_THETA] * s[C_VOL]);
-  }
-  state.theta_initialized = true;
-}
-
-/* Fluid fraction (8-11)-(8-14) at the nodes from the grains' volumes (with the optional
-   smoothing) and at the points (8-16). Done at the start of each sub-step, before the
-   particles-to-grid map and the forces on the grains, so that the pressure with which the fluid
-   and the grains push each other belongs to the grains' present positions (refresh_pressure):
-   with the pressure of the previous sub-step the restoring force of the fluid on a grain lags
-   one step behind its displacement, which feeds energy into the grain-fluid oscillation (stiff:
-   K / theta per unit volume change) and made the moving dense bed of C3 blow up. */
-/* What the coupling reads of grain k (position, velocity, radius, mass) is finite, the radius
-   and mass positive: a grain whose mass underflowed (d = 1e-110) gets a non-finite position from
-   its integrator, whose stencil would index far outside the grid. */
-void FluidSolver::check_grain(int k) const {
-  const double *x = pts.x[k], *v = pts.v[k];
-  const char *what = nullptr;
-  if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))) what = "position";
-  else if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))) what = "velocity";
-  else if (!(std::isfinite(pts.radius[k]) && pts.radius[k] > 0.0)) what = "radius";
-  else if (!(std::isfinite(pts.rmass[k]) && pts.rmass[k] > 0.0)) what = "mass";
-  if (!what) return;
-  std::ostringstream os;
-  os << "Fix mpm/fluid: the " << what << " of grain " << pts.tag[k] << " (group '" << opt.couple_group
-     << "') is not finite" << (what[0] == 'r' || what[0] == 'm' ? " and positive" : "") << " at step " << clock.step << " (x = (" << x[0] << ", " << x[1] << ", " << x[2]
-     << "), v = (" << v[0] << ", " << v[1] << ", " << v[2] << "), radius " << pts.radius[k] << ", mass " << pts.rmass[k]
-     << "); a grain of underflowing mass or an unstable DEM step";
-  throw LocalError(os.str());
-}
-
-void FluidSolver::fluid_fraction() {
-  const int nlocal = pts.nlocal;
-  double **x = pts.x;
-  const double *radius = pts.radius;
-  if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
-  std::fill(g_.sol.begin(), g_.sol.end(), 0.0);
-  std::fill(g_.need.begin(), g_.need.end(), 0.0);
-  for (int d = 0; d < 3; ++d) {
-    grain_base_lo_[d] = INT_MAX;
-    grain_base_hi_[d] = INT_MIN;
-  }
-  for (int k = 0; k < nlocal; ++k) {
-    if (!is_grain(k)) continue;
-    check_grain(k);
-    Stencil &ps = grain_shapes_[k];
-    if (!shape_of(x[k], ps)) {
-      ps.base[0] = INT_MIN;  // outside the grid: no fluid there
-      continue;
-    }
-    for (int d = 0; d < 3; ++d) {
-      grain_base_lo_[d] = std::min(grain_base_lo_[d], ps.base[d]);
-      grain_base_hi_[d] = std::max(grain_base_hi_[d], ps.base[d]);
-    }
-    const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
-    for_nodes(ps, [&](std::size_t n, double w) {
-      g_.sol[n] += w * Vk;
-      g_.need[n] = 1.0;
-    });
-  }
-  grid_.reverse_sum(g_.need.data(), 1);  // nodes some grain reads (fit of the pressure only there)
-  // and back to the halo copies: a point of this rank must add its pressure moments to a node
-  // that only another rank's grain reads (else np 2 differs from np 1 with 'grad_p fit')
-  grid_.forward(g_.need.data(), 1);
-  // Walls: the solid volume mapped to a node outside a grid face is folded onto its mirror node
-  // inside (reflected shape functions), so that no node has the sliver volume that (8-13) gives
-  // the padding nodes (1/48 of a cell for the B-spline: one grain near the wall would swing its
-  // theta by tens of per cent, and the pressure of the points next to the wall with it, by
-  // K dtheta/theta). Node volumes: half a cell on the wall, full inside; a padding node takes the
-  // fraction of its mirror.
-  fold_to_mirror(g_.sol, 1);
-  grid_.reverse_sum(g_.sol.data(), 1);
-  if (opt.theta_smooth > 0.0) smooth_solid_volume();
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const int mi[3] = {opt.grid.mirror(i, 0), opt.grid.mirror(j, 1), opt.grid.mirror(k, 2)};
-    const double Vj = solid_node_volume(mi[0], mi[1], mi[2]);
-    const std::size_t m = grid_.in_patch(mi[0], mi[1], mi[2]) ? grid_.index(mi[0], mi[1], mi[2]) : n;
-    g_.th[n] = std::min(1.0, std::max(opt.theta_min, 1.0 - g_.sol[m] / Vj));  // (8-11), (8-14)
-  });
-  grid_.forward(g_.th.data(), 1);
-  const double *const gth = g_.th.data();
-  for (const int i : plist_) {
-    double th = 0.0;
-    for_nodes(shapes_[i], [&](std::size_t n, double w) { th += w * gth[n]; });
-    pts.state[i][C_THETA] = th;
-  }
-}
-
-// The points' density and pressure for the new fluid fraction (their volume is unchanged).
-void FluidSolver::refresh_pressure() { update_stress(0.0, true); }
-
-/* Walls: what is mapped to a node outside a grid face (patch, partial sums before the reverse sum)
-   is folded onto its mirror node inside (reflected shape functions), one direction after the
-   other, so a corner's share ends on the inside too. */
-void FluidSolver::fold_to_mirror(std::vector<double> &a, int stride) {
-  const GridSpec &gs = opt.grid;
-  const IndexBox &pb = grid_.patch();
-  for (int d = 0; d < 3; ++d) {
-    if (gs.periodic[d]) continue;
-    // only the patch's padding layers outside the low and the high face
-    for (const IndexBox &b : gs.padding_layers(pb, d)) {
-      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-        for (int j = b.lo[1]; j <= b.hi[1]; ++j)
-          for (int i = b.lo[0]; i <= b.hi[0]; ++i) {
-            int idx[3] = {i, j, k};
-            idx[d] = gs.mirror(idx[d], d);
-            if (!grid_.in_patch(idx[0], idx[1], idx[2])) continue;
-            double *from = &a[stride * grid_.index(i, j, k)];
-            double *to = &a[stride * grid_.index(idx[0], idx[1], idx[2])];
-            for (int c = 0; c < stride; ++c)
-              if (from[c] != 0.0) {
-                to[c] += from[c];
-                from[c] = 0.0;
-              }
-          }
-    }
-  }
-}
-
-/* Smoothing of the grains' volume at the owned nodes by a discrete diffusion of the solid
-   fraction phi_j = S_j / V_j (smoothing_step along each direction, smoothing_passes passes). */
-void FluidSolver::smooth_solid_volume() { smooth_node_volume(g_.sol); }
-
-// The same filter for any volume-like quantity at the owned nodes: a holds `stride` values per
-// node, each smoothed alone (one pass over the nodes and one exchange for all of them).
-void FluidSolver::smooth_node_volume(std::vector<double> &a, int stride) {
-  const GridSpec &gs = opt.grid;
-  const int passes = smoothing_passes(opt.theta_smooth, gs.dx);
-  if (passes <= 0) return;
-  const std::size_t N = grid_.size();
-  // the node volumes of the patch (owned, forwarded to the halo; 0 on padding nodes) do not change
-  // with the grid's patch: computed once after setup_grid
-  std::vector<double> &vol = g_.vnode;
-  if (!g_.vnode_ready) {
-    g_.vnode_ready = true;
-    vol.assign(N, 0.0);
-    grid_.for_owned([&](int i, int j, int k, std::size_t n) { vol[n] = solid_node_volume(i, j, k); });
-    grid_.forward(vol.data(), 1);
-  }
-  // phi and phi_new take turns (each pass writes the other and they swap): both are 0 outside the
-  // box of the pass, which only grows, so the nodes a pass does not write hold the same in both
-  std::vector<double> &phi = g_.phi, &phi_new = g_.phi_new;
-  phi.assign(stride * N, 0.0);
-  phi_new.assign(stride * N, 0.0);
-  // the box (global node indices, over all ranks) of the nodes with a nonzero fraction: a pass
-  // along d changes no node farther than one node along d from it, so the passes sweep only that
-  // box, grown by one node along d before each pass along d; everywhere else phi stays 0, as the
-  // pass would give it. (The C3 tank at Grid40, theta_smooth 0.01: 8 passes x 3 directions over
-  // the whole grid, twice per coupled step, took 40 % of the run.)
-  int box[6] = {INT_MAX, INT_MAX, INT_MAX, INT_MAX, INT_MAX, INT_MAX};  // lo[3], -hi[3]
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double V = vol[n];
-    bool nz = false;
-    for (int c = 0; c < stride; ++c) {
-      phi[stride * n + c] = V > 0.0 ? a[stride * n + c] / V : 0.0;
-      if (phi[stride * n + c] != 0.0) nz = true;
-      // an owned padding node (no volume) keeps phi = 0 in every pass and ends with a = 0 x 0
-      if (!(V > 0.0)) a[stride * n + c] = 0.0;
-    }
-    if (nz) {
-      const int idx[3] = {i, j, k};
-      for (int d = 0; d < 3; ++d) {
-        box[d] = std::min(box[d], idx[d]);
-        box[3 + d] = std::min(box[3 + d], -idx[d]);
-      }
-    }
-  });
-  MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_INT, MPI_MIN, comm_);
-  IndexBox nzb;  // the nodes with a nonzero fraction, grown by the passes
-  int *const lo = nzb.lo, *const hi = nzb.hi;
-  for (int d = 0; d < 3; ++d) {
-    lo[d] = box[d];
-    hi[d] = box[3 + d] == INT_MAX ? INT_MIN : -box[3 + d];
-    if (gs.periodic[d] && lo[d] <= hi[d]) {  // indices wrap: no restriction along d
-      lo[d] = INT_MIN / 2;
-      hi[d] = INT_MAX / 2;
-    }
-  }
-  const bool any = !nzb.empty();
-  grid_.forward(phi.data(), stride);
-  const IndexBox &ob = grid_.owned();
-  const IndexBox &pb = grid_.patch();
-  const std::size_t step[3] = {1, grid_.stride_y(), grid_.stride_z()};
-  const double *const V = vol.data();
-  IndexBox b = ob.cut(nzb);  // owned nodes inside the box
-  for (int pass = 0; pass < passes && any; ++pass)
-    for (int d = 0; d < 3; ++d) {
-      if (!gs.periodic[d] && gs.ncell[d] < 2) continue;
-      if (!gs.periodic[d]) {
-        --lo[d];
-        ++hi[d];
-      }
-      b = ob.cut(nzb);
-      const double *const p = phi.data();
-      double *const q = phi_new.data();
-      const std::size_t sd = step[d];
-      // row by row along x: along y and z a row's neighbours exist or not as a whole, along x
-      // they do except at the patch's ends
-      auto one = [&](std::size_t n, int id) {  // any node: the neighbours that exist
-        const bool has[2] = {id - 1 >= pb.lo[d], id + 1 <= pb.hi[d]};
-        const std::size_t m[2] = {has[0] ? n - sd : 0, has[1] ? n + sd : 0};
-        const double Vn[2] = {has[0] ? V[m[0]] : 0.0, has[1] ? V[m[1]] : 0.0};
-        for (int c = 0; c < stride; ++c) {
-          const double phin[2] = {has[0] ? p[stride * m[0] + c] : 0.0, has[1] ? p[stride * m[1] + c] : 0.0};
-          q[stride * n + c] = smoothing_step(V[n], p[stride * n + c], Vn, phin, has);
-        }
-      };
-      auto row = [&](std::size_t n0, int len) {  // nodes n0 .. n0 + len - 1 with both neighbours
-        if (len <= 0) return;
-        if (stride == 1)
-          smooth_row<1>(p, q, V, n0, len, sd);
-        else if (stride == 3)
-          smooth_row<3>(p, q, V, n0, len, sd);
-        else
-          for (int t = 0; t < len; ++t) one(n0 + static_cast<std::size_t>(t), pb.lo[d] + 1);
-      };
-      for (int k = b.lo[2]; k <= b.hi[2]; ++k)
-        for (int j = b.lo[1]; j <= b.hi[1]; ++j) {
-          const std::size_t n0 = grid_.index(b.lo[0], j, k);
-          if (d != 0) {
-            const int jk = d == 1 ? j : k;
-            if (jk - 1 >= pb.lo[d] && jk + 1 <= pb.hi[d]) {
-              row(n0, b.hi[0] - b.lo[0] + 1);
-            } else {
-              for (int i = b.lo[0]; i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), jk);
-            }
-            continue;
-          }
-          const int ilo = std::max(b.lo[0], pb.lo[0] + 1), ihi = std::min(b.hi[0], pb.hi[0] - 1);
-          for (int i = b.lo[0]; i <= b.hi[0] && i < ilo; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
-          row(n0 + static_cast<std::size_t>(ilo - b.lo[0]), ihi - ilo + 1);
-          for (int i = std::max(ihi + 1, b.lo[0]); i <= b.hi[0]; ++i) one(n0 + static_cast<std::size_t>(i - b.lo[0]), i);
-        }
-      phi.swap(phi_new);
-      grid_.forward(phi.data(), stride);
-    }
-  if (!any) return;  // a is +-0 at every owned node with a volume, 0 on the others: as phi V
-  // outside the last box phi is 0 and a was +-0 (or set 0 above): only the box is written back
-  grid_.for_box(b, [&](int, int, int, std::size_t n) {
-    for (int c = 0; c < stride; ++c) a[stride * n + c] = phi[stride * n + c] * V[n];
-  });
 }
 
 /* a + w v with the rounding of a loop that only sums w v into a: the build with FMA (MPM_SIMD)
@@ -423,21 +112,11 @@ void FluidSolver::couple_fluid_grains(double h) {
   with_stencil(opt.shape, [&](auto ns) { couple_kernel<decltype(ns)::value>(h); });
 }
 
+// couple_kernel's first step: the pressure the grains feel, at the nodes (projection: the last
+// solve's gradient; grad_p weak: the fluid's own weak gradient; else the points' pressure moments
+// for the nodal fit).
 template <int NS>
-void FluidSolver::couple_kernel(double h) {
-  const int nlocal = pts.nlocal;
-  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  const double *const gst = g_.st.data();
-  double *const gdr = g_.dr.data();
-  double **v = pts.v;
-  const double *radius = pts.radius, *rmass = pts.rmass;
-  const int nsub = state.nsub;
-  if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
-
-  // projection: the grains feel the nodal gradient of the last solve (the one the fluid felt),
-  // and the fluid gets no pressure reaction (its share -theta grad p is in the projection)
-  const bool proj = opt.projection;
-  const bool weak = opt.grad_p == GradP::Weak || proj;
+void FluidSolver::grain_pressure_inputs(bool proj, bool weak) {
   if (!proj && weak) point_sums<NS>();
   if (proj) {
     projection_gradient_to_grains();
@@ -447,7 +126,7 @@ void FluidSolver::couple_kernel(double h) {
   } else {
     // pressure at the nodes for the force on the grains (fit_linear_pressure); reaction points:
     // the points' volume at the nodes (rq[3 n], folded) in the same pass over the points. pfit is
-    // 0 here (see the end of this function)
+    // 0 here (see the end of couple_kernel)
     if (opt.reaction_points) {
       std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
       pressure_moments<NS, true>();
@@ -458,24 +137,14 @@ void FluidSolver::couple_kernel(double h) {
     }
     grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
   }
+}
 
-  // the box of the grains' stencils (fluid_fraction found them for this sub-step)
-  const IndexBox gbox = stencil_box(grain_base_lo_, grain_base_hi_, NS, grid_.patch());
-  const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
-  // What the grains read (st) is read only at their stencils, here and, through the forward, at
-  // the owned nodes of the exchanged boxes, and by the drag exchange below in the same box: st is
-  // set only at the owned nodes of the bounding box of those (the rest keeps stale values nobody
-  // reads). dr is 0 outside that box after the reverse sum.
-  const IndexBox dbox = bounding_box(gbox, xboxes);
-  IndexBox sbox = grid_.owned().cut(dbox);
-  if (grid_.restricted()) sbox = sbox.cut(grid_.work());
-  // pfit is 0 outside the points' stencils and the exchanged boxes (with grad_p weak and the
-  // projection everywhere): there the node reads a record of zeros, not the array
-  const IndexBox pbox = stencil_box(base_lo_, base_hi_, NS, grid_.patch());
-  const IndexBox rbox = !proj && !weak ? bounding_box(pbox, xboxes) : IndexBox();
+// couple_kernel: what the grains read at the owned nodes of sbox (StRec: fluid fraction,
+// pressure, fitted gradient, mass, velocity); rbox: the nodes whose pfit record is summed.
+void FluidSolver::grain_node_state(const IndexBox &sbox, const IndexBox &rbox, bool weak) {
   static const double kZeroPfit[PfitRec::N] = {};
   const double mmin = mass_min();
-  if (!sbox.empty()) grid_.for_box(sbox, [&](int i, int j, int k, std::size_t n) {
+  grid_.for_box(sbox, [&](int i, int j, int k, std::size_t n) {
     const double *c = rbox.contains(i, j, k) ? &g_.pfit[PfitRec::N * n] : kZeroPfit;
     const double *g = &g_.p2g[P2gRec::N * n];
     double *st = &g_.st[StRec::N * n];
@@ -494,7 +163,7 @@ void FluidSolver::couple_kernel(double h) {
       st[StRec::U + 3] = 1.0;
     }
   });
-  grid_.forward(g_.st.data(), StRec::N);
+}
 
   // Drag, exchanged node by node. Each grain k has the coefficient K_k (frozen over the sub-step)
   // and touches node j with weight S_jk. At every node the fluid (mass M_j, velocity u_j) and the
@@ -505,9 +174,20 @@ void FluidSolver::couple_kernel(double h) {
   // keeps the right terminal slip (see mpm::drag_implicit_impulse). Grain k receives the share
   // S_jk K_k / K_j of J_j. The pressure-gradient force (7-15) is explicit (not stiff); its
   // reaction goes to the nodes too.
+// couple_kernel, per grain: Kgrain[k], the pressure force (grain_force_) and the grain's shares
+// of K, K v, mass, pressure reaction and K a at the nodes of its stencil (dr).
+// (inlined into couple_kernel: as a call of its own, GCC emitted for it a register-to-register
+// vmovq encoding that valgrind 3.19 cannot decode, which stopped callgrind on coupled runs)
+template <int NS>
+[[gnu::always_inline]] inline void FluidSolver::grain_drag_sums(std::vector<double> &Kgrain, bool proj, bool weak) {
+  const int nlocal = pts.nlocal;
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const double *const gst = g_.st.data();
+  double *const gdr = g_.dr.data();
+  double **v = pts.v;
+  const double *radius = pts.radius, *rmass = pts.rmass;
+  const int nsub = state.nsub;
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
-  std::vector<double> Kgrain(static_cast<std::size_t>(nlocal), 0.0);
-  // dr is 0 here (see the end of this function)
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
     const Stencil &ps = grain_shapes_[k];
@@ -570,19 +250,12 @@ void FluidSolver::couple_kernel(double h) {
       row4(q + DrRec::KA) += w * r2;
     });
   }
-  // the grains wrote dr in gbox only (0 elsewhere until the reverse sum)
-  if (opt.reaction_points && !proj) {
-    // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
-    std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
-    if (!gbox.empty())
-      grid_.for_box(gbox, [&](int, int, int, std::size_t n) {
-        for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
-      });
-    fold_to_mirror(g_.rp, 3);
-    grid_.reverse_sum(g_.rp.data(), 3);
-  }
-  grid_.reverse_sum(g_.dr.data(), DrRec::N);
+}
 
+// couple_kernel: the drag impulse of each owned node inside dbox over h (drag_implicit_impulse),
+// the force on the fluid (rx) and the impulse per unit K for the grains (dr).
+void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
+  const double mmin = mass_min();
   // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned
   // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -609,8 +282,16 @@ void FluidSolver::couple_kernel(double h) {
       q[DrRec::J + d] = q[DrRec::K] > 0.0 ? J[d] / q[DrRec::K] : 0.0;  // impulse per unit K, to the grains
     }
   });
-  if (opt.reaction_points && !proj) route_reaction<NS>();
-  grid_.forward(g_.dr.data(), DrRec::N);
+}
+
+// couple_kernel's last step: each grain's share of its nodes' drag impulses, as a force averaged
+// over the sub-steps (grain_force_).
+template <int NS>
+void FluidSolver::grain_drag_forces(const std::vector<double> &Kgrain, double h) {
+  const int nlocal = pts.nlocal;
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const double *const gdr = g_.dr.data();
+  const int nsub = state.nsub;
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
     const Stencil &ps = grain_shapes_[k];
@@ -621,6 +302,58 @@ void FluidSolver::couple_kernel(double h) {
     for (int d = 0; d < 3; ++d)
       grain_force_[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
   }
+}
+
+template <int NS>
+void FluidSolver::couple_kernel(double h) {
+  const int nlocal = pts.nlocal;
+  double *const gdr = g_.dr.data();
+  if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
+
+  // projection: the grains feel the nodal gradient of the last solve (the one the fluid felt),
+  // and the fluid gets no pressure reaction (its share -theta grad p is in the projection)
+  const bool proj = opt.projection;
+  const bool weak = opt.grad_p == GradP::Weak || proj;
+  grain_pressure_inputs<NS>(proj, weak);
+
+  // the box of the grains' stencils (fluid_fraction found them for this sub-step)
+  const IndexBox gbox = stencil_box(grain_base_lo_, grain_base_hi_, NS, grid_.patch());
+  const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
+  // What the grains read (st) is read only at their stencils, here and, through the forward, at
+  // the owned nodes of the exchanged boxes, and by the drag exchange below in the same box: st is
+  // set only at the owned nodes of the bounding box of those (the rest keeps stale values nobody
+  // reads). dr is 0 outside that box after the reverse sum.
+  const IndexBox dbox = bounding_box(gbox, xboxes);
+  IndexBox sbox = grid_.owned().cut(dbox);
+  if (grid_.restricted()) sbox = sbox.cut(grid_.work());
+  // pfit is 0 outside the points' stencils and the exchanged boxes (with grad_p weak and the
+  // projection everywhere): there the node reads a record of zeros, not the array
+  const IndexBox pbox = stencil_box(base_lo_, base_hi_, NS, grid_.patch());
+  const IndexBox rbox = !proj && !weak ? bounding_box(pbox, xboxes) : IndexBox();
+  if (!sbox.empty()) grain_node_state(sbox, rbox, weak);
+  grid_.forward(g_.st.data(), StRec::N);
+
+  // the drag coefficients, pressure forces and the grains' shares at the nodes (dr is 0 here: see
+  // the end of this function)
+  std::vector<double> Kgrain(static_cast<std::size_t>(nlocal), 0.0);
+  grain_drag_sums<NS>(Kgrain, proj, weak);
+  // the grains wrote dr in gbox only (0 elsewhere until the reverse sum)
+  if (opt.reaction_points && !proj) {
+    // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
+    std::fill(g_.rp.begin(), g_.rp.end(), 0.0);
+    if (!gbox.empty())
+      grid_.for_box(gbox, [&](int, int, int, std::size_t n) {
+        for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
+      });
+    fold_to_mirror(g_.rp, 3);
+    grid_.reverse_sum(g_.rp.data(), 3);
+  }
+  grid_.reverse_sum(g_.dr.data(), DrRec::N);
+
+  drag_exchange(dbox, h);
+  if (opt.reaction_points && !proj) route_reaction<NS>();
+  grid_.forward(g_.dr.data(), DrRec::N);
+  grain_drag_forces<NS>(Kgrain, h);
   // pfit and dr are 0 at the next call (they are allocated 0 and no other code writes them): only
   // the nodes written are cleared, the stencils of the points (pfit) and of the grains (dr) and
   // the halo and owner boxes of the exchanges; the drag exchange above wrote +0 to dr at the

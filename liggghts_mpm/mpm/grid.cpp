@@ -139,6 +139,44 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
 void LocalGrid::reverse_sum(double *data, int stride) { exchange(data, stride, true); }
 void LocalGrid::forward(double *data, int stride) { exchange(data, stride, false); }
 
+namespace {
+
+// A box moves row by row along x: the stride values of the nodes of one row are contiguous in
+// data (x fastest). Buffers hold the boxes' rows one after the other (z, y, x, value: the order
+// node by node), so that the rows of one box follow each other in the message. sv: values per
+// node; row_step: values from one row to the next along y.
+double *pack_box(const LocalGrid &g, const double *data, const IndexBox &b, double *buf, std::size_t sv,
+                 std::size_t row_step) {
+  if (b.empty()) return buf;
+  const std::size_t len = std::size_t(b.hi[0] - b.lo[0] + 1) * sv;
+  for (int k = b.lo[2]; k <= b.hi[2]; ++k) {
+    const double *row = data + g.index(b.lo[0], b.lo[1], k) * sv;
+    for (int j = b.lo[1]; j <= b.hi[1]; ++j, row += row_step, buf += len)
+      std::memcpy(buf, row, len * sizeof(double));
+  }
+  return buf;
+}
+
+// reverse: each value added to its node once (per transfer, in list order: the same sums);
+// forward: stored
+const double *unpack_box(const LocalGrid &g, double *data, const IndexBox &b, const double *buf, std::size_t sv,
+                         std::size_t row_step, bool reverse) {
+  if (b.empty()) return buf;
+  const std::size_t len = std::size_t(b.hi[0] - b.lo[0] + 1) * sv;
+  for (int k = b.lo[2]; k <= b.hi[2]; ++k) {
+    double *row = data + g.index(b.lo[0], b.lo[1], k) * sv;
+    for (int j = b.lo[1]; j <= b.hi[1]; ++j, row += row_step, buf += len) {
+      if (reverse)
+        for (std::size_t m = 0; m < len; ++m) row[m] += buf[m];
+      else
+        std::memcpy(row, buf, len * sizeof(double));
+    }
+  }
+  return buf;
+}
+
+}  // namespace
+
 void LocalGrid::exchange(double *data, int stride, bool reverse) {
   // reverse: halo boxes are packed and sent, owner boxes receive and add.
   // forward: owner boxes are packed and sent, halo boxes receive and store.
@@ -150,34 +188,10 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   // along periodic dimensions); outside it both sides hold the value of a node without fluid
   auto box_of = [&](const Transfer &t) { return restricted_ ? t.mine.cut(work_) : t.mine; };
 
-  // A box moves row by row along x: the stride values of the nodes of one row are contiguous in
-  // data (x fastest). Buffers hold the boxes' rows one after the other (z, y, x, value: the order
-  // node by node), so that the rows of one box follow each other in the message.
-  auto pack = [&](const IndexBox &b, double *buf) {
-    if (b.empty()) return buf;
-    const std::size_t len = std::size_t(b.hi[0] - b.lo[0] + 1) * sv;
-    for (int k = b.lo[2]; k <= b.hi[2]; ++k) {
-      const double *row = data + index(b.lo[0], b.lo[1], k) * sv;
-      for (int j = b.lo[1]; j <= b.hi[1]; ++j, row += row_step, buf += len)
-        std::memcpy(buf, row, len * sizeof(double));
-    }
-    return buf;
-  };
-  // reverse: each value added to its node once (per transfer, in list order: the same sums);
-  // forward: stored
+  // the boxes' rows to and from the buffers (pack_box, unpack_box)
+  auto pack = [&](const IndexBox &b, double *buf) { return pack_box(*this, data, b, buf, sv, row_step); };
   auto unpack = [&](const IndexBox &b, const double *buf) {
-    if (b.empty()) return buf;
-    const std::size_t len = std::size_t(b.hi[0] - b.lo[0] + 1) * sv;
-    for (int k = b.lo[2]; k <= b.hi[2]; ++k) {
-      double *row = data + index(b.lo[0], b.lo[1], k) * sv;
-      for (int j = b.lo[1]; j <= b.hi[1]; ++j, row += row_step, buf += len) {
-        if (reverse)
-          for (std::size_t m = 0; m < len; ++m) row[m] += buf[m];
-        else
-          std::memcpy(row, buf, len * sizeof(double));
-      }
-    }
-    return buf;
+    return unpack_box(*this, data, b, buf, sv, row_step, reverse);
   };
 
   // Self images (periodic wrap on this rank): through a buffer, in the same order.
@@ -196,7 +210,13 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
     }
   }
   if (nprocs_ == 1) return;
+  exchange_peers(send, recv, stride, box_of, pack, unpack);
+}
 
+// exchange() with the other ranks: one message per peer, its boxes in list order.
+template <class BoxOf, class Pack, class Unpack>
+void LocalGrid::exchange_peers(const std::vector<Transfer> &send, const std::vector<Transfer> &recv, int stride,
+                               BoxOf &&box_of, Pack &&pack, Unpack &&unpack) {
   // One message per peer: all boxes for that peer, in list order.
   // xcount_: values sent to / received from each peer; xoff_: their offsets in the buffers
   // (then the write positions).

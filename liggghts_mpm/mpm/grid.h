@@ -177,6 +177,9 @@ class LocalGrid {
     int shift[3];        // peer index = my index - shift (halo side)
   };
   void exchange(double *data, int stride, bool reverse);
+  template <class BoxOf, class Pack, class Unpack>
+  void exchange_peers(const std::vector<Transfer> &send, const std::vector<Transfer> &recv, int stride,
+                      BoxOf &&box_of, Pack &&pack, Unpack &&unpack);
 
   GridSpec spec_;
   MPI_Comm comm_ = MPI_COMM_NULL;

@@ -165,6 +165,12 @@ class FluidSolver {
   template <int NS> void musl_gradient();
   template <int NS, bool VOL> void pressure_moments();  // VOL: also the points' volume (rq)
   template <int NS> void couple_kernel(double h);
+  // couple_kernel's steps (coupling.cpp)
+  template <int NS> void grain_pressure_inputs(bool proj, bool weak);
+  void grain_node_state(const IndexBox &sbox, const IndexBox &rbox, bool weak);
+  template <int NS> void grain_drag_sums(std::vector<double> &Kgrain, bool proj, bool weak);
+  void drag_exchange(const IndexBox &dbox, double h);
+  template <int NS> void grain_drag_forces(const std::vector<double> &Kgrain, double h);
   template <int NS> void point_sums();             // grad_p weak: WkRec (reaction points: rq)
   void weak_pressure_gradient();                   // grad_p weak
   void weak_face_copy();                           // grad_p weak: face and padding nodes
@@ -203,9 +209,15 @@ class FluidSolver {
   // gradient L (9, row-major); stores pcell_[i]
   void sum_cell(int i, const double *L);
   void smooth_solid_volume();
+  // smooth_node_volume's steps (fluid_fraction.cpp)
+  const std::vector<double> &node_volumes();
+  void smoothing_start(std::vector<double> &a, int stride, IndexBox &nzb);
+  void smoothing_sweep(int d, int stride, const IndexBox &b, const double *V);
   double solid_node_volume(int i, int j, int k) const;
   void init_theta();
   double stable_dt();
+  void coupled_limits(const double *glob);  // stable_dt: the pore-pressure wave limits
+  std::string projection_limit(double dt, double dt_sub, const char *what, bool at_setup);  // check_timestep
   bool is_point(int i) const { return (pts.mask[i] & pts.point_bit) != 0; }
   bool is_grain(int i) const { return opt.coupled && (pts.mask[i] & pts.grain_bit) != 0; }
   double mass_min() const { return opt.mass_threshold * state.point_mass_ref; }

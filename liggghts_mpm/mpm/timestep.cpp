@@ -75,10 +75,16 @@ double FluidSolver::stable_dt() {
   const double c = c_max_, dx = opt.grid.dx;
   const double dt_ac = acoustic_dt_limit(opt.cfl, dx, c, glob[0]);
   const double dt_visc = viscous_dt_limit(dx, eos.rho0, opt.viscosity, opt.dimension);
-  // Grains an integrator moves: the pore-pressure waves (fluid_laws.h). The coupled wave limits the
-  // fluid step when the fluid is not sub-cycled; with sub-cycling the grains' own wave limits the
-  // grains' step. Largest rho_f (1 - theta) / theta over the points against the lightest moving
-  // grain.
+  coupled_limits(glob);
+  return std::min(dt_ac, dt_visc);
+}
+
+// Grains an integrator moves: the pore-pressure waves (fluid_laws.h). The coupled wave limits the
+// fluid step when the fluid is not sub-cycled; with sub-cycling the grains' own wave limits the
+// grains' step. Largest rho_f (1 - theta) / theta over the points against the lightest moving
+// grain. glob: stable_dt's reduced maxima (|v|max, ..., ratio, -theta min, -grain density min).
+void FluidSolver::coupled_limits(const double *glob) {
+  const double c = c_max_, dx = opt.grid.dx;
   couple_theta_min_ = glob[4] < 0.0 ? -glob[4] : 1.0;
   couple_rho_grain_ = glob[5] > -HUGE_VAL ? -glob[5] : 0.0;
   c_couple_ = c_grain_ = 0.0;
@@ -90,7 +96,6 @@ double FluidSolver::stable_dt() {
     dt_couple_ = acoustic_dt_limit(opt.cfl, dx, c_couple_, glob[0]);
     dt_grain_ = c_grain_ > 0.0 ? acoustic_dt_limit(opt.cfl, dx, c_grain_, glob[0]) : HUGE_VAL;
   }
-  return std::min(dt_ac, dt_visc);
 }
 
 // Once per run, under the equation of state (both reduced in stable_dt): the points' density
@@ -157,29 +162,7 @@ std::string FluidSolver::check_timestep(bool at_setup) {
   // satisfies it, the coupled one
   const double dt_sub = std::min(dt_stable_, dt_couple_);
   std::string log = range_warning();
-  if (opt.projection && (dt > dt_sub ? !opt.subcycle : at_setup)) {
-    // the limit applied: advective cfl*dx/|v|max or viscous dx^2 rho/(2 dim eta)
-    const double dt_adv = acoustic_dt_limit(cfl, dx, 0.0, vmax_);
-    const double dt_visc = viscous_dt_limit(dx, opt.rho0, opt.viscosity, opt.dimension);
-    std::ostringstream os;
-    os.precision(4);
-    os << "advective limit cfl*dx/|v|max = " << dt_adv << " (cfl = " << cfl << ", dx = " << dx << ", |v|max = " << vmax_
-       << "), viscous limit dx^2 rho/(2 dim eta) = " << dt_visc << "; "
-       << (dt_adv <= dt_visc ? "advective" : "viscous") << " limit applies";
-    // six significant digits (std::to_string printed 0.000000 for a step below 1e-6)
-    auto sig6 = [](double x) {
-      std::ostringstream t;
-      t.precision(6);
-      t << x;
-      return t.str();
-    };
-    if (dt > dt_sub)
-      throw Error("Fix mpm/fluid: " + std::string(what) + sig6(dt) + " exceeds the largest stable time step of " +
-                  "'pressure projection' (" + os.str() + "); reduce the timestep to " + sig6(dt_sub / every) +
-                  " or use keyword 'subcycle yes'" + (at_setup ? "" : " (limit reached during the run)"));
-    state.nsub = 1;
-    return "fix mpm/fluid: pressure projection, no sound speed: " + os.str() + "\n";
-  }
+  if (opt.projection && (dt > dt_sub ? !opt.subcycle : at_setup)) return projection_limit(dt, dt_sub, what, at_setup);
   if (dt <= dt_sub) {
     state.nsub = 1;
     return log;
@@ -218,6 +201,34 @@ std::string FluidSolver::check_timestep(bool at_setup) {
   }
   state.nsub = nsub;
   return log;
+}
+
+// check_timestep under 'pressure projection' (no sound speed), when the step exceeds the limit
+// without sub-cycling or at set-up: the error naming the limit that applies, else its log line.
+std::string FluidSolver::projection_limit(double dt, double dt_sub, const char *what, bool at_setup) {
+  const int every = opt.fluid_every;
+  const double cfl = opt.cfl, dx = opt.grid.dx;
+  // the limit applied: advective cfl*dx/|v|max or viscous dx^2 rho/(2 dim eta)
+  const double dt_adv = acoustic_dt_limit(cfl, dx, 0.0, vmax_);
+  const double dt_visc = viscous_dt_limit(dx, opt.rho0, opt.viscosity, opt.dimension);
+  std::ostringstream os;
+  os.precision(4);
+  os << "advective limit cfl*dx/|v|max = " << dt_adv << " (cfl = " << cfl << ", dx = " << dx << ", |v|max = " << vmax_
+     << "), viscous limit dx^2 rho/(2 dim eta) = " << dt_visc << "; "
+     << (dt_adv <= dt_visc ? "advective" : "viscous") << " limit applies";
+  // six significant digits (std::to_string printed 0.000000 for a step below 1e-6)
+  auto sig6 = [](double x) {
+    std::ostringstream t;
+    t.precision(6);
+    t << x;
+    return t.str();
+  };
+  if (dt > dt_sub)
+    throw Error("Fix mpm/fluid: " + std::string(what) + sig6(dt) + " exceeds the largest stable time step of " +
+                "'pressure projection' (" + os.str() + "); reduce the timestep to " + sig6(dt_sub / every) +
+                " or use keyword 'subcycle yes'" + (at_setup ? "" : " (limit reached during the run)"));
+  state.nsub = 1;
+  return "fix mpm/fluid: pressure projection, no sound speed: " + os.str() + "\n";
 }
 
 }  // namespace mpm

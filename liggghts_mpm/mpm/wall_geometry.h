@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mpm {
@@ -187,6 +188,27 @@ class WallGeometry {
   static void closest_point(const Tri &t, const double x[3], Hit &h);
 
  private:
+  // collect's steps (wall_constraints.cpp): the candidates nearest first (at most kCand), the hits
+  // kept (at most kMax, one per wall direction of a mesh: directions within kCos), the constraints
+  static constexpr int kCand = 512, kMax = 16;
+  static constexpr double kCos = 0.8660;  // 30 degrees
+  struct KeptHits {
+    int idx[kMax];
+    Hit hits[kMax];
+    double dd[kMax][3];   // x - closest point
+    double dir[kMax][3];  // direction of the hit (unsigned for faces)
+    bool back[kMax];      // behind the triangle's plane (one-sided meshes)
+    int nh = 0;
+  };
+  int nearest_candidates(const double x[3], double reach, const std::vector<int> *cand, int ncand,
+                         std::pair<double, int> *cl) const;
+  void keep_hits(const double x[3], double reach, double r2, const std::pair<double, int> *cl, int ncl,
+                 KeptHits &kept) const;
+  int constraints(const KeptHits &kept, double reach, double reach_fluid, double rf2, double rb2,
+                  WallConstraint *out) const;
+  // push_back's steps (wall_constraints.cpp): one crossing undone, one point out from behind
+  bool push_across(double x[3], double v[3], const double *x_old, double off) const;
+  bool push_from_behind(double x[3], double v[3], double reach, double off) const;
   void bins_build(const double box[6]);
   // Candidate triangles for a query ball (x, r); returns null if x lies outside the bins (then
   // every triangle is a candidate).

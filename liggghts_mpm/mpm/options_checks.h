@@ -1,0 +1,18 @@
+// The checks of fix mpm/fluid's settings after its keywords are read (options_checks.cpp); used by
+// the parser and fix_modify (options.cpp).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "mpm/options.h"
+
+namespace mpm {
+
+// A keyword given (seen) that another choice makes inert: an error naming it and the reason;
+// command: "" (the fix command) or "fix_modify ".
+void check_inert(const Options &o, const std::vector<std::string> &seen, const char *command);
+// parse_options after its keywords (seen; given: cell, density, bulk): the settings that follow
+// from them, the grid fitted to the bounds and the checks. Throws mpm::Error.
+void finish_options(Options &o, const std::vector<std::string> &seen, const bool given[3], const ParseEnv &env);
+
+}  // namespace mpm
