@@ -146,6 +146,14 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   if (theta)
     for (std::size_t n = 0; n < beta_.size(); ++n) beta_[n] = theta[n] / opt_.rho0;
   pressure_rhs(grid_, lab_, geo_, u_.data(), th, theta_prev, h, rhs_.data());
+  // grid damping c (update_grid): u* = (u_old + h f / m) / s, s = 1 + h c, and the step is
+  // s u = u_old + h f / m - h grad p / rho, i.e. u = u* - (h / s) grad p / rho. The solve gives
+  // that p (the source times s, the correction with h / s): the pressure of a damped fluid at
+  // rest is rho g depth. Solving with h instead gave p / s, the multiplier of the damped u*:
+  // 1 / (1 + 1e-3 s x 20 1/s) = 0.980 of rho g depth in the closed mesh box at rest
+  // (docs/theory/projection.md, "Mesh walls: the pressure beside a mesh floor").
+  const double s = 1.0 + h * opt_.damping, hs = h / s;
+  if (s != 1.0) grid_.for_owned([&](int, int, int, std::size_t n) { rhs_[n] *= s; });
   last_ = solve_rhs(p_.data(), step, "the pressure projection");
   // for the points and grains: the padding nodes behind the box walls carry the pressure (and
   // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
@@ -158,7 +166,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
     theta_last_.assign(theta, theta + grid_.size());
     have_theta_last_ = true;
   }
-  correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), h, u_.data());
+  correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), hs, u_.data());
   grid_.forward(u_.data(), 3);
   if (pvol && opt_.volume_correction > 0.0 && vc_time > 0.0)
     volume_drift(pvol, theta, h, std::min(opt_.volume_correction * vc_time, 1.0), step);
@@ -205,7 +213,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
       std::size_t mq = c;
       if (grid_.in_patch(q[0], q[1], q[2])) mq = grid_.index(q[0], q[1], q[2]);
       const bool mq_fluid = lab_.kind[mq] != kSolid;
-      for (int d = 0; d < 3; ++d) ut[d] = mq_fluid ? v[d] - h * inv_rho_[mq] * grad_[3 * mq + d] : 0.0;
+      for (int d = 0; d < 3; ++d) ut[d] = mq_fluid ? v[d] - hs * inv_rho_[mq] * grad_[3 * mq + d] : 0.0;
       for (int d = 0; d < 3; ++d) v[d] = wall_fluid ? u_[3 * c + d] : 0.0;
       if (theta && !mesh_)
         for (int d = 0; d < 3; ++d)
