@@ -13,6 +13,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "mpm/grid.h"
 #include "mpm/projection_ops.h"
@@ -86,6 +87,16 @@ class PressureSolver {
   bool any_periodic() const;
   long node_key(int i, int j, int k) const;
   long seal_components(const NodeLabels &labels);
+  long flood_from_surface(const NodeLabels &labels);
+  void least_keys(const NodeLabels &labels);
+  // solve's steps, in order (pressure_solver.cpp)
+  const NodeLabels &wall_in_enclosed(const NodeLabels &labels_in, NodeLabels &walled, PressureResult &res) const;
+  void update_active_box(const NodeLabels &labels);
+  void prepare_operator(const NodeLabels &labels, const double *beta, PressureResult &res);
+  void load_vectors(const NodeLabels &labels, const double *beta, const double *rhs, const double *p,
+                    const double *p_empty, PressureResult &res);
+  void run_pcg(PressureResult &res);
+  void store_solution(const NodeLabels &labels, double *p, const double *p_empty);
   std::map<long, std::pair<double, long>> component_sums(const std::map<long, std::pair<double, long>> &mine) const;
   bool unknown(const NodeLabels &labels, int i, int j, int k, std::size_t n) const;
 
@@ -94,6 +105,11 @@ class PressureSolver {
   PressureSettings settings_;
   ProjectionGeometry geo_;
   std::unique_ptr<Hypre> h_;
+  // sealed components (seal_components, pressure_solver_sealed.cpp): per patch node the smallest
+  // global key of the FLUID nodes its open faces connect it to, -1 where that set reaches an EMPTY
+  // node; the node whose own key it is (one per sealed component) is held at p = 0. Empty: no
+  // sealed component.
+  std::vector<double> comp_;
 };
 
 }  // namespace mpm

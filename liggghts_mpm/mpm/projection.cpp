@@ -132,12 +132,26 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   have_prev_ = true;
   LocalGrid::WorkScope scope(grid_, work ? &work_ : nullptr);
   make_labels(p2g, mmin, theta, bc.walls());
+  const double hs = solve_pressure(vel, p2g, mmin, theta, h, step);
+  correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), hs, u_.data());
+  grid_.forward(u_.data(), 3);
+  if (pvol && opt_.volume_correction > 0.0 && vc_time > 0.0)
+    volume_drift(pvol, theta, h, std::min(opt_.volume_correction * vc_time, 1.0), step);
+  else
+    drift_.clear();
+  if (acceleration_on()) acceleration_pressure(vel, theta ? theta : theta_.data(), h, p2g, mmin, step);
+  average_pressure(h);
+  set_velocities(vel, p2g, mmin, theta, h, hs, bc);
+}
+
+double Projection::solve_pressure(const double *vel, const double *p2g, double mmin, const double *theta, double h,
+                                  long step) {
   const double *theta_prev = theta && have_theta_last_ ? theta_last_.data() : nullptr;
   // u* as it is; every wall condition comes after the projection: the wall's reaction is the
   // pressure, and a wall node's velocity zeroed before it (normal or, no-slip, tangential) would
   // be moved again by the correction (measured: the F1 column at rest, docs/projection.md)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    double *v = vel + VelRec::N * n + VelRec::V_NEW;
+    const double *v = vel + VelRec::N * n + VelRec::V_NEW;
     for (int d = 0; d < 3; ++d) u_[3 * n + d] = v[d];
   });
   grid_.forward(u_.data(), 3);
@@ -146,6 +160,14 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   if (theta)
     for (std::size_t n = 0; n < beta_.size(); ++n) beta_[n] = theta[n] / opt_.rho0;
   pressure_rhs(grid_, lab_, geo_, u_.data(), th, theta_prev, h, rhs_.data());
+  // grid damping c (update_grid): u* = (u_old + h f / m) / s, s = 1 + h c, and the step is
+  // s u = u_old + h f / m - h grad p / rho, i.e. u = u* - (h / s) grad p / rho. The solve gives
+  // that p (the source times s, the correction with h / s): the pressure of a damped fluid at
+  // rest is rho g depth. Solving with h instead gave p / s, the multiplier of the damped u*:
+  // 1 / (1 + 1e-3 s x 20 1/s) = 0.980 of rho g depth in the closed mesh box at rest
+  // (docs/theory/projection.md, "Mesh walls: the pressure beside a mesh floor").
+  const double s = 1.0 + h * opt_.damping, hs = h / s;
+  if (s != 1.0) grid_.for_owned([&](int, int, int, std::size_t n) { rhs_[n] *= s; });
   last_ = solve_rhs(p_.data(), step, "the pressure projection");
   // for the points and grains: the padding nodes behind the box walls carry the pressure (and
   // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
@@ -158,14 +180,11 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
     theta_last_.assign(theta, theta + grid_.size());
     have_theta_last_ = true;
   }
-  correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), h, u_.data());
-  grid_.forward(u_.data(), 3);
-  if (pvol && opt_.volume_correction > 0.0 && vc_time > 0.0)
-    volume_drift(pvol, theta, h, std::min(opt_.volume_correction * vc_time, 1.0), step);
-  else
-    drift_.clear();
-  if (acceleration_on()) acceleration_pressure(vel, th, h, p2g, mmin, step);
-  average_pressure(h);
+  return hs;
+}
+
+void Projection::set_velocities(double *vel, const double *p2g, double mmin, const double *theta, double h,
+                                double hs, Boundaries &bc) {
   if (mesh_) {
     // nodes behind mesh walls: the projected velocity of the fluid in front, then the wall
     // condition (the normal velocity relative to the wall removed), as the padding nodes
@@ -175,49 +194,52 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     double *v = vel + VelRec::N * n + VelRec::V_NEW;
     const double m = p2g[P2gRec::N * n + P2gRec::M];
+    if (!(m > mmin && m > 0.0)) return;  // no fluid: velocity stays 0
     if (mesh_ && behind_mesh(i, j, k, n)) {
-      if (!(m > mmin && m > 0.0)) return;
       for (int d = 0; d < 3; ++d) v[d] = u_ext_[3 * n + d];
       bc.apply(v, i, j, k, h);
       return;
     }
     if (lab_.kind[n] == kSolid) {
-      // padding nodes behind the box walls (in the points' stencils): the projected velocity of
-      // the wall node in front, with the wall condition. Their own u* is not projected; left as
-      // it is, it would let the points next to a free-slip wall fall through the rest state. An
-      // EMPTY wall node's velocity (extrapolated from the fluid) counts too: with 0 there the
-      // points along the back wall of the dam break hung back (wall height 0.15 a off at MPM24).
-      if (!(m > mmin && m > 0.0)) return;
-      const std::size_t c = wall_node(i, j, k);
-      const bool wall_fluid = lab_.kind[c] != kSolid;
-      // with grains (box walls only): the components along the walls (periodic or tangential)
-      // keep the node's own u* corrected by the pressure gradient of its mirror node inside (the
-      // node its share of the grains' volume is folded to, and whose gradient the grains read
-      // here: mirror_to_padding), a pressure force on its mass and no other change of momentum.
-      // Copying the wall node's velocity changed the momentum of this mass by m (u_wall - u*),
-      // among others the drag the grains near the wall gave it: with a constant force on the
-      // grains of a box periodic in x and y, cells of 3 grain diameters, 0.03 s, the x momentum of
-      // fluid and grains 3.1 % above the impulse, 0.19 % without the copy (docs/projection.md,
-      // "Momentum of grains and fluid")
-      const int q[3] = {opt_.grid.mirror(i, 0), opt_.grid.mirror(j, 1), opt_.grid.mirror(k, 2)};
-      const int idx[3] = {i, j, k};
-      double ut[3];
-      std::size_t mq = c;
-      if (grid_.in_patch(q[0], q[1], q[2])) mq = grid_.index(q[0], q[1], q[2]);
-      const bool mq_fluid = lab_.kind[mq] != kSolid;
-      for (int d = 0; d < 3; ++d) ut[d] = mq_fluid ? v[d] - h * inv_rho_[mq] * grad_[3 * mq + d] : 0.0;
-      for (int d = 0; d < 3; ++d) v[d] = wall_fluid ? u_[3 * c + d] : 0.0;
-      if (theta && !mesh_)
-        for (int d = 0; d < 3; ++d)
-          if (q[d] == idx[d]) v[d] = ut[d];
-      bc.apply(v, i, j, k, h);
-      mirror_normal(v, i, j, k, p2g, mmin);
+      padding_velocity(v, i, j, k, theta != nullptr, h, hs, bc, p2g, mmin);
       return;
     }
-    if (!(m > mmin && m > 0.0)) return;  // no fluid: velocity stays 0
     for (int d = 0; d < 3; ++d) v[d] = u_[3 * n + d];
     bc.apply(v, i, j, k, h);
   });
+}
+
+/* Padding node (i, j, k) behind the box walls (in the points' stencils), holding mass: the
+   projected velocity of the wall node in front, with the wall condition. Its own u* is not
+   projected; left as it is, it would let the points next to a free-slip wall fall through the rest
+   state. An EMPTY wall node's velocity (extrapolated from the fluid) counts too: with 0 there the
+   points along the back wall of the dam break hung back (wall height 0.15 a off at MPM24). */
+void Projection::padding_velocity(double *v, int i, int j, int k, bool grains, double h, double hs, Boundaries &bc,
+                                  const double *p2g, double mmin) const {
+  const std::size_t c = wall_node(i, j, k);
+  const bool wall_fluid = lab_.kind[c] != kSolid;
+  // with grains (box walls only): the components along the walls (periodic or tangential)
+  // keep the node's own u* corrected by the pressure gradient of its mirror node inside (the
+  // node its share of the grains' volume is folded to, and whose gradient the grains read
+  // here: mirror_to_padding), a pressure force on its mass and no other change of momentum.
+  // Copying the wall node's velocity changed the momentum of this mass by m (u_wall - u*),
+  // among others the drag the grains near the wall gave it: with a constant force on the
+  // grains of a box periodic in x and y, cells of 3 grain diameters, 0.03 s, the x momentum of
+  // fluid and grains 3.1 % above the impulse, 0.19 % without the copy (docs/projection.md,
+  // "Momentum of grains and fluid")
+  const int q[3] = {opt_.grid.mirror(i, 0), opt_.grid.mirror(j, 1), opt_.grid.mirror(k, 2)};
+  const int idx[3] = {i, j, k};
+  double ut[3];
+  std::size_t mq = c;
+  if (grid_.in_patch(q[0], q[1], q[2])) mq = grid_.index(q[0], q[1], q[2]);
+  const bool mq_fluid = lab_.kind[mq] != kSolid;
+  for (int d = 0; d < 3; ++d) ut[d] = mq_fluid ? v[d] - hs * inv_rho_[mq] * grad_[3 * mq + d] : 0.0;
+  for (int d = 0; d < 3; ++d) v[d] = wall_fluid ? u_[3 * c + d] : 0.0;
+  if (grains && !mesh_)
+    for (int d = 0; d < 3; ++d)
+      if (q[d] == idx[d]) v[d] = ut[d];
+  bc.apply(v, i, j, k, h);
+  mirror_normal(v, i, j, k, p2g, mmin);
 }
 
 /* Padding node (i, j, k) behind the box walls: along each direction d in which it lies behind a

@@ -87,6 +87,16 @@ class Projection {
 
  private:
   void make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls);
+  // project's steps. solve_pressure: u* from vel into u_, the solve into p_, its gradient grad_ and
+  // the points' and grains' copies (p_ext_, grad_ext_); returns the step of the correction,
+  // h / (1 + h damping). set_velocities: the projected velocity with the wall conditions into
+  // vel's V_NEW at the owned nodes holding mass (behind mesh walls and in the padding too);
+  // padding_velocity: that of one padding node behind the box walls (grains: theta given)
+  double solve_pressure(const double *vel, const double *p2g, double mmin, const double *theta, double h, long step);
+  void set_velocities(double *vel, const double *p2g, double mmin, const double *theta, double h, double hs,
+                      Boundaries &bc);
+  void padding_velocity(double *v, int i, int j, int k, bool grains, double h, double hs, Boundaries &bc,
+                        const double *p2g, double mmin) const;
   // mesh walls: closes the faces the triangles cross (with the wall velocity), makes the nodes
   // within 2 cells behind a one-sided wall SOLID, and fills frac_ (fluid-side share of a node's
   // dual cell, for the surface threshold)
@@ -119,6 +129,10 @@ class Projection {
   double mirror_sum(const std::vector<double> &a, int i, int j, int k) const;
   void extrapolate_above_surface(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
                                  bool with_p);
+  // its steps: the components along the surface of the first layer's gradient, one layer further
+  void gradient_along_surface(std::vector<double> &grad);
+  void extrapolation_pass(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
+                          bool with_p);
   void extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const;
   // with grains: the padding nodes behind the box walls take the gradient of their mirror node
   // inside (the node their share of the grains' volume is folded to, FluidSolver::fluid_fraction),

@@ -335,35 +335,40 @@ void Projection::extend_to_padding(const std::vector<double> &a, std::vector<dou
    alone (the grains' gradient of the acceleration pressure, whose p the points read unextended). */
 void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::vector<double> &p,
                                            std::vector<double> &grad, bool with_p) {
-  const double dx = opt_.grid.dx;
-  // per node: 1 if its gradient (gk) / pressure (pk) is known: FLUID nodes, and EMPTY nodes next
+  // per node: 1 if its gradient (gk_) / pressure (pk_) is known: FLUID nodes, and EMPTY nodes next
   // to a FLUID one for the gradient (pressure_gradient's one-sided surface face)
-  std::vector<double> &gk = gk_, &pk = pk_;
-  zero_for_sweep(gk);
-  zero_for_sweep(pk);
+  zero_for_sweep(gk_);
+  zero_for_sweep(pk_);
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kFluid) {
-      gk[n] = pk[n] = 1.0;
+      gk_[n] = pk_[n] = 1.0;
       return;
     }
     if (lab_.kind[n] != kEmpty) return;
     for (int d = 0; d < 3; ++d)
       for (int side = -1; side <= 1; side += 2) {
         std::size_t m;
-        if (open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kFluid) gk[n] = 1.0;
+        if (open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kFluid) gk_[n] = 1.0;
       }
   });
-  // An EMPTY node next to the fluid has from pressure_gradient only the components along its faces
-  // to FLUID nodes: above a level surface the vertical one, and 0 along the surface, so the points
-  // near the surface read an unaccelerated velocity along it from the nodes above them and the
-  // standing wave ran slow (20 cells across: 0.962 of its frequency). The other components are
-  // the mean of the FLUID neighbours' (docs/theory/projection.md, "Free surface: the gradient
-  // along the surface").
-  {
+  gradient_along_surface(grad);
+  grid_.forward(gk_.data(), 1);
+  grid_.forward(pk_.data(), 1);
+  grid_.forward(grad.data(), 3);
+  for (int pass = 0; pass < 3; ++pass) extrapolation_pass(p2g, mmin, p, grad, with_p);
+}
+
+/* An EMPTY node next to the fluid has from pressure_gradient only the components along its faces
+   to FLUID nodes: above a level surface the vertical one, and 0 along the surface, so the points
+   near the surface read an unaccelerated velocity along it from the nodes above them and the
+   standing wave ran slow (20 cells across: 0.962 of its frequency). The other components are the
+   mean of the FLUID neighbours' (docs/theory/projection.md, "Free surface: the gradient along the
+   surface"). Owned nodes (halos not forwarded). */
+void Projection::gradient_along_surface(std::vector<double> &grad) {
   std::vector<std::pair<std::size_t, int>> fill;
   std::vector<double> val;
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (lab_.kind[n] != kEmpty || gk[n] == 0.0) return;
+    if (lab_.kind[n] != kEmpty || gk_[n] == 0.0) return;
     for (int d = 0; d < 3; ++d) {
       bool along = false;
       for (int side = -1; side <= 1; side += 2) {
@@ -388,51 +393,53 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
     }
   });
   for (std::size_t q = 0; q < fill.size(); ++q) grad[3 * fill[q].first + fill[q].second] = val[q];
-  }
+}
+
+/* One layer of the continuation above the surface: an EMPTY node holding fluid whose gradient is
+   not known takes the mean of its face neighbours' that are known, and one whose pressure is not
+   known the linear continuation from the neighbours whose pressure is (with_p). The nodes that
+   become known in a pass are marked after it (the pass reads the flags before it); halos
+   forwarded. */
+void Projection::extrapolation_pass(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
+                                    bool with_p) {
+  const double dx = opt_.grid.dx;
+  std::vector<double> &gk = gk_, &pk = pk_;
+  std::vector<std::size_t> gnew, pnew;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] != kEmpty) return;
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    if (!(m > mmin && m > 0.0)) return;
+    double g[3] = {0, 0, 0}, psum = 0.0;
+    int ng = 0, np = 0;
+    for (int d = 0; d < 3; ++d)
+      for (int side = -1; side <= 1; side += 2) {
+        std::size_t q;
+        if (!open_face(grid_, lab_, i, j, k, d, side, &q)) continue;
+        if (gk[q] != 0.0) {
+          for (int e = 0; e < 3; ++e) g[e] += grad[3 * q + e];
+          ++ng;
+        }
+        // x_n - x_q = -side dx e_d
+        if (with_p && gk[n] != 0.0 && pk[q] != 0.0) {
+          psum += p[q] - side * dx * grad[3 * n + d];
+          ++np;
+        }
+      }
+    if (gk[n] == 0.0 && ng > 0) {
+      for (int e = 0; e < 3; ++e) grad[3 * n + e] = g[e] / ng;
+      gnew.push_back(n);
+    }
+    if (pk[n] == 0.0 && np > 0) {
+      p[n] = psum / np;
+      pnew.push_back(n);
+    }
+  });
+  for (const std::size_t n : gnew) gk[n] = 1.0;
+  for (const std::size_t n : pnew) pk[n] = 1.0;
   grid_.forward(gk.data(), 1);
   grid_.forward(pk.data(), 1);
   grid_.forward(grad.data(), 3);
-  // the nodes that become known in a pass are marked after it (the pass reads the flags before it)
-  std::vector<std::size_t> gnew, pnew;
-  for (int pass = 0; pass < 3; ++pass) {
-    gnew.clear();
-    pnew.clear();
-    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-      if (lab_.kind[n] != kEmpty) return;
-      const double m = p2g[P2gRec::N * n + P2gRec::M];
-      if (!(m > mmin && m > 0.0)) return;
-      double g[3] = {0, 0, 0}, psum = 0.0;
-      int ng = 0, np = 0;
-      for (int d = 0; d < 3; ++d)
-        for (int side = -1; side <= 1; side += 2) {
-          std::size_t q;
-          if (!open_face(grid_, lab_, i, j, k, d, side, &q)) continue;
-          if (gk[q] != 0.0) {
-            for (int e = 0; e < 3; ++e) g[e] += grad[3 * q + e];
-            ++ng;
-          }
-          // x_n - x_q = -side dx e_d
-          if (with_p && gk[n] != 0.0 && pk[q] != 0.0) {
-            psum += p[q] - side * dx * grad[3 * n + d];
-            ++np;
-          }
-        }
-      if (gk[n] == 0.0 && ng > 0) {
-        for (int e = 0; e < 3; ++e) grad[3 * n + e] = g[e] / ng;
-        gnew.push_back(n);
-      }
-      if (pk[n] == 0.0 && np > 0) {
-        p[n] = psum / np;
-        pnew.push_back(n);
-      }
-    });
-    for (const std::size_t n : gnew) gk[n] = 1.0;
-    for (const std::size_t n : pnew) pk[n] = 1.0;
-    grid_.forward(gk.data(), 1);
-    grid_.forward(pk.data(), 1);
-    grid_.forward(grad.data(), 3);
-    if (with_p) grid_.forward(p.data(), 1);
-  }
+  if (with_p) grid_.forward(p.data(), 1);
 }
 
 }  // namespace mpm

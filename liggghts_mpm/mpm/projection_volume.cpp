@@ -119,13 +119,14 @@ bool Projection::deep_inside(int i, int j, int k) const {
    the velocity field and the forces alone: with Du/Dt = a_f - grad p / rho and div u = 0,
        div(beta grad p) = div(theta (a_f - (u . grad) u)),   no normal acceleration at walls,
    p = 0 at the free surface. Here u is the projected velocity, a_f the grid forces per mass of the
-   step (gravity, viscosity, drag, damping: (u* - u_old) / h), (u . grad) u by central differences
+   step (gravity, viscosity, drag: (u* - u_old) / h, with grid damping c (1 + h c) u* in place of u*,
+   and the damping's - c u), (u . grad) u by central differences
    between FLUID nodes (one-sided next to a non-FLUID node). The same operator and labels as the
    projection: at rest it is the projection's hydrostatic pressure. Not in it: d(theta)/dt of moving
    grains, the acceleration of walls. */
 void Projection::acceleration_pressure(const double *vel, const double *theta, double h, const double *p2g,
                                       double mmin, long step) {
-  const double inv2dx = 0.5 / opt_.grid.dx, invdx = 1.0 / opt_.grid.dx;
+  const double inv2dx = 0.5 / opt_.grid.dx, invdx = 1.0 / opt_.grid.dx, c = opt_.damping;
   const long s[3] = {1, static_cast<long>(grid_.stride_y()), static_cast<long>(grid_.stride_z())};
   grid_.for_owned([&](int, int, int, std::size_t n) {
     double *a = &acc_[3 * n];
@@ -137,6 +138,8 @@ void Projection::acceleration_pressure(const double *vel, const double *theta, d
     // V_NEW still holds u*: the forces of the step per mass
     for (int d = 0; d < 3; ++d) a[d] = (rec[VelRec::V_NEW + d] - rec[VelRec::V_OLD + d]) / h;
     const double *u = &u_[3 * n];
+    if (c > 0.0)  // damped u* = (u_old + h f / m) / (1 + h c): the forces f / m and the damping's - c u
+      for (int d = 0; d < 3; ++d) a[d] = ((1.0 + h * c) * rec[VelRec::V_NEW + d] - rec[VelRec::V_OLD + d]) / h - c * u[d];
     for (int e = 0; e < 3; ++e) {  // - u_e d/dx_e u
       const std::size_t lo = n - s[e], hi = n + s[e];
       const bool fl = lab_.kind[lo] == kFluid, fh = lab_.kind[hi] == kFluid;

@@ -4,9 +4,10 @@ fix mpm/fluid (f_ID[20..], docs/fix_mpm_fluid.md "Wall loads and probes"). Stand
 
     test_wall_force.py CASE --exe build/liggghts_mpm --work DIR [--mpirun "mpirun ..."]
 
-CASE is one of: plate_projection, plate_projection_np2, plate_eos, lifters_projection, box_projection, probe_projection, probe_eos,
-bad_input. The inputs are tests/data/in.wall_force_plate and in.wall_force_lifters; the STL files
-are written here (a plane plate) or by tools/make_drum_stl.py (a drum with two lifter bars).
+CASE is one of: plate_projection, plate_projection_np2, plate_eos, lifters_projection, box_projection,
+box_probe_projection, probe_projection, probe_eos, bad_input. The inputs are tests/data/in.wall_force_plate,
+in.wall_force_lifters and tests/data/in.mesh_walls_box; the STL files are tests/data/box.stl, written here
+(a plane plate) or by tools/make_drum_stl.py (a drum with two lifter bars).
 
 The references come from the water's mass distribution alone (momentum balance at rest):
   * plate: water held between the grid face x = 0 and a vertical plate at x = xp, at rest. The
@@ -129,9 +130,10 @@ def case_lifters_projection(r):
 
 
 def lifters_checks(d, label):
-    """Measured (docs/fix_mpm_fluid.md, "Wall loads and probes"): F_z +3.8 %, T_y -5.3 %. The
-    acceptance of 1 % is not met; the bounds below hold what was measured (5 %, 8 %) so that a
-    change that makes it worse is seen."""
+    """Measured (docs/validation/wall_loads.md): F_z +4.87 %, T_y -4.34 % (+3.8 %, -5.3 % with the
+    pressure of the damped velocity, 1 / (1 + h c) of the damped fluid's). The acceptance of 1 % is
+    not met; the bounds below were set for +3.8 % and -5.3 % (5 %, 8 %) so that a change that makes
+    it worse is seen."""
     v = {k: c[0] for k, c in read_csv(os.path.join(d, "wall_force_lifters.csv")).items()}
     fx, fy, fz, tx, ty, tz = read_ave(os.path.join(d, "wall_force_ave.txt"))
     W = v["mass"] * v["g"]
@@ -145,9 +147,9 @@ def lifters_checks(d, label):
 
 def case_box_projection(r):
     """Closed mesh box (tests/data/box.stl, 0.3 m) holding water 0.15 m deep at rest, dx = 2.5 cm:
-    the mesh carries the weight. Measured -2.1 % (the pressure's gradient is 2 % below rho g beside
-    the mesh floor: the velocity condition at the floor nodes carries the rest); acceptance 1 %:
-    not met; the bound 3 % holds the measured state."""
+    the mesh carries the weight. Measured -0.14 % (-2.1 % while the solve's pressure was that of the
+    damped velocity, 1 / (1 + h c) of the damped fluid's; docs/theory/projection.md "Mesh walls");
+    the bound 3 % is the one set for -2.1 %."""
     d = r.fresh("wall_force_box_projection")
     with open(os.path.join(DATA, "in.mesh_walls_box")) as f:
         text = f.read()
@@ -165,8 +167,57 @@ def case_box_projection(r):
     W = v["mass"] * v["g"]
     print(f"  box projection: F_z {fz:.5g} N against -M g = {-W:.5g} N ({-fz / W - 1:+.2%}); F_x {fx:.2g}, "
           f"F_y {fy:.2g} N; largest speed {v['vmax']:.2g} m/s")
-    check(abs(-fz / W - 1) < 0.03, "box projection: the mesh carries the weight within 3 % (acceptance 1 %: not met)")
+    check(abs(-fz / W - 1) < 0.03, "box projection: the mesh carries the weight within 3 %")
     check(abs(fx) < 1e-3 * W and abs(fy) < 1e-3 * W, "box projection: sideways force below 0.1 % of the weight")
+
+
+# the closed mesh box's probes: (x, y, z) and what they stand for; the box spans [0.1, 0.4]^3
+# (not on the box's vertical edges near the floor: nodes outside such an edge that lie in a wall's
+# plane are labelled on the fluid side, EMPTY with a trace of mass, and give the nodes behind the
+# walls p = 0; measured -22.6 % at the corner (0.1, 0.1, 0.1), docs/theory/projection.md "Mesh walls")
+BOX_PROBES = ((0.25, 0.25, 0.1, "on the mesh floor"), (0.25, 0.25, 0.175, "at mid-depth"),
+              (0.1, 0.25, 0.175, "on a vertical mesh wall at mid-depth"), (0.1, 0.25, 0.1, "on the floor's edge"))
+
+
+def box_probe_run(r, case, extra):
+    """The closed mesh box of case box_projection (dx 2.5 cm, fluid step 1e-3 s, grid damping 20 1/s),
+    0.6 s from the hydrostatic fill, with the probes BOX_PROBES averaged over the last 0.1 s."""
+    d = r.fresh(case)
+    with open(os.path.join(DATA, "in.mesh_walls_box")) as f:
+        text = f.read()
+    probes = " ".join(f"probe point {x} {y} {z}" for x, y, z, _ in BOX_PROBES)
+    text = text.replace("pressure eos bulk ${bulk} ", "").replace("timestep        ${tstep}", "timestep        1e-3")
+    text = text.replace("hydrostatic z ${top} ${g}", f"hydrostatic z ${{top}} ${{g}} {extra} {probes} probe_window 0.1")
+    cols = " ".join(f"f_fluid[{26 + j}]" for j in range(len(BOX_PROBES)))
+    text = text.replace("run             ${steps}", f"fix             pr all ave/time ${{steps}} 1 ${{steps}} {cols} "
+                        "file probe.txt\nrun             ${steps}")
+    with open(os.path.join(d, "in.box"), "w") as f:
+        f.write(text)
+    import shutil
+    shutil.copy(os.path.join(DATA, "box.stl"), d)
+    r.execute(d, "in.box", {"dx": 0.025, "steps": 600})
+    return d
+
+
+def case_box_probe_projection(r):
+    """Probes in the closed mesh box at rest read rho g (H - z) within 0.5 %, H = M / (rho A) from the
+    mass: on the mesh floor, at mid-depth, on a vertical mesh wall and on the edge between floor and
+    wall, for the
+    solve's pressure and for the acceleration pressure. With grid damping c the solve gave the
+    multiplier of the damped velocity, 1 / (1 + h c) = 0.980 of rho g depth at every probe here
+    (docs/theory/projection.md, "Mesh walls"); measured after: within 0.01 %."""
+    for extra, label in (("", "multiplier"), ("pressure_output acceleration", "acceleration pressure")):
+        d = box_probe_run(r, "wall_force_box_probe" + ("_acc" if extra else ""), extra)
+        v = {k: c[0] for k, c in read_csv(os.path.join(d, "mesh_walls_box.csv")).items()}
+        rows = [ln.split() for ln in open(os.path.join(d, "probe.txt")) if ln.strip() and not ln.startswith("#")]
+        lo, side = 0.1, 0.3
+        H = lo + v["mass"] / (v["rho"] * side * side)
+        for (x, y, z, where), pv in zip(BOX_PROBES, rows[-1][1:]):
+            ref = v["rho"] * v["g"] * (H - z)
+            err = float(pv) / ref - 1
+            print(f"  {label}, probe {where} ({x}, {y}, {z}): {float(pv):.6g} Pa against rho g (H - z) = "
+                  f"{ref:.6g} Pa ({err:+.3%})")
+            check(abs(err) < 0.005, f"{label}: probe {where} within 0.5 % of rho g depth")
 
 
 def probe_checks(d, label, eos):
