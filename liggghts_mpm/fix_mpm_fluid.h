@@ -77,6 +77,8 @@ class FixMpmFluid : public Fix {
 
   int parse_mesh_wall(int narg, char **arg, int iarg);
   void fill_points();
+  void create_point(const double *x, double vol);
+  void finish_fill(int nlocal_before, double vol);
   void check_fill_memory(class Region *region, const int lo[3], const int hi[3]);
   void refresh_walls();
   void check_gate_side();

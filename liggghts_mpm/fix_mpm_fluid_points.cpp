@@ -234,22 +234,37 @@ void FixMpmFluid::fill_points() {
               bool mine = true;
               for (int d = 0; d < 3; ++d) mine = mine && x[d] >= domain->sublo[d] && x[d] < domain->subhi[d];
               if (!mine) continue;
-              atom->avec->create_atom(o.fill_type, x);
-              const int n = atom->nlocal - 1;
-              for (int m = 0; m < modify->nfix; ++m) {
-                Fix *f = modify->fix[m];
-                if (f && f->create_attribute && f != this) {
-                  f->pre_set_arrays();
-                  f->set_arrays(n);
-                }
-              }
-              atom->mask[n] |= groupbit;
-              atom->v[n][0] = atom->v[n][1] = atom->v[n][2] = 0.0;
-              atom->rmass[n] = solver->init_point(x, vol, pdata[n]);
-              atom->radius[n] = 0.5 * std::min(spacing[0], std::min(spacing[1], spacing[2]));
-              if (atom->density_flag && atom->density) atom->density[n] = o.eos.rho0;
+              create_point(x, vol);
             }
+  finish_fill(nlocal_before, vol);
+}
 
+/* One material point at x of volume vol, at rest, in the fix's group (the other fixes' per-atom
+   arrays set as for any new atom). */
+void FixMpmFluid::create_point(const double *x, double vol) {
+  const mpm::Options &o = solver->opt;
+  const double *spacing = solver->state.spacing;
+  atom->avec->create_atom(o.fill_type, const_cast<double *>(x));
+  const int n = atom->nlocal - 1;
+  for (int m = 0; m < modify->nfix; ++m) {
+    Fix *f = modify->fix[m];
+    if (f && f->create_attribute && f != this) {
+      f->pre_set_arrays();
+      f->set_arrays(n);
+    }
+  }
+  atom->mask[n] |= groupbit;
+  atom->v[n][0] = atom->v[n][1] = atom->v[n][2] = 0.0;
+  atom->rmass[n] = solver->init_point(x, vol, pdata[n]);
+  atom->radius[n] = 0.5 * std::min(spacing[0], std::min(spacing[1], spacing[2]));
+  if (atom->density_flag && atom->density) atom->density[n] = o.eos.rho0;
+}
+
+/* After fill_points created its points: the global count (none is an error), tags, the atom map,
+   the reference point mass and the note on the screen and in the log. */
+void FixMpmFluid::finish_fill(int nlocal_before, double vol) {
+  const mpm::Options &o = solver->opt;
+  const mpm::GridSpec &gs = o.grid;
   bigint nnew = atom->nlocal - nlocal_before, nall = 0;
   MPI_Allreduce(&nnew, &nall, 1, MPI_LMP_BIGINT, MPI_SUM, world);
   if (nall == 0) error->all(FLERR, "Fix mpm/fluid: keyword 'fill' created no material points (region empty?)");
