@@ -134,12 +134,12 @@ InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bo
 // theta_sat zeta/g becomes the exponential steady-ablation profile, so that the
 // surface gradient is theta_sat/g F(w g) and the bottom one smaller by
 // exp(-w g); their difference w theta_sat heats the vaporized liquid from T_m
-// to T_sat (docs/laser_model.md, "Energy-consistent melt layer").
+// to T_sat (docs/theory/laser_model.md, "Energy-consistent melt layer").
 InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected = false);
 // The same with the flow's part of the gradients tied to the surface temperature,
 // b2 g = beta theta_sat - gamma (beta >= 0): the layer gives the heat its outflow
 // carries at its own temperature and takes gamma from upstream (--melt-heat flux,
-// docs/laser_model.md 2.7). Every term still rises with phi: one bracketed root.
+// docs/theory/laser_model.md 2.7). Every term still rises with phi: one bracketed root.
 InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
                                     bool advected = false);
 // Nondimensional vaporization recession rate dS1/dtau by (3-25).
@@ -150,7 +150,7 @@ double recession_rate_from_flux(const Material& m, double R, const InterfaceStat
 
 // ------------------------------------------------------------ solid conduction
 // Pre-melting surface temperature, (3-26) at n = 0, with the coefficient 2 of
-// the classical constant-flux solution (see docs/laser_model.md).
+// the classical constant-flux solution (see docs/theory/laser_model.md).
 double premelt_temperature(const Groups& G, double xi, double n, double tau);
 // Melt onset time (3-27) consistent with premelt_temperature.
 double melt_onset_tau(const Groups& G, double xi);

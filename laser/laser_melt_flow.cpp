@@ -88,7 +88,7 @@ bool Drill::solve_melt_flow(double ta, double tb) {
   return true;
 }
 
-// Flux-conservative surface velocity (docs/laser_model.md, 2.6): the layer's
+// Flux-conservative surface velocity (docs/theory/laser_model.md, 2.6): the layer's
 // volume flux per unit circumference Q = int_0^g u dzeta = f g^2/2 (u = f zeta)
 // crosses the cell faces xi_(k+1/2) = (k + 1/2) d(xi), which bound exactly the
 // node areas; dg/dtau = -(1/xi) d(xi Q)/dxi = v(xi, g) - u(xi, g) dg/dxi. The
@@ -283,7 +283,7 @@ void Drill::melt_temperature() {
   }
 }
 
-// --melt-heat flux (docs/laser_model.md 2.7): the heat the flow carries through
+// --melt-heat flux (docs/theory/laser_model.md 2.7): the heat the flow carries through
 // the cell faces, volume rate q = |c_k| g_up^2 at the flux-weighted mean
 // temperature 2 theta_sat/3 of the upwind layer, and the layer's gradients
 // 2 b2 g = D (heat per unit area and time leaving the column) are solved

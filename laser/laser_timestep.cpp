@@ -23,7 +23,7 @@ constexpr double kStableFraction = 0.25;
 // limit of (4-14) at the quasi-steady centre state. The linearisation is not the
 // worst state of a run: in the first steps after onset, when the layer is a few
 // steps thick, the run-time check fired from 0.85 of it (Table 5.1, 7.5e10 W/m2,
-// rising and rising-fall; docs/laser_model.md 2.8), i.e. only after running. At
+// rising and rising-fall; docs/theory/laser_model.md 2.8), i.e. only after running. At
 // half of it no run has become unstable, and the automatic step's companion at
 // 2 dt (a quarter of the limit x 2) is exactly at this bound.
 constexpr double kAcceptFraction = 0.5;

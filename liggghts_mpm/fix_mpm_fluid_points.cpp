@@ -41,7 +41,7 @@ using namespace FixConst;
 using mpm::NCOL;
 
 
-/* mesh_wall fix-ID kind [value] [side s] (the meshes are LIGGGHTS fixes; docs/mesh_walls.md) */
+/* mesh_wall fix-ID kind [value] [side s] (the meshes are LIGGGHTS fixes; docs/theory/mesh_walls.md) */
 int FixMpmFluid::parse_mesh_wall(int narg, char **arg, int iarg) {
   using mpm::bad_arg;
   using mpm::parse_double;

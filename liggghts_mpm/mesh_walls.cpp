@@ -1,5 +1,5 @@
 // Fluid boundary conditions on LIGGGHTS wall meshes: reading the meshes and gathering their
-// triangles; see mesh_walls.h and docs/mesh_walls.md.
+// triangles; see mesh_walls.h and docs/theory/mesh_walls.md.
 #include "mesh_walls.h"
 
 #include <mpi.h>

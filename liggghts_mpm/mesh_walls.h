@@ -1,5 +1,5 @@
 // Fluid boundary conditions on LIGGGHTS wall meshes (fix mesh/surface, moved or not by
-// fix move/mesh) for the MPM grid of fix mpm/fluid. User and developer notes: docs/mesh_walls.md.
+// fix move/mesh) for the MPM grid of fix mpm/fluid. User and developer notes: docs/theory/mesh_walls.md.
 //
 // MeshWalls reads the triangles of the named meshes (node positions and the per-node velocity
 // property "v" that fix move/mesh and the surface-velocity options of fix mesh/surface maintain)

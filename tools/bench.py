@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Benchmark harness (docs/performance.md).
+"""Benchmark harness (docs/validation/performance.md).
 
   tools/python tools/bench.py [--quick] [--out DIR] [--np 2] [--only SECTION ...]
 
@@ -402,7 +402,7 @@ def section_coupling(a):
     tank = os.path.join(TOP, "inputs", "tank", "in.tank")
     short = ["-var", "tdry", "0.0004", "-var", "tsnap", "0.0001", "-var", "tsettle", "0.0005",
              "-var", "tend", "0.0005", "-var", "tfront", "0.0001"]
-    # the fluid every step with the weakly compressible model, as docs/performance.md measured it
+    # the fluid every step with the weakly compressible model, as docs/validation/performance.md measured it
     # (in.tank defaults to the projection with the fluid every 10 DEM steps)
     short += ["-var", "pressure", "eos", "-var", "wallkind", "noslip", "-var", "damp", "100",
               "-var", "extra", "transfer apic theta_smooth 0.01"]

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Inviscid early-time kinetic energy of a water column released at one face (docs/projection.md,
+"""Inviscid early-time kinetic energy of a water column released at one face (docs/theory/projection.md,
 "The released column"): the reference of inputs/tank/in.column, computed from the inputs alone by
 two independent methods.
 

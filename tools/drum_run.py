@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Runs and checks the wet tumbling mill inputs/drum/in.drum (CASES.md C7, docs/drum.md).
+"""Runs and checks the wet tumbling mill inputs/drum/in.drum (CASES.md C7, docs/validation/drum.md).
 
 run:     writes drum.stl (tools/make_drum_stl.py), sets the mixture height hfill so that the water
          fills a third of the drum's inside for the chosen bead count, runs liggghts_mpm in a work

@@ -11,7 +11,7 @@ forward 6 + 12.
 
   tools/python tools/halo_volume.py [--halo 5]
 
-Prints a Markdown table (docs/scaling.md): uniform cuts, non-periodic grid, bspline2 (pad 1).
+Prints a Markdown table (docs/guide/mpi.md): uniform cuts, non-periodic grid, bspline2 (pad 1).
 """
 import argparse
 import itertools

@@ -7,7 +7,7 @@ Runs the cases it needs into --work/<melt layer>/ (a few seconds each, skipped w
 the run directory already has a summary.json) and writes fig3_7.png ... fig5_8.png
 into --work. --melt-energy text draws the dissertation's linear melt layer (the
 model of chapter 5); the default is laser_drill's default, the energy-consistent
-advected layer, whose holes are 16-22 % shallower (docs/laser_model.md 2.9).
+advected layer, whose holes are 16-22 % shallower (docs/theory/laser_model.md 2.9).
 With --sweep, Figure 5.1 uses DIR/sweep.csv of tools/laser_sweep.py.
 """
 import argparse
@@ -225,7 +225,7 @@ def main():
     fig_history(a.work, d, "fig5_6.png", r"Fig. 5.6: rising-fall $\xi_p$ = 0.6, 7.5e10 W/m$^2$")
     d = R.get("I7.5e+10_rf1", ["--intensity", 7.5e10, "--xi-p", "1"])
     fig_rates(a.work, d, "fig5_7.png", "Fig. 5.7: rates, Pr = 0.142, rising-fall $\\xi_p$ = 1")
-    # the explicit update (4-14) is unstable for Pr = 142 (docs/laser_model.md)
+    # the explicit update (4-14) is unstable for Pr = 142 (docs/theory/laser_model.md)
     d = R.get("pr142_rf1", ["--pr", 142, "--xi-p", "1", "--melt-update", "implicit"])
     label = r"rising-fall $\xi_p$ = 1, implicit melt update"
     if d is None:

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the STL mesh of a closed drum with lifter bars (inputs/drum, docs/drum.md).
+"""Writes the STL mesh of a closed drum with lifter bars (inputs/drum, docs/validation/drum.md).
 
 The drum's axis is along y. Its cross-section (x-z plane) is the polygon of N flat segments
 circumscribing the circle of the inner diameter (as tools/make_jar_stl.py's jar), with --lifters

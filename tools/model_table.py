@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The figures of docs/model_table.md: each example input of the fluid and coupled cases run with
+"""The figures of docs/validation/model_table.md: each example input of the fluid and coupled cases run with
 the fix's defaults (`pressure projection`) and with `pressure eos` (the input's bulk), measured
 against the case's reference (CASES.md), with the wall time of each run.
 

@@ -1,16 +1,16 @@
 #!/usr/bin/env python3
-"""Uniform suspension settling (inputs/suspension/in.suspension, docs/suspension.md).
+"""Uniform suspension settling (inputs/suspension/in.suspension, docs/validation/suspension.md).
 
 The reference is computed from the inputs alone: the steady hindered settling velocity of a
 uniform suspension, where each grain's drag (the law's formula, written out here again from
-docs/drag.md, not taken from the code) balances its buoyant weight in the mixture,
+docs/theory/drag.md, not taken from the code) balances its buoyant weight in the mixture,
 
     K(theta, w) w = theta (rho_p - rho_f) V g,    theta = 1 - phi,
     w = v_p - u_f (slip),  u_f = -phi/(1 - phi) v_p (no net volume flux)  =>  v_p = theta w.
 
     suspension.py ref  [--d 1e-3 --rhop 1500 ...]      reference velocities
     suspension.py analyse suspension.csv --vref V      settling and ringing of one run
-    suspension.py sweep --exe build/liggghts_mpm --work DIR [--quick]   the table of docs/suspension.md
+    suspension.py sweep --exe build/liggghts_mpm --work DIR [--quick]   the table of docs/validation/suspension.md
 
 Standard library only (tests/cases/test_suspension.py imports it).
 """
@@ -147,7 +147,7 @@ def phi_mid(res, info, d=1e-3):
 
 INPUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "inputs", "suspension", "in.suspension")
 
-# model x options of the table in docs/suspension.md
+# model x options of the table in docs/validation/suspension.md
 VARIANTS = [
     ("proj", {"pressure": "projection"}),
     ("eos", {"pressure": "eos"}),

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Taichi reference for the 3-D dam-break benchmark (docs/performance.md).
+"""Taichi reference for the 3-D dam-break benchmark (docs/validation/performance.md).
 
   tools/python-bench tools/taichi_dambreak.py [--cells 23] [--threads 1] [--warm 10] [--nsteps 300]
 

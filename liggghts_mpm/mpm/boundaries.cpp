@@ -33,7 +33,7 @@ void Boundaries::apply(double *vel, int i, int j, int k, double h) {
     if (fc < 0) continue;
     // normal component: no penetration; tangential: keep (1 - sticky) of it, or for a shear
     // face the exact decay over h under the wall stress mu v_t / delta on the fluid within a cell
-    // of the face, rate nu / (delta dx) (as mesh_wall ... shear, docs/mesh_walls.md)
+    // of the face, rate nu / (delta dx) (as mesh_wall ... shear, docs/theory/mesh_walls.md)
     const Face &f = opt_->face[fc];
     const double keep = f.kind == BcKind::Shear
                             ? wall_slip_decay(wall_layer_rate(opt_->viscosity / opt_->eos.rho0, f.delta, gs.dx), h)
@@ -133,7 +133,7 @@ void Boundaries::add_face_traction(const Stencil &ps, const double *xp, double V
    towards the fluid, shared among the nodes by their weights at q. Nodes behind the wall take
    their share out again through the velocity condition; the nodes in front get the push that the
    internal force (8-24) alone lacks there (without it a curved mesh wall draws the fluid in:
-   docs/mesh_walls.md). */
+   docs/theory/mesh_walls.md). */
 void Boundaries::add_mesh_traction(const double *xp, double V, double p, double *p2g) {
   const GridSpec &gs = opt_->grid;
   double q[3], nrm[3];

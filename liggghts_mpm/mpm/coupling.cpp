@@ -396,7 +396,7 @@ void FluidSolver::point_sums() {
    traction) / sum_p S_ip V_p: the P2G force less the points' external forces. At rest every free
    node balances it with the weight of its fluid and the grains' reaction, so a grain reads
    exactly rho g there, whatever the packing and next to a floor, where the anti-locked cell
-   pressure has its staircase (docs/background/well_balanced.md). Nodes on a grid face and padding
+   pressure has its staircase (docs/theory/well_balanced.md). Nodes on a grid face and padding
    nodes (their velocity is the wall's) take the value of the nearest node off the faces. */
 void FluidSolver::weak_pressure_gradient() {
   const GridSpec &gs = opt.grid;

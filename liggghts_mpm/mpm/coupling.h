@@ -9,11 +9,11 @@ namespace mpm {
 // m = (r (4), M (4 x 4)) of PfitRec (r = sum S V p e, M = sum S V e e^T, e = (1, x_s - x_j)).
 // Writes (p_j, b) and returns true if the fit is determined (well conditioned, finite). A plain
 // weighted mean would be the pressure of the points' centre, which next to a wall or the bed's
-// floor lies up to a cell off the node (docs/drag.md); the fit reproduces any linear field.
+// floor lies up to a cell off the node (docs/theory/drag.md); the fit reproduces any linear field.
 bool fit_linear_pressure(const double *moments, double dx, double out[4]);
 
 // Passes of the [1/4 1/2 1/4] filter that smooth the solid fraction to a Gaussian of standard
-// deviation L: each pass adds dx^2/2 to the variance (docs/drag.md, "Smoothing the fluid fraction").
+// deviation L: each pass adds dx^2/2 to the variance (docs/theory/drag.md, "Smoothing the fluid fraction").
 int smoothing_passes(double L, double dx);
 
 // One pass of that filter along one direction at a node of volume V and fraction phi, from its

@@ -3,7 +3,7 @@
 // the pressure-gradient (buoyancy) force (7-15) and the backward-Euler
 // two-body drag exchange (the verification helpers, exact exchange and
 // settling curves of case C1, live in tests/unit/test_drag_laws.cpp). Independent of the grid, of MPI and of LIGGGHTS so that
-// they can be tested alone. Derivation and choices: docs/drag.md.
+// they can be tested alone. Derivation and choices: docs/theory/drag.md.
 //
 // Sign convention: K >= 0 is the per-particle linear drag coefficient
 // [kg/s]; the drag force on the particle is F = K (u_f - v_s) and the fluid

@@ -57,7 +57,7 @@ inline double viscous_dt_limit(double dx, double rho, double eta, int dim) {
   return dx * dx * rho / (2.0 * dim * eta);
 }
 
-// Pore-pressure waves of fluid and grains pushed by the same pressure (docs/coupled_stability.md),
+// Pore-pressure waves of fluid and grains pushed by the same pressure (docs/theory/coupled_stability.md),
 // with r = rho_f (1 - theta) / (theta rho_p) and c_f the fluid's sound speed. Fluid and grains
 // together (the fluid not sub-cycled): c = c_f sqrt(1 + r). The grains' own wave when the fluid
 // follows them within the step (sub-cycled): c_g = c_f sqrt(r).

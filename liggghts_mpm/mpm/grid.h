@@ -125,7 +125,7 @@ class LocalGrid {
   void for_owned_all(Fn &&fn) const {
     for_box(owned_, fn);
   }
-  // The work box (the projection's sparse sweeps, docs/performance.md "Sparse grid"): while set,
+  // The work box (the projection's sparse sweeps, docs/validation/performance.md "Sparse grid"): while set,
   // for_owned visits only the owned nodes inside it; null: every owned node again. WorkScope
   // sets it for a scope.
   void set_work(const IndexBox *b) {
@@ -198,7 +198,7 @@ class LocalGrid {
   double wait_seconds_ = 0.0;
 };
 
-// The sparse grid (keyword sparse, docs/performance.md): blocks of kSize^3 nodes of a rank's patch
+// The sparse grid (keyword sparse, docs/validation/performance.md): blocks of kSize^3 nodes of a rank's patch
 // that hold values this sub-step, the blocks the material points' stencils reach plus, for good,
 // the blocks of the nodes the halo exchange moves (so that the exchange stays as it is). The solver
 // clears, updates and sweeps only active blocks; every node of an inactive block is zero, since

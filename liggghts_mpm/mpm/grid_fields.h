@@ -3,7 +3,7 @@
 // Node records are rows of doubles, padded to multiples of 4 so that the transfer kernels read and
 // write them as 4-wide rows (mpm::Row4, one AVX register): a record's named fields are offsets
 // into the row, its N the row length. The fields of one phase sit in one record so a kernel
-// touches one contiguous row per node (docs/design.md, docs/performance.md).
+// touches one contiguous row per node (docs/design.md, docs/validation/performance.md).
 #pragma once
 #include <cstddef>
 #include <vector>

@@ -191,7 +191,7 @@ void finish_options(Options &o, const std::vector<std::string> &seen, const bool
   // pressure_output: with grains the acceleration pressure is solved anyway (grain_pressure's
   // default), so the points carry the flow's pressure at no cost; the multiplier's part that
   // removes the transfer's divergence within one step reached 5 times rho g h + rho (omega R)^2 in
-  // a turning drum with lifters where the acceleration pressure stayed below it (docs/drum.md)
+  // a turning drum with lifters where the acceleration pressure stayed below it (docs/validation/drum.md)
   if (o.projection && o.coupled && o.grain_pressure_acceleration &&
       std::find(seen.begin(), seen.end(), "pressure_output") == seen.end())
     o.pressure_acceleration = true;
@@ -203,7 +203,7 @@ void finish_options(Options &o, const std::vector<std::string> &seen, const bool
   o.dimension = env.dimension;
   o.grid.dx = o.cell_size;
   // volume_correction: by default at the rate of a gravity wave one cell long, sqrt(g / cell)
-  // (g = 9.81 m/s^2, SI units; docs/projection.md, "Volume over long runs")
+  // (g = 9.81 m/s^2, SI units; docs/theory/projection.md, "Volume over long runs")
   if (o.projection && std::find(seen.begin(), seen.end(), "volume_correction") == seen.end())
     o.volume_correction = std::sqrt(kVolumeCorrectionG / o.grid.dx);
   o.eos.rho0 = o.rho0;

@@ -250,7 +250,7 @@ PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *
 }
 
 /* A FLUID node without any open face (walled in by closed faces: seen at the corner nodes of the
-   box outside the rotating jar's mesh, docs/jar.md "C4 with the projection") has a zero row: PFMG
+   box outside the rotating jar's mesh, docs/validation/jar.md "C4 with the projection") has a zero row: PFMG
    then returns INF, hypre's PCG stops at once with its error flag and leaves the old pressure.
    Such a node takes no part in the solve (an identity row, p = 0, as a SOLID node): no face
    connects it to the rest. Returns labels_in, or walled (a copy with those nodes SOLID) if there

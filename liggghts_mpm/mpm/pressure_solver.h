@@ -5,7 +5,7 @@
 // PCG preconditioned by one PFMG V-cycle (or SMG). EMPTY and SOLID nodes are
 // identity rows with their couplings removed and their known values moved to
 // the right-hand side, so the matrix stays symmetric positive (semi)definite.
-// docs/projection.md has the design and the measurements.
+// docs/theory/projection.md has the design and the measurements.
 #pragma once
 #include <mpi.h>
 

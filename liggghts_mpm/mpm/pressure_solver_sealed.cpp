@@ -21,7 +21,7 @@ constexpr double kReached = -1.0, kUnreached = -2.0;
    EMPTY). Their block of the operator has the constants as null space, and the moving wall faces
    around such a pocket (a lifter bar turning through the grid: its staircase of closed faces
    changes the pocket's volume from step to step) give it a right-hand side that sums to a
-   nonzero value: no solution, and PCG diverges (docs/projection.md, "Sealed pockets"). Labels
+   nonzero value: no solution, and PCG diverges (docs/theory/projection.md, "Sealed pockets"). Labels
    each FLUID node with the smallest global key of its set (-1 if the set reaches an EMPTY node)
    by sweeps forward and backward over the owned nodes and halo exchanges until nothing changes
    on any rank. Returns the number of FLUID nodes in sealed sets on all ranks. Collective. */

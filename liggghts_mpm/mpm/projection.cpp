@@ -149,7 +149,7 @@ double Projection::solve_pressure(const double *vel, const double *p2g, double m
   const double *theta_prev = theta && have_theta_last_ ? theta_last_.data() : nullptr;
   // u* as it is; every wall condition comes after the projection: the wall's reaction is the
   // pressure, and a wall node's velocity zeroed before it (normal or, no-slip, tangential) would
-  // be moved again by the correction (measured: the F1 column at rest, docs/projection.md)
+  // be moved again by the correction (measured: the F1 column at rest, docs/theory/projection.md)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     const double *v = vel + VelRec::N * n + VelRec::V_NEW;
     for (int d = 0; d < 3; ++d) u_[3 * n + d] = v[d];
@@ -225,7 +225,7 @@ void Projection::padding_velocity(double *v, int i, int j, int k, bool grains, d
   // Copying the wall node's velocity changed the momentum of this mass by m (u_wall - u*),
   // among others the drag the grains near the wall gave it: with a constant force on the
   // grains of a box periodic in x and y, cells of 3 grain diameters, 0.03 s, the x momentum of
-  // fluid and grains 3.1 % above the impulse, 0.19 % without the copy (docs/projection.md,
+  // fluid and grains 3.1 % above the impulse, 0.19 % without the copy (docs/theory/projection.md,
   // "Momentum of grains and fluid")
   const int q[3] = {opt_.grid.mirror(i, 0), opt_.grid.mirror(j, 1), opt_.grid.mirror(k, 2)};
   const int idx[3] = {i, j, k};
@@ -249,7 +249,7 @@ void Projection::padding_velocity(double *v, int i, int j, int k, bool grains, d
    the quadratic B-spline's share of the node above it (1/8 of its velocity on the wall itself) and
    crossed the wall, to be put back there (C3 with projection: f_fluid[8] 79,040 at Grid20 and
    6.4e5 at Grid48 by 0.2 s). With the odd reflection the interpolated normal velocity is 0 on the
-   wall and linear near it: Grid20 0 put back, fronts within 3 mm (docs/tank.md). */
+   wall and linear near it: Grid20 0 put back, fronts within 3 mm (docs/validation/tank.md). */
 void Projection::mirror_normal(double *v, int i, int j, int k, const double *p2g, double mmin) const {
   const GridSpec &gs = opt_.grid;
   const int q[3] = {gs.mirror(i, 0), gs.mirror(j, 1), gs.mirror(k, 2)};

@@ -1,4 +1,4 @@
-// The pressure model 'projection' of fix mpm/fluid (docs/projection.md): the glue between the
+// The pressure model 'projection' of fix mpm/fluid (docs/theory/projection.md): the glue between the
 // solver's grid update and the discrete operators (projection_ops.h) and the hypre solve
 // (pressure_solver.h). Per fluid sub-step: labels from the node mass, the box walls, the gate and
 // the mesh walls;
@@ -31,7 +31,7 @@ class Projection {
   // pvol: sum S V of the points per node (owned nodes, after the reverse sum), for the
   // volume correction (keyword volume_correction; null: none). Throws mpm::Error naming the
   // step if the solve does not converge.
-  // work (sparse sweeps, docs/performance.md "Sparse grid"): a box of the patch that holds every
+  // work (sparse sweeps, docs/validation/performance.md "Sparse grid"): a box of the patch that holds every
   // node with fluid mass grown by kWorkMargin nodes; the sweeps then visit its nodes only and every
   // array keeps outside it the value the full sweep gives there (no fluid within reach: 0, EMPTY).
   // Not with theta (couple) or mesh walls. null: the whole patch.

@@ -1,5 +1,5 @@
 // Discrete operators of the pressure projection on the node lattice of the
-// background grid (docs/projection.md): the approximate projection of Almgren,
+// background grid (docs/theory/projection.md): the approximate projection of Almgren,
 // Bell & Szymczak (1996) moved from cells to nodes. Velocities and pressure
 // live at the nodes; the faces of the dual cells, halfway between neighbouring
 // nodes, carry the fluxes theta u of the volume-averaged continuity equation
@@ -39,7 +39,7 @@ struct NodeLabels {
   // to FLUID nodes (surface_weight). Empty: none (free_surface node, or set by the caller).
   std::vector<std::uint8_t> wet;
   std::vector<double> wall_u;
-  // Ghost-fluid free surface (docs/projection.md, "Free surface"): per node the signed distance
+  // Ghost-fluid free surface (docs/theory/projection.md, "Free surface"): per node the signed distance
   // to the free surface in units of dx, positive inside the fluid (empty: p = 0 at the EMPTY
   // nodes themselves). A face between a FLUID node n and an EMPTY node m then holds p = 0 at the
   // fraction s_f = level_n / (level_n - level_m) of the face's length from n (at least
@@ -66,7 +66,7 @@ struct NodeLabels {
 // of dx^3) and so are its faces along the wall (area 1/2 or 1/4 of dx^2). This
 // keeps the Neumann walls second-order accurate and the flux theta u through a
 // wall node's face consistent with its theta, which the fix computes on the
-// half cell (docs/projection.md, the measurement). Without it every dual cell
+// half cell (docs/theory/projection.md, the measurement). Without it every dual cell
 // is a full cube, i.e. the wall sits half a cell behind the wall nodes.
 struct ProjectionGeometry {
   GridSpec spec;
@@ -100,7 +100,7 @@ constexpr double kMinSurfaceFraction = 1e-3;
 // the fraction of its face to an EMPTY neighbour as near the surface, l_n / (l_n - l_m) with both
 // levels near 0, made the pressure oversensitive to the levels: a level moved by delta changed
 // the pressure by 11 rho g dx delta instead of 0.45 (PressureSolver.GhostSurfaceOnANodePlane-
-// IsWellConditioned), and np 2 drifted from np 1 (docs/projection.md). The bound also keeps a
+// IsWellConditioned), and np 2 drifted from np 1 (docs/theory/projection.md). The bound also keeps a
 // fluid filled up to a node plane from flipping its nodes between EMPTY and FLUID.
 constexpr double kLevelMin = 1.5;
 constexpr double kLevelTie = kLevelMin * kMinSurfaceFraction / (1.0 - kMinSurfaceFraction);
@@ -181,7 +181,7 @@ void corrected_flux_divergence(const LocalGrid &grid, const NodeLabels &labels,
 // (w = 0): the open face alone next to a wall, 0 between two walls. At an EMPTY node holding fluid
 // (labels.wet) the same over its faces to FLUID nodes with w_f = surface_weight. With u -= h g / rho the projection then removes
 // kinetic energy (in the norm sum rho theta_f w_f s_f u^2) and a hydrostatic pressure is balanced
-// exactly (docs/projection.md, "Free surface: energy and stiffness"). Off the surface and with
+// exactly (docs/theory/projection.md, "Free surface: energy and stiffness"). Off the surface and with
 // theta = 1 it is the mean of the two face gradients. At another EMPTY node: the mean of the
 // ghost-fluid gradients of its faces to FLUID nodes (continued from the fluid side). theta null: 1. The
 // gradient the fluid's nodes feel and the one to interpolate to grains.

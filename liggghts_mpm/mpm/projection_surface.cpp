@@ -18,7 +18,7 @@ namespace mpm {
 namespace {
 // A node is EMPTY (p = 0) when it holds less than this fraction of the fluid mass of a full dual
 // cell. The B-spline spreads a point's mass 1.5 cells: with the mass threshold alone the surface
-// (p = 0) sits ~1.5 cells outside the fluid. Measured (docs/projection.md): F1 pressure error
+// (p = 0) sits ~1.5 cells outside the fluid. Measured (docs/theory/projection.md): F1 pressure error
 // 0.43 / 0.22 (threshold only), 0.22 / 0.11 (0.25), 0.009 / 0.007 (0.5) at 8 / 16 cells, but 0.5
 // leaves the column moving (0.07 m/s after 1 s) and the MPM16 dam-break front 0.39 a off; 0.25:
 // at rest to 1e-12 m/s, front 0.037 a (apic).
@@ -30,7 +30,7 @@ constexpr double kSurfaceFill = 0.25;
 // The signed distance (units of dx, positive inside) from a node to a plane free surface whose
 // fluid gives the node the fill f: the inverse of the fill F(s) = int_{-inf}^{s} N(x) dx of the
 // shape function N across the surface (uniform fluid up to the plane at s cells above the node;
-// docs/projection.md, "Free surface: energy and stiffness"). With fill - 1/2 as the level instead,
+// docs/theory/projection.md, "Free surface: energy and stiffness"). With fill - 1/2 as the level instead,
 // the ghost surface moved 1 / N(0) = 4/3 (quadratic B-spline) times as far as the water near a
 // node and the surface was too stiff: the standing wave ran fast.
 double surface_distance(double f, ShapeKind shape) {
@@ -118,7 +118,7 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
    the B-spline gives part of the wall-side points' mass): the mass a fluid continued by
    reflection at the walls would give. Without it the nodes next to a wall read a fill 1-3 % low,
    the ghost surface sits lower there and a column at rest starts to circulate (F1: 0.02 m/s after
-   1 s, docs/projection.md). Reads fold_mass_ on the owned nodes and halos. */
+   1 s, docs/theory/projection.md). Reads fold_mass_ on the owned nodes and halos. */
 double Projection::folded_mass(int i, int j, int k) const { return mirror_sum(fold_mass_, i, j, k); }
 
 /* a at node (i, j, k) plus a at its mirror images behind the box walls (reflected at each
@@ -143,7 +143,7 @@ double Projection::mirror_sum(const std::vector<double> &a, int i, int j, int k)
   return sum;
 }
 
-/* Mesh walls (docs/projection.md, "Mesh walls"). A grid face whose segment between its two nodes
+/* Mesh walls (docs/theory/projection.md, "Mesh walls"). A grid face whose segment between its two nodes
    crosses a triangle is a wall moving with the triangle's velocity along the face normal (zero
    relative flux, like the gate; a wall through a node leaves that node on the fluid side). The
    nodes up to 2 cells behind a one-sided wall are SOLID: they take part in no solve (no spurious

@@ -20,11 +20,11 @@ namespace {
 // flow; corrected, it moved the surface of a standing wave of 2 % of the depth: amplitude over
 // three periods 0.84 of its start with no band, 1.003 with 0.02, 0.953 with 0.05 (0.953 without
 // any correction); the sloshing tank's volume after 10 s 1.007 / 1.009 / 1.018 of the start
-// (docs/projection.md, "Volume drift and `volume_correction`")
+// (docs/theory/projection.md, "Volume drift and `volume_correction`")
 constexpr double kVolumeBand = 0.02;
 }  // namespace
 
-/* Volume correction (keyword volume_correction k, docs/projection.md "Volume drift"). The
+/* Volume correction (keyword volume_correction k, docs/theory/projection.md "Volume drift"). The
    points hold their volume V = m / (theta rho0), but the approximate projection makes the nodal
    velocities divergence-free only up to its approximation error, so the point cloud drifts: where
    the flow converges the points crowd, elsewhere they open gaps (F2 dam break, MPM16 apic, 2 s:
@@ -40,7 +40,7 @@ constexpr double kVolumeBand = 0.02;
    (e < 0) drawn together, but the latter only where no EMPTY node lies within two nodes
    (deep_inside): under the free surface phi falls from 1 to 0 over 1.5 cells and is no error.
    Measured: correcting compression alone removed it better but opened gaps, the fluid's volume
-   on the grid growing by 2-8 % (docs/projection.md). The density-error source of the pressure
+   on the grid growing by 2-8 % (docs/theory/projection.md). The density-error source of the pressure
    equation of Kugelstadt, Longva, Thuerey & Bender (2021), "Implicit density projection for
    volume conserving liquids", IEEE TVCG 27(4), applied as they do to the positions, with the
    projection's operator. */
@@ -69,7 +69,7 @@ void Projection::add_volume_correction(const double *pvol, const double *theta, 
    removes the fraction a of the error this step. The points move by dt w on top of the fluid's
    velocity; w never enters their velocity, so the correction neither adds momentum nor energy
    (as a source in the velocity's own solve it entered the points' velocity, which FLIP keeps;
-   docs/projection.md "Volume drift and `volume_correction`"). Zero first guess:
+   docs/theory/projection.md "Volume drift and `volume_correction`"). Zero first guess:
    the drift of a step is a function of that step's state only (restart, np 2 = np 1). */
 void Projection::volume_drift(const double *pvol, const double *theta, double h, double share, long step) {
   const std::size_t n = grid_.size();
@@ -110,12 +110,12 @@ bool Projection::deep_inside(int i, int j, int k) const {
 }
 
 
-/* pressure_output acceleration (docs/projection.md, "The pressure the points carry"). The
+/* pressure_output acceleration (docs/theory/projection.md, "The pressure the points carry"). The
    projection's p is the Lagrange multiplier that makes this step's velocity divergence-free: it
    removes whatever divergence the step's u* holds, the transfer's as well (FLIP and APIC do not
    give back on the grid the divergence-free velocity they took from it), in one step h, so that
    part of it is of order rho |du| dx / h and grows without bound as h shrinks (C3, F2 dam break,
-   docs/tank.md). The pressure of the incompressible Navier-Stokes equations is instead fixed by
+   docs/validation/tank.md). The pressure of the incompressible Navier-Stokes equations is instead fixed by
    the velocity field and the forces alone: with Du/Dt = a_f - grad p / rho and div u = 0,
        div(beta grad p) = div(theta (a_f - (u . grad) u)),   no normal acceleration at walls,
    p = 0 at the free surface. Here u is the projected velocity, a_f the grid forces per mass of the
@@ -168,7 +168,7 @@ void Projection::acceleration_pressure(const double *vel, const double *theta, d
 /* The pressure a sensor of finite response time reads (keyword pressure_average tau). Under the
    projection an impact or a transfer event that must change the velocity within one fluid step h
    gives a pressure of order rho |du| dx / h for that step: the pressure impulse (its integral over
-   time) converges as h shrinks, the single-step peak does not (docs/tank.md). The exponential
+   time) converges as h shrinks, the single-step peak does not (docs/validation/tank.md). The exponential
    average pa += (1 - exp(-h / tau)) (p - pa) responds to an impulse I with I / tau, independent of
    h, and to a steady pressure with that pressure. Nodes hold a fixed place, as a wall sensor. */
 void Projection::average_pressure(double h) {

@@ -109,7 +109,7 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
   // coupling reads the fluid's arrays (zero outside the active blocks, as on the dense grid) and
   // writes only its own, which its phases sweep on the whole patch; the projection writes the
   // fluid's velocity only where there is mass, and sweeps its own arrays on the work box
-  // (projection_work_box; pure fluid without mesh walls) or the whole patch (docs/performance.md,
+  // (projection_work_box; pure fluid without mesh walls) or the whole patch (docs/validation/performance.md,
   // "Sparse grid")
   sparse_ = opt.sparse;
   if (sparse_) blocks_.setup(grid_);
@@ -159,7 +159,7 @@ void FluidSolver::step() {
   // the grains get the impulse of the N steps, N h F, in this step (force N F): velocity Verlet
   // then advances them as one symplectic step of N dt. Keeping F for N steps instead spreads the
   // kick over the drift and makes every undamped coupled oscillation grow
-  // (docs/coupled_stability.md, "every N").
+  // (docs/theory/coupled_stability.md, "every N").
   for (int k = 0; k < pts.nlocal; ++k) {
     if (!is_grain(k)) continue;
     for (int d = 0; d < 3; ++d) {
@@ -430,7 +430,7 @@ void FluidSolver::interpolate_pressure() {
 void FluidSolver::update_stress(double h, bool theta_only) {
   if (opt.projection) {
     // incompressible: density rho0 and the volume m / (theta rho0) held (the points' number per
-    // cell measures the volume drift, docs/projection.md); the pressure is the solve's
+    // cell measures the volume drift, docs/theory/projection.md); the pressure is the solve's
     for (const int i : plist_) {
       double *s = pts.state[i];
       s[C_RHO] = opt.rho0;

@@ -6,7 +6,7 @@
 // product rule. for_stencil walks the nodes with the y-z products hoisted out
 // of the x loop and the flat node index advanced by strides, so a transfer
 // kernel does ~4 multiplications per node for the weights instead of
-// recomputing the index and all products (docs/performance.md).
+// recomputing the index and all products (docs/validation/performance.md).
 #pragma once
 #include <cstddef>
 

@@ -1,5 +1,5 @@
 // The solver's stable time step: acoustic (CFL) and viscous limits of the fluid, and the
-// pore-pressure waves of fluid and grains with couple (docs/coupled_stability.md).
+// pore-pressure waves of fluid and grains with couple (docs/theory/coupled_stability.md).
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -146,7 +146,7 @@ std::string FluidSolver::check_timestep(bool at_setup) {
        << ", " << csym << " = " << cformula << " = " << cval << ", fluid sound speed c_f = " << c_max_
        << ", lowest fluid fraction theta = " << couple_theta_min_ << ", lightest moving grain rho_p = "
        << couple_rho_grain_ << "); " << before << "reduce the timestep to " << limit / every << after
-       << " (docs/coupled_stability.md)" << (at_setup ? "" : " (limit reached during the run)");
+       << " (docs/theory/coupled_stability.md)" << (at_setup ? "" : " (limit reached during the run)");
     throw Error(os.str());
   };
   // the grains' wave: sub-cycling the fluid does not help, the grains move once per step

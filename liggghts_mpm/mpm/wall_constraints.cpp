@@ -1,6 +1,6 @@
 // Fluid wall conditions on triangle walls: the conditions at the grid nodes (collect, impose,
 // nearest_face) and the push-back of the material points; the geometry queries are in
-// wall_geometry.cpp. See wall_geometry.h and docs/mesh_walls.md.
+// wall_geometry.cpp. See wall_geometry.h and docs/theory/mesh_walls.md.
 #include "mpm/wall_geometry.h"
 
 #include <Eigen/Dense>
@@ -30,7 +30,7 @@ using wall_tri::wall_velocity;
 //     text's "50 % sticky wall" of C4), whatever it was;
 //   shear delta f: target f, keep exp(-rate h): the exact solution over h of
 //     dv_t/dt = -rate (v_t - f w_t), the wall shear stress mu (f w_t - v_t) / delta acting on the
-//     fluid within 'reach' of the wall, rate = nu / (delta reach) (docs/mesh_walls.md).
+//     fluid within 'reach' of the wall, rate = nu / (delta reach) (docs/theory/mesh_walls.md).
 inline void constrain(double v[3], const WallConstraint &c, double h) {
   double r[3];
   sub3(v, c.w, r);

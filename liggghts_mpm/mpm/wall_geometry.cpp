@@ -1,6 +1,6 @@
 // Fluid wall conditions on triangle walls, the geometry alone: the triangles and their bins,
 // closest points, crossings, node sides and the rotation fit (the conditions at the nodes and the
-// points are in wall_constraints.cpp); see wall_geometry.h and docs/mesh_walls.md.
+// points are in wall_constraints.cpp); see wall_geometry.h and docs/theory/mesh_walls.md.
 #include "mpm/wall_geometry.h"
 
 #include <Eigen/Dense>

@@ -1,6 +1,6 @@
 // Fluid wall conditions on triangle walls: the geometry alone (no LIGGGHTS, no MPI). The triangles
 // (node positions and velocities) are handed in by liggghts_mpm/mesh_walls.h, which reads them from
-// LIGGGHTS meshes and gathers them over the ranks; docs/mesh_walls.md.
+// LIGGGHTS meshes and gathers them over the ranks; docs/theory/mesh_walls.md.
 //
 // At a grid node the wall condition acts in the wall's frame:
 //   relative velocity r = v - w (w = wall velocity at the closest point),
@@ -68,7 +68,7 @@ struct WallConstraint {
 
 // Relaxation rate (1/time) of the tangential slip of the fluid within 'depth' of a wall whose
 // unresolved viscous layer of thickness delta carries the stress mu v_slip / delta: the law of the
-// shear kinds of mesh walls and grid faces (docs/mesh_walls.md).
+// shear kinds of mesh walls and grid faces (docs/theory/mesh_walls.md).
 inline double wall_layer_rate(double nu, double delta, double depth) { return nu / (delta * depth); }
 
 // Fraction of the tangential slip (v_t - f w_t) left after a time h at relaxation rate 'rate': the
@@ -158,14 +158,14 @@ class WallGeometry {
   // votes[2 k] (normal side) and votes[2 k + 1] (opposite side), k < walls().
   void side_votes(const double *const *x, int n, double reach, long *votes) const;
 
-  // The pressure projection (docs/projection.md, "Mesh walls").
+  // The pressure projection (docs/theory/projection.md, "Mesh walls").
   // Whether the segment from a to a + len e_d (len > 0) crosses a triangle: its ends lie on
   // different sides of the triangle's plane (one-sided meshes: an end in the plane counts as on the
   // fluid side; two-sided meshes: an end in the plane, the other not, is a crossing, so a node in
   // a two-sided wall is cut off on both sides) and the crossing point inside the triangle (1e-9 in
   // barycentric weights). *w_d: the d component of the wall velocity's normal part, (w . n) n_d,
   // at the crossing (of the first such triangle in the fixed order): a wall moving along itself
-  // is no source of fluid (docs/projection.md, "Mesh walls"). len <= margin, else all triangles
+  // is no source of fluid (docs/theory/projection.md, "Mesh walls"). len <= margin, else all triangles
   // are scanned.
   bool crosses(const double a[3], int d, double len, double *w_d) const;
   // Side of x with respect to the nearest triangle within 'reach': -1 behind a one-sided mesh

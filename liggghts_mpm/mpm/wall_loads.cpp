@@ -1,5 +1,5 @@
-// What the fluid does to its mesh walls, and what pressure probes read (docs/fix_mpm_fluid.md,
-// "Wall loads and probes"; docs/mesh_walls.md, "Force and torque on a mesh"): the pressure field
+// What the fluid does to its mesh walls, and what pressure probes read (docs/reference/fix_mpm_fluid.md,
+// "Wall loads and probes"; docs/theory/mesh_walls.md, "Force and torque on a mesh"): the pressure field
 // of the sub-step sampled on the triangles and at the probes, summed over the sub-steps of a fluid
 // step (walls) or of a probe window.
 //
@@ -304,7 +304,7 @@ void FluidSolver::probe_sums(double h) {
 }
 
 /* pressure projection: the pressure its solve has at the free surface. With mesh walls the solve
-   puts p = 0 at the first EMPTY node above the fluid (docs/projection.md, "Mesh walls": the node
+   puts p = 0 at the first EMPTY node above the fluid (docs/theory/projection.md, "Mesh walls": the node
    surface), so that its pressure at rest is rho g (h + delta) at depth h, delta about one cell
    (measured: 1.00 dx in a tank at rest). The fluid feels only the gradient; a wall feels the
    value. The surface of the fluid is where the nodal mass falls to half a full cell's, rho0 dx^3:

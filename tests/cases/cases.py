@@ -751,7 +751,7 @@ def case_tank_projection_far_wall(r):
     gradient of the acceleration pressure (grain_pressure's default); with grain_pressure multiplier,
     whose part that removes the transfer's divergence within one step threw beads up the far wall,
     1.85 against 1.64 m/s and 15 mm above (full C3 Grid20: a bead at 0.208 m at 0.3 s, the water's
-    top at 0.080 m; docs/projection.md, "What the grains feel")."""
+    top at 0.080 m; docs/theory/projection.md, "What the grains feel")."""
     d, p = r.run("tank_projection_far_wall", os.path.join(r.inputs, "tank", "in.tank"),
                  {"quick": 1, "pressure": "projection", "tend": 0.26, "tfront": 0.002})
     f = read_csv(os.path.join(d, "fronts.csv"))
@@ -839,7 +839,7 @@ def case_jar_quick_projection(r):
 
 
 def case_porewave(r):
-    """Pore-pressure wave of fluid and grains (inputs/porewave, docs/coupled_stability.md): a dense
+    """Pore-pressure wave of fluid and grains (inputs/porewave, docs/theory/coupled_stability.md): a dense
     free lattice (theta = 0.4, rho_p = 2500, water K = 2.2e7, cell 5 mm) perturbed at random decays
     below the coupled limit (also sub-cycled and with every 2); above it a clear error, no NaN."""
     inp = os.path.join(r.inputs, "porewave", "in.porewave")

@@ -5,7 +5,7 @@ the inputs alone. With `pressure eos` and the standard model (the fluid's own no
 gradient as its points see it, the reaction through the points) within 2 % mid-depth and resting on the floor, at
 cells of 1.5 and 3 grain diameters (at 3 d the water is 3 cells deep: the bed lies within 1.5 cells
 of the floor and of the free surface), with and without theta_smooth (measured 0.9963-1.0008,
-docs/projection.md "Archimedes with eos"). The dissertation's literal coupling (model yang2016) must
+docs/theory/projection.md "Archimedes with eos"). The dissertation's literal coupling (model yang2016) must
 miss on the floor by more than 2 %, so that the case can tell the two apart.
 
     test_archimedes.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR [--mpirun "..."]

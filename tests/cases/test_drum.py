@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""mpm_case.drum_quick: the wet tumbling mill inputs/drum/in.drum (CASES.md C7, docs/drum.md) at
+"""mpm_case.drum_quick: the wet tumbling mill inputs/drum/in.drum (CASES.md C7, docs/validation/drum.md) at
 reduced size on fix mpm/fluid's defaults (pressure projection): 600 beads, cells of 10 mm (16 across
 the drum, 1 point per cell), water filling a third of the drum, the drum turning for 0.15 turn at
 75 % of the critical speed.

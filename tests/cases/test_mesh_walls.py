@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Whole-program tests of the fluid boundary condition on LIGGGHTS wall meshes (mesh_wall of
-fix mpm/fluid, liggghts_mpm/mesh_walls.h; docs/mesh_walls.md). Standard library only.
+fix mpm/fluid, liggghts_mpm/mesh_walls.h; docs/theory/mesh_walls.md). Standard library only.
 
     test_mesh_walls.py CASE --exe build/liggghts_mpm --work DIR [--mpirun "mpirun ..."]
                             [--unit build/test_mesh_walls_unit]
@@ -109,7 +109,7 @@ def case_gate(r):
         gate_checks(d, f"gate {kind}", dx, adv)
     # one-sided gate (fluid on the opposite side of the normal +x): holds the column as well; the
     # fluid that passes under it is 'behind' it and is pushed back while within a cell of it, so
-    # the release is slower (measured 0.080 m): use 'side both' for gates (docs/mesh_walls.md)
+    # the release is slower (measured 0.080 m): use 'side both' for gates (docs/theory/mesh_walls.md)
     d, _ = r.run("gate_opposite", "in.mesh_walls_gate", "gate.stl", {"fside": "opposite", "dx": dx})
     gate_checks(d, "gate side opposite", dx, 0.04)
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Momentum and kinetic energy of grains and water exchanging forces (tests/data/in.momentum,
-docs/projection.md "Momentum of grains and fluid"): 300 grains settle through water in a box
+docs/theory/projection.md "Momentum of grains and fluid"): 300 grains settle through water in a box
 periodic in x and y, free-slip floor, frictionless contacts, a constant force fx on every grain.
 Nothing else acts along x, so the x momentum of points + grains must be N fx t (a bound computed
 from the inputs alone), and the kinetic energy gained since the release can be no more than the
@@ -12,7 +12,7 @@ Cases: eos (cells of 3 and 1.5 grain diameters: momentum within 1e-4 of the impu
 above the work), projection (cells of 3 diameters, and of 1.5 with theta_smooth of one cell: no
 energy above the work, momentum within the bound measured for this build). The projection does not
 meet 1e-4 (0.19 % at 3 diameters, 0.06 % at 1.5 with theta_smooth) nor is it stable at 1.5
-diameters without theta_smooth or at 1 diameter with it (docs/projection.md): those bounds are a
+diameters without theta_smooth or at 1 diameter with it (docs/theory/projection.md): those bounds are a
 guard against regressions, not the target.
 """
 import os
@@ -24,7 +24,7 @@ from cases import DATA, check, driver_main, read_csv  # noqa: E402
 
 TARGET = 1e-4        # |P - N fx t| / (N fx t), the conservation target (eos meets it)
 # projection: measured 4.8e-3 (0.03 s) / 1.2e-3 (0.02 s) with the energy-stable surface (1.9e-3 /
-# 6.2e-4 before it); guards, the target 1e-4 is not met (docs/projection.md, "Momentum of grains and fluid")
+# 6.2e-4 before it); guards, the target 1e-4 is not met (docs/theory/projection.md, "Momentum of grains and fluid")
 PROJ_BOUND = {3.0: 1e-2, 1.5: 2e-3}
 
 

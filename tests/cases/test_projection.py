@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""fix mpm/fluid ... pressure projection (docs/projection.md): the incompressible fluid
+"""fix mpm/fluid ... pressure projection (docs/theory/projection.md): the incompressible fluid
 of a pressure solve, alone and coupled with grains.
 
     test_projection.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR --mpirun "mpirun ..."
@@ -70,7 +70,7 @@ def case_dambreak(r):
     d, p = r.dambreak("projection_dambreak", cells=24, pressure="projection")
     # measured flip, ghost-fluid surface (default): front 0.428 / 0.187 / 0.083 a, height 0.023 /
     # 0.018 / 0.018 a at MPM16 / 24 / 32; 'free_surface node': front 0.378 / 0.120 / 0.063 a,
-    # height 0.031 / 0.023 / 0.022 a (docs/projection.md, "Free surface"); with the adjoint nodal
+    # height 0.031 / 0.023 / 0.022 a (docs/theory/projection.md, "Free surface"); with the adjoint nodal
     # gradient, the level as the distance to the surface and the EMPTY nodes holding fluid in the
     # surface flux: MPM32 front 0.068 a, height 0.021 a
     check_dambreak(d, "MPM24 projection", 0.21, 0.025)
@@ -175,7 +175,7 @@ def case_wave(r):
     x_c - L/2 = -2 A sin(w t) / (k^2 h L); fitted frequency within 2 % of w^2 = g k tanh(k h), the
     amplitude within 5 % of its start after three periods (neither growing nor damped away).
     The frequency's target is 2 % of the dispersion relation; at 20 cells the model reaches 3.6 %
-    (0.964, docs/projection.md "Free surface: energy and stiffness": the discrete fill of the EMPTY
+    (0.964, docs/theory/projection.md "Free surface: energy and stiffness": the discrete fill of the EMPTY
     node above the surface), so this case guards 4 % until that is resolved; at 40 and 80 cells
     the frequency is within 2 % (0.983, 0.991 with flip)."""
     sys.path.insert(0, os.path.join(os.path.dirname(r.inputs), "tools"))
@@ -346,7 +346,7 @@ def drift_run(r, case, cells, rate, transfer="flip", tend=3.0, outevery=5):
 
 
 def case_volume_correction(r):
-    """volume_correction 10 (docs/projection.md "Volume drift"): F1 stays at rest (and its pressure
+    """volume_correction 10 (docs/theory/projection.md "Volume drift"): F1 stays at rest (and its pressure
     error is that of the run without); in the F2 dam break (MPM16, apic, 2 s after the release)
     the overlapping share of the points' volume falls and the fluid's volume on the grid stays
     nearer the held one than without."""
@@ -376,7 +376,7 @@ def case_volume_correction(r):
 
 
 def case_drift_table(r):
-    """Not a CTest case: the measurement of docs/projection.md "Volume drift" (points per interior
+    """Not a CTest case: the measurement of docs/theory/projection.md "Volume drift" (points per interior
     cell and Martin & Moyce errors of the F2 dam break with and without volume_correction).
     Environment: DRIFT_CELLS (16), DRIFT_RATES (0,2,10,50), DRIFT_TRANSFER (flip)."""
     cells = int(os.environ.get("DRIFT_CELLS", "16"))
@@ -519,7 +519,7 @@ def case_coupled_np2_vs_np1(r):
     filled up to a node plane, where the ghost surface's levels are 0 up to what the grains
     displace: with a FLUID bound of 1e-9 on the level (below kLevelTie) the surface layer's clamped
     faces amplified the solver's round-off from step to step, and np 2 differed from np 1 by
-    2.3e-7 m/s (grains) and 5 % (point pressure) after 30 steps (docs/projection.md)."""
+    2.3e-7 m/s (grains) and 5 % (point pressure) after 30 steps (docs/theory/projection.md)."""
     for name, params in (("acceleration", COUPLED), ("multiplier", COUPLED_MULTIPLIER)):
         res = coupled_np2_vs_np1(r, name, params)
         if res is None:
@@ -534,7 +534,7 @@ def case_drop(r):
     16 cells, flip, 1 s): the splash hits the floor and both side walls, and no point crosses a wall
     (f_fluid[8] = 0). Before the padding nodes carried minus their mirror node's normal velocity
     they carried 0, a point on a wall read 1/8 of the velocity of the node beyond it, and 1936
-    points had been put back by 1 s (docs/tank.md)."""
+    points had been put back by 1 s (docs/validation/tank.md)."""
     d, p = r.run("projection/drop", os.path.join(os.path.dirname(__file__), "..", "data", "in.projection_drop"), {})
     s = read_csv(os.path.join(d, "drop.csv"))
     print(f"  {len(s['t'])} rows to t = {s['t'][-1]:.3f} s; largest |v| {max(s['vmax']):.2f} m/s; points put back "

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""fix mpm/fluid ... pressure projection with mesh walls (docs/projection.md, "Mesh walls"):
+"""fix mpm/fluid ... pressure projection with mesh walls (docs/theory/projection.md, "Mesh walls"):
 closed grid faces where the triangles cross them, the nodes behind the walls out of the solve.
 
     test_projection_mesh.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR --mpirun "mpirun ..."
@@ -173,7 +173,7 @@ def case_spin(r):
     moves it is the facets' own normal motion, omega times the distance from a facet's centre line,
     up to about 1 cm/s). Before the closed faces carried the normal velocity only, the points
     collapsed (cells 18: occupied cells 1944 -> 1246 in 0.2 s, the surface 8 mm lower) and this run
-    stopped at step 181 with a failed solve (docs/projection.md, "Mesh walls")."""
+    stopped at step 181 with a failed solve (docs/theory/projection.md, "Mesh walls")."""
     cells, rpm = 12, 104.0
     d = r.fresh("projection_mesh/spin")
     shutil.copy(os.path.join(DATA, "in.projection_jar_spin"), d)

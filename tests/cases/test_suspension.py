@@ -2,7 +2,7 @@
 """A uniform suspension settles at its drag law's hindered velocity:
 inputs/suspension/in.suspension at reduced size, solid fraction 0.3, `pressure projection`. The
 mean settling velocity of the grains of the middle region against the steady velocity of a
-uniform suspension computed from the inputs alone (tools/suspension.py, docs/suspension.md), and
+uniform suspension computed from the inputs alone (tools/suspension.py, docs/validation/suspension.md), and
 no acoustic ringing: the velocity's deviation from its 10 ms running mean stays small.
 
     test_suspension.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR [--mpirun "..."]
@@ -24,7 +24,7 @@ TOL = 0.07    # settling velocity / reference at this size: 1.010 measured with 
               # acceleration pressure (grain_pressure's default; 1.052-1.067 on the
               # multiplier), window 0.08-0.15 s after the release. The middle region holds about 260 grains: the count's
               # sampling scatter (about 2 %, hard spheres) moves the reference by about 4 %, so the 3 %
-              # of the acceptance is checked at full size (docs/suspension.md: 0.999-1.010), not here
+              # of the acceptance is checked at full size (docs/validation/suspension.md: 0.999-1.010), not here
 RING = 0.1    # largest deviation of the velocity from its 10 ms running mean / v_ref: 0.033 measured here
               # (0.0017 measured here), eos 0.12-0.16 at phi 0.3, no dtheta_source 7-20 (full size)
 PRING = 0.05  # the same for the largest pressure / its mean: 0.006 here; full size eos 1.7-4.0, projection 0.002-0.009
@@ -50,7 +50,7 @@ def settle(r, case, t1=0.08, **v):
 def case_projection(r):
     # the chosen options: dtheta_source yes (the default; without it the column rings at 60-120 Hz
     # and settles 2-4x too fast) and theta_smooth of one cell (without it the grains' own velocity
-    # fluctuations grow and the suspension settles 12 % slow at phi 0.1); docs/suspension.md
+    # fluctuations grow and the suspension settles 12 % slow at phi 0.1); docs/validation/suspension.md
     res = settle(r, "projection_phi03", phi=0.3, pressure="projection", extra="transfer apic theta_smooth 0.002")
     if res is None:
         return

@@ -106,7 +106,7 @@ TEST(LaserLaws, InterfaceResidualIsMonotone) {
 }
 
 TEST(LaserLaws, RecessionRateMatchesEvaporationFlux) {
-  // (3-25) with N_i and Psi derived in docs/laser_model.md equals
+  // (3-25) with N_i and Psi derived in docs/theory/laser_model.md equals
   // rho ds1/dt = j_v M (3-16), (3-17) once (4-29) is satisfied.
   const Groups G = make_groups(kMat, kI0, kR);
   for (double xi : {0.0, 0.7, 1.5}) {

@@ -213,7 +213,7 @@ TEST(LaserOptions, AbsorptivityScalesTheIntensity) {
 // with the flow the least-squares coefficient A changes. Measured: at
 // Pr = 1420 A drops from 3.42e5 to 3.12e5, at Pr = 142 it stays 8034 (the
 // root the rule of (4-19) selects there is nearly independent of the pressure,
-// docs/laser_model.md 2.6), so the test holds the Pr = 1420 case.
+// docs/theory/laser_model.md 2.6), so the test holds the Pr = 1420 case.
 TEST(LaserOptions, RecoilKnightEntersTheFlowOnly) {
   Config c = short_case(1420.0, MeltFlow::Conservative);
   c.melt_heat = MeltHeat::Ode;  // the figures above; with --melt-heat flux A drops by 4.8 % (271217 -> 258310)

@@ -30,7 +30,7 @@ std::vector<std::string> shipped_configs() {
 }  // namespace
 
 // The sweep of the acceptance is 30 steps log-spaced 1e-7 ... 1e-5 s over the
-// full pulse (tools/laser_sweep.py, docs/laser_model.md 2.8); here a subset of
+// full pulse (tools/laser_sweep.py, docs/theory/laser_model.md 2.8); here a subset of
 // those steps (every fourth, and the two at which the explicit update became
 // unstable only after running: 5.30e-6 and 6.21e-6 s) over a 100 us pulse, in
 // which that instability appeared (step 16, t = 85-99 us).

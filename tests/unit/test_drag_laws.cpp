@@ -1,5 +1,5 @@
 // Drag laws, buoyancy, exponential drag exchange and the C1 settling numbers
-// against hand-computed values (docs/drag.md).
+// against hand-computed values (docs/theory/drag.md).
 #include <gtest/gtest.h>
 
 #include <cmath>

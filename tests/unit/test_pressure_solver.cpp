@@ -3,7 +3,7 @@
 // with Dirichlet and wall boundaries, exact hydrostatics through a bed of
 // varying fluid fraction, moving walls, periodicity, the projection itself,
 // the checkerboard mode, 2 ranks against 1, and the failure path. Run with 1
-// and 2 MPI ranks (figures printed on rank 0 are quoted in docs/projection.md).
+// and 2 MPI ranks (figures printed on rank 0 are quoted in docs/theory/projection.md).
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -259,7 +259,7 @@ TEST(PressureSolver, HydrostaticBedExact) {
 
 TEST(PressureSolver, WalledInFluidNodeIsLeftOut) {
   // A FLUID node whose six faces are all closed (in the rotating jar: box corner nodes outside
-  // the jar mesh, docs/jar.md "C4 with the projection") has a zero row. Before it was left out,
+  // the jar mesh, docs/validation/jar.md "C4 with the projection") has a zero row. Before it was left out,
   // PFMG returned INF, PCG stopped at once with hypre's error flag and the old pressure (here 0)
   // stood as the answer. Now: p = 0 there, the rest of the bed hydrostatic (the node is an
   // obstacle; u* = -g dt is still exactly projected to rest), and enclosed = 1 on its rank.
@@ -302,7 +302,7 @@ TEST(PressureSolver, WalledInFluidNodeIsLeftOut) {
 
 TEST(PressureSolver, SealedPocketIsMadeCompatible) {
   // A set of FLUID nodes that closed faces seal off from every EMPTY node (a pocket of water
-  // between a lifter bar's faces and the drum: docs/projection.md "Sealed pockets") has the
+  // between a lifter bar's faces and the drum: docs/theory/projection.md "Sealed pockets") has the
   // constants as null space. With a source that does not sum to zero over it (moving wall faces
   // around it) PCG diverged: the turning drum stopped with "did not converge". Now the pocket's
   // source is made compatible (its mean removed), one node held at 0 and p returned with zero
@@ -405,7 +405,7 @@ TEST(PressureSolver, GhostSurfaceOnANodePlaneIsWellConditioned) {
   // surface there by 2 delta cells (level = half the signed distance here): the pressure may
   // change by at most about 2 rho g dx delta (bound: twice that). Measured: 0.45 rho g dx delta;
   // with 1e-9 as the FLUID bound instead of kLevelTie the +1e-7 nodes are FLUID with their surface
-  // faces clamped, and the change is 11 rho g dx delta (docs/projection.md, "np 2 against np 1
+  // faces clamped, and the change is 11 rho g dx delta (docs/theory/projection.md, "np 2 against np 1
   // with grains and the ghost surface").
   const double rho = 1000.0, g = 9.81, dt = 1e-3, eps = 1e-7, delta = 1e-9;
   const int top = 6, ip = 2, jp = 3;  // a -eps node, between +eps ones
@@ -656,7 +656,7 @@ TEST(PressureSolver, ProjectionSmoothFieldConverges) {
   // projection fall with the cell away from the boundaries (measured about 3x per
   // halving at 3 cells from them: the approximation error of the projection). The
   // largest defect sits on the last FLUID layer under the free surface, where p has
-  // a kink (p = 0 above it); it does not fall with the cell (docs/projection.md).
+  // a kink (p = 0 above it); it does not fall with the cell (docs/theory/projection.md).
   ProjectionRun r[2] = {project(12, true, MPI_COMM_WORLD), project(24, true, MPI_COMM_WORLD)};
   if (root())
     for (int m = 0; m < 2; ++m)
@@ -696,7 +696,7 @@ TEST(PressureSolver, CheckerboardIsTheStiffestModeNotANullMode) {
   // The nodal gradient of the checkerboard is zero (a mean of two face gradients
   // of opposite sign), and a nodal velocity checkerboard has zero face flux:
   // both odd-even modes are invisible to the nodal operators, which is why the
-  // pressure must come from the compact face operator above (docs/projection.md).
+  // pressure must come from the compact face operator above (docs/theory/projection.md).
   std::vector<double> grad(3 * P.grid.size()), div(P.grid.size());
   P.each_patch([&](int i, int j, int k, std::size_t n) {
     P.p[n] = cb(i, j, k);

@@ -1,5 +1,5 @@
 // The state of the last pressure solve that a restart file and the next run carry
-// (mpm::ProjectionState, mpm::gather_global, Projection::save / load; docs/projection.md
+// (mpm::ProjectionState, mpm::gather_global, Projection::save / load; docs/theory/projection.md
 // "Restart and the state between runs"), serially and on 2 MPI ranks.
 #include <gtest/gtest.h>
 #include <mpi.h>

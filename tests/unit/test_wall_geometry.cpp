@@ -1,6 +1,6 @@
 // Unit tests of mpm::WallGeometry (liggghts_mpm/mpm/wall_geometry.h) without LIGGGHTS: closest
 // points against a dense sampling of the triangle, the five wall kinds on a plate against the
-// formulas of docs/mesh_walls.md, undoing a crossing, and the bins against a scan of every triangle.
+// formulas of docs/theory/mesh_walls.md, undoing a crossing, and the bins against a scan of every triangle.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -363,8 +363,8 @@ TEST(WallGeometry, BinsMatchBruteForce) {
 // The projection's closed faces carry the wall's velocity along the wall normal only: a wall moving
 // along itself (a jar turning about its axis) is no source or sink of fluid, whatever the grid
 // face it cuts. Measured before: with the full wall velocity along the face, the staircase of the
-// faces cut by the turning jar of docs/jar.md made sources and sinks one cell apart, and the
-// water's points collapsed into clumps (docs/projection.md, "Mesh walls").
+// faces cut by the turning jar of docs/validation/jar.md made sources and sinks one cell apart, and the
+// water's points collapsed into clumps (docs/theory/projection.md, "Mesh walls").
 TEST(WallGeometry, CrossingCarriesTheNormalVelocityOnly) {
   const double sn = std::sin(M_PI / 6.0), cs = std::cos(M_PI / 6.0);
   const double n[3] = {sn, 0.0, cs}, t[3] = {cs, 0.0, -sn};
