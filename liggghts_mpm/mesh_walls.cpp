@@ -17,6 +17,7 @@
 #include "modify.h"
 #include "multi_vector_container.h"
 #include "tri_mesh.h"
+#include "mpm/mpi_exchange.h"
 
 using LAMMPS_NS::FixMeshSurface;
 using LAMMPS_NS::MultiVectorContainer;
@@ -100,27 +101,6 @@ void pack_for_ranks(const double *rec, const double lo[3], const double hi[3], c
           o[at + 20] = static_cast<double>(9 * ix + 3 * iy + iz);
         }
   }
-}
-
-// The records out[q] sent to each rank q, those of all ranks received (rtot values, in rank order).
-std::vector<double> exchange_records(MPI_Comm world, const std::vector<std::vector<double>> &out, int &rtot) {
-  const int nprocs = static_cast<int>(out.size());
-  std::vector<int> scount(nprocs), rcount(nprocs), sdisp(nprocs), rdisp(nprocs);
-  for (int q = 0; q < nprocs; ++q) scount[q] = static_cast<int>(out[q].size());
-  MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, world);
-  int stot = 0;
-  rtot = 0;
-  for (int q = 0; q < nprocs; ++q) {
-    sdisp[q] = stot;
-    rdisp[q] = rtot;
-    stot += scount[q];
-    rtot += rcount[q];
-  }
-  std::vector<double> sbuf(std::max(stot, 1)), rbuf(std::max(rtot, 1));
-  for (int q = 0; q < nprocs; ++q) std::copy(out[q].begin(), out[q].end(), sbuf.begin() + sdisp[q]);
-  MPI_Alltoallv(sbuf.data(), scount.data(), sdisp.data(), MPI_DOUBLE, rbuf.data(), rcount.data(),
-                rdisp.data(), MPI_DOUBLE, world);
-  return rbuf;
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <unordered_map>
 
+#include "mpm/mpi_exchange.h"
+
 namespace mpm {
 
 long long cell_key(const GridSpec &gs, const double x[3]) {
@@ -39,20 +41,8 @@ double largest_cell_mean(MPI_Comm comm, const std::vector<long long> &key, const
     o.push_back(e.second.first);
     o.push_back(e.second.second);
   }
-  std::vector<int> scount(nprocs), rcount(nprocs), sdisp(nprocs), rdisp(nprocs);
-  for (int q = 0; q < nprocs; ++q) scount[q] = static_cast<int>(out[q].size());
-  MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, comm);
-  int stot = 0, rtot = 0;
-  for (int q = 0; q < nprocs; ++q) {
-    sdisp[q] = stot;
-    rdisp[q] = rtot;
-    stot += scount[q];
-    rtot += rcount[q];
-  }
-  std::vector<double> sbuf(std::max(stot, 1)), rbuf(std::max(rtot, 1));
-  for (int q = 0; q < nprocs; ++q) std::copy(out[q].begin(), out[q].end(), sbuf.begin() + sdisp[q]);
-  MPI_Alltoallv(sbuf.data(), scount.data(), sdisp.data(), MPI_DOUBLE, rbuf.data(), rcount.data(), rdisp.data(),
-                MPI_DOUBLE, comm);
+  int rtot = 0;
+  const std::vector<double> rbuf = exchange_records(comm, out, rtot);
   std::unordered_map<long long, std::pair<double, double>> cells;
   for (int at = 0; at + 3 <= rtot; at += 3) {
     auto &s = cells[static_cast<long long>(rbuf[at])];

@@ -29,7 +29,6 @@ References, from the drum's outline alone (make_drum_stl.outline, the polygon it
     give the count they give; the mesh fill is compared with it (reported; the polygon mantle lies
     outside the cylinder, so the mesh fill holds slightly more).
 """
-import argparse
 import math
 import os
 import shutil
@@ -254,23 +253,5 @@ def case_bad_input(r):
               f"{case} (got: {msg.strip()[:200]})")
 
 
-CASES = {k[5:]: v for k, v in globals().items() if k.startswith("case_")}
-
-
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("case", choices=sorted(CASES))
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--inputs", default=None)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--mpirun", default="mpirun")
-    a = ap.parse_args()
-    CASES[a.case](Runner(a))
-    if cases.FAILURES:
-        print(f"{len(cases.FAILURES)} check(s) failed")
-        sys.exit(1)
-    print("all checks passed")
-
-
 if __name__ == "__main__":
-    main()
+    sys.exit(cases.driver_main(globals()))

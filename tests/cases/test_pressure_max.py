@@ -20,7 +20,6 @@ reported beside it: the deepest points lie at s/2 = dx/4.
     free surface: with `shape linear` the same tank gives +0.09 % at 10 cells deep. With eos every point of a cell has the
     cell's pressure (anti-locking), so the single point largest equals f_ID[10].
 """
-import argparse
 import os
 import sys
 
@@ -73,25 +72,5 @@ def case_projection_np2(r):
     check(abs(o2["pcell"] - o1["pcell"]) <= 1e-9 * o1["pcell"], f"np 2 = np 1 ({o2['pcell']!r} vs {o1['pcell']!r})")
 
 
-CASES = {k[5:]: v for k, v in globals().items() if k.startswith("case_")}
-
-
-def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("case", choices=sorted(CASES))
-    ap.add_argument("--exe", required=True)
-    ap.add_argument("--inputs", default=None)
-    ap.add_argument("--work", required=True)
-    ap.add_argument("--mpirun", default="mpirun")
-    a = ap.parse_args()
-    CASES[a.case](Runner(a))
-    if cases.FAILURES:
-        print(f"{len(cases.FAILURES)} check(s) failed")
-        sys.exit(1)
-    print("all checks passed")
-
-
-Runner = cases.Runner
-
 if __name__ == "__main__":
-    main()
+    sys.exit(cases.driver_main(globals()))
