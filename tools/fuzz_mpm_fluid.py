@@ -114,6 +114,9 @@ SPEC = {
     "output": ([(("int", 0, 2 ** 31 - 1), "10"), (("free", "o"), "o"), (("words", ["points"]), "points"),
                 (("words", ["v", "p", "rho"]), "v")], "eos"),
     "mesh_wall": ([(("free", "nosuch"), "nosuch"), (("words", ["freeslip"]), "freeslip")], "mesh"),
+    "probe": ([(("words", ["point", "box"]), "point"), (R(0, 0.4), "0.1"), (R(0, 0.05), "0.02"), (R(0, 0.3), "0.1")],
+              "eos"),
+    "probe_window": ([(R(0, INF, False, True), "0.01")], "probe"),
 }
 
 BAD_REAL = ["0", "-1", "nan", "inf", "-inf", "1e308", "-1e308", "1e-308", "1e400", "99999999999999999999",
@@ -177,6 +180,8 @@ def fixargs(context):
         base = base.replace("viscosity 1e-3 ", "")
     if context in ("couple", "couple_proj"):
         base += COUPLED
+    if context == "probe":  # probe_window needs a probe
+        base += " probe point 0.1 0.02 0.1"
     return base
 
 
