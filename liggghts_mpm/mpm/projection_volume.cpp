@@ -88,7 +88,7 @@ void Projection::volume_drift(const double *pvol, const double *theta, double h,
   grid_.forward(drift_.data(), 3);
 }
 
-// no EMPTY node and no node behind a mesh wall among the 26 neighbours: phi is within the band
+// no EMPTY node among the 26 neighbours and no node behind a mesh wall within two nodes: phi is within the band
 // kVolumeBand of 1 there for a regular fill (under the surface phi falls from 1 to 0 over 1.5 cells:
 // one node below the last FLUID one it is F(1) = 0.979 for the quadratic B-spline). With two nodes
 // instead, a tank 5 cells deep had almost no node where gaps were closed, only crowding was
@@ -99,12 +99,13 @@ void Projection::volume_drift(const double *pvol, const double *theta, double h,
 // vertical / 30 / 60 degree walls at 8.4e-3 / 1.0e-2 / 6.0e-2 m/s after 1 s with k = 10; with
 // these nodes left out 1.9e-12 / 3.5e-12 / 7.0e-12 m/s, test mpm_case.projection_mesh_rest)
 bool Projection::deep_inside(int i, int j, int k) const {
-  for (int c = -1; c <= 1; ++c)
-    for (int b = -1; b <= 1; ++b)
-      for (int a = -1; a <= 1; ++a)
+  for (int c = -2; c <= 2; ++c)
+    for (int b = -2; b <= 2; ++b)
+      for (int a = -2; a <= 2; ++a)
         if (grid_.in_patch(i + a, j + b, k + c)) {
           const std::size_t q = grid_.index(i + a, j + b, k + c);
-          if (lab_.kind[q] == kEmpty || behind_mesh(i + a, j + b, k + c, q)) return false;
+          const bool near = a >= -1 && a <= 1 && b >= -1 && b <= 1 && c >= -1 && c <= 1;
+          if ((near && lab_.kind[q] == kEmpty) || (mesh_ && behind_mesh(i + a, j + b, k + c, q))) return false;
         }
   return true;
 }
