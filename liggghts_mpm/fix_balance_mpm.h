@@ -3,7 +3,7 @@
 // one processor-grid dimension so that every slab holds the same weight of
 // atoms (material points of fix mpm/fluid, grains, ...), moves the atoms to
 // their new owners and lets LIGGGHTS rebuild its communication and bins.
-// User page: docs/reference/fix_balance_mpm.md.
+// User page: docs/fix_balance_mpm.md.
 #ifdef FIX_CLASS
 FixStyle(balance/mpm,FixBalanceMpm)
 #else

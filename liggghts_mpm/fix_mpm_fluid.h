@@ -4,7 +4,7 @@
    (mpm/solver.h), which knows nothing of LIGGGHTS. This class is the adapter: the fix's hooks, the
    per-point state rows (grow, copy, pack, restart), views of the atom arrays for the solver, the
    filling, the mesh walls, and the translation of the solver's errors into LIGGGHTS errors.
-   See docs/reference/fix_mpm_fluid.md and docs/design.md. */
+   See docs/fix_mpm_fluid.md and docs/design.md. */
 
 #ifdef FIX_CLASS
 

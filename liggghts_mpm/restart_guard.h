@@ -4,7 +4,7 @@
 // 'file'.partial, checking every write, and the copy is renamed to 'file' only when all of it was
 // written (the file's size on disk equal to the bytes received). Otherwise the partial copy is
 // removed, an older file of the same name is left as it was, and the run stops with an error
-// naming the file and the cause (docs/reference/fix_mpm_fluid.md, Restrictions).
+// naming the file and the cause (docs/fix_mpm_fluid.md, Restrictions).
 //
 // Covered: the write_restart command (replaced by write_restart_command) and the files of the
 // restart command while a fix mpm/fluid is defined (it redirects them: PeriodicRestarts). File

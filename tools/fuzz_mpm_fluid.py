@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Fuzz driver for the arguments of fix mpm/fluid and fix balance/mpm (standard library only).
 
-For every keyword of the keyword table of docs/reference/fix_mpm_fluid.md (and the keywords of fix
+For every keyword of the keyword table of docs/fix_mpm_fluid.md (and the keywords of fix
 balance/mpm) it writes small input scripts with bad values in each argument position (0,
 negative, nan, inf, 1e308, 1e-308, 1e400, huge integers, words, a missing argument), repeated
 keywords, conflicting keyword pairs, and the same through fix_modify, runs liggghts_mpm on each and
@@ -33,7 +33,7 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-DOC = os.path.join(HERE, "..", "docs", "reference", "fix_mpm_fluid.md")
+DOC = os.path.join(HERE, "..", "docs", "fix_mpm_fluid.md")
 
 FLUID = """atom_style sphere
 atom_modify map array sort 0 0
@@ -71,7 +71,7 @@ AXIS = ("words", ["x", "y", "z"])
 YESNO = ("words", ["yes", "no"])
 
 # keyword -> (argument slots with a valid example each, context): context 'eos', 'proj', 'couple',
-# 'couple_proj'. The ranges are those of the keyword table (docs/reference/fix_mpm_fluid.md).
+# 'couple_proj'. The ranges are those of the keyword table (docs/fix_mpm_fluid.md).
 SPEC = {
     "cell": ([(R(0, INF, True, True), "0.025")], "eos"),
     "grid": ([(R(-INF, INF), v) for v in ("0", "0.4", "0", "0.05", "0", "0.3")], "eos"),
@@ -164,7 +164,7 @@ BAL_SPEC = {
 
 
 def doc_keywords():
-    """The keyword column of the Keywords table of docs/reference/fix_mpm_fluid.md."""
+    """The keyword column of the Keywords table of docs/fix_mpm_fluid.md."""
     names, inside = [], False
     for line in open(DOC):
         if line.startswith("## "):

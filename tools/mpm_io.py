@@ -10,7 +10,7 @@
   paired_frames(rundir, prefix)       steps that have both an HDF5 file and a bead dump
   write_rows(path, rows)              a list of dicts as CSV (columns: every key, in order of first use)
 
-The HDF5 layout (liggghts_mpm/mpm/hdf5_series.cpp, docs/reference/fix_mpm_fluid.md 'Output'):
+The HDF5 layout (liggghts_mpm/mpm/hdf5_series.cpp, docs/fix_mpm_fluid.md 'Output'):
 prefix_<step, 9 digits>.h5 with root attributes 'time' and 'step', /points/xyz (n, 3) and one data
 set per point field (/points/v (n, 3), /points/p (n), ...); prefix.xmf lists the steps as comment
 blocks '<!-- mpm-step step="S" time="T" file="F" -->' (a restarted run drops the later ones).

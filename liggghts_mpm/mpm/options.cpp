@@ -480,7 +480,7 @@ Options parse_options(int narg, char **arg, const ParseEnv &env) {
     const Keyword *k = find_keyword(kw);
     if (!k)
       throw Error(std::string("Fix mpm/fluid: unknown keyword '") + kw +
-                  "' (see docs/reference/fix_mpm_fluid.md for the keywords)");
+                  "' (see docs/fix_mpm_fluid.md for the keywords)");
     // a keyword given again replaces its value (boundary and mesh_wall: one face or mesh each)
     if (std::find(seen.begin(), seen.end(), kw) != seen.end() && strcmp(kw, "boundary") != 0 &&
         strcmp(kw, "mesh_wall") != 0 && strcmp(kw, "probe") != 0)

@@ -3,7 +3,7 @@
 // Every keyword of the fix command is one row of keywords(): name, type, unit, range, default and
 // help (the help is what an error message says the keyword expects). The rows drive the parser,
 // fix_modify, the end of the 'output' field lists (a word that is a keyword ends them) and the
-// keyword table of docs/reference/fix_mpm_fluid.md (a unit test checks the page lists exactly these rows).
+// keyword table of docs/fix_mpm_fluid.md (a unit test checks the page lists exactly these rows).
 // A numeric keyword is one row with its target member and bounds; words and lists have a parse
 // function. Adding a numeric keyword: one row here plus its use.
 #pragma once

@@ -1,4 +1,4 @@
-// What the fluid does to its mesh walls, and what pressure probes read (docs/reference/fix_mpm_fluid.md,
+// What the fluid does to its mesh walls, and what pressure probes read (docs/fix_mpm_fluid.md,
 // "Wall loads and probes"; docs/theory/mesh_walls.md, "Force and torque on a mesh"): the pressure field
 // of the sub-step sampled on the triangles and at the probes, summed over the sub-steps of a fluid
 // step (walls) or of a probe window.

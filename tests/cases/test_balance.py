@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Whole-program tests of fix balance/mpm (liggghts_mpm/fix_balance_mpm.h; docs/reference/fix_balance_mpm.md).
+"""Whole-program tests of fix balance/mpm (liggghts_mpm/fix_balance_mpm.h; docs/fix_balance_mpm.md).
 Standard library only.
 
     test_balance.py CASE --exe build/liggghts_mpm --inputs inputs --work DIR [--mpirun "mpirun ..."]

@@ -62,7 +62,7 @@ def main():
             rc, out = run([os.path.join(prefix, "bin", "laser_drill"), "--help"], cwd=work)
             check(rc == 0 and "laser_drill" in out, "laser_drill --help exits 0")
         doc = os.path.join(prefix, "share", "doc", "liggghts_mpm")
-        for f in ("index.md", "reference/fix_mpm_fluid.md", "reference/fix_balance_mpm.md", "README.md", "LICENSE", "CHANGELOG.md"):
+        for f in ("index.md", "fix_mpm_fluid.md", "fix_balance_mpm.md", "README.md", "LICENSE", "CHANGELOG.md"):
             check(os.path.isfile(os.path.join(doc, f)), "share/doc/liggghts_mpm/" + f)
         check(os.path.isdir(os.path.join(doc, "img")), "share/doc/liggghts_mpm/img/")
         inp = os.path.join(prefix, "share", "liggghts_mpm", "inputs")

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Whole-program tests of `fill region-ID nx ny nz type T inside mesh-ID [outside mesh-ID ...]` of
-fix mpm/fluid (docs/reference/fix_mpm_fluid.md, keyword `fill`): the drum of inputs/drum (drum.stl
+fix mpm/fluid (docs/fix_mpm_fluid.md, keyword `fill`): the drum of inputs/drum (drum.stl
 of tools/make_drum_stl.py with its defaults: inner diameter 0.16 m, length 0.04 m, 72 mantle
 segments circumscribing the circle, 6 lifter bars 8 x 8 mm), filled below h = 0.065 m with cells of
 5 mm and 2 x 2 x 2 points per cell (spacing s = 2.5 mm, gap g = s/2), at rest (run 0).

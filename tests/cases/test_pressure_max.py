@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Whole-program tests of the largest pressure f_ID[10] of fix mpm/fluid: the largest over the grid
-cells of the mean pressure of the points in each cell (docs/reference/fix_mpm_fluid.md, "Global
+cells of the mean pressure of the points in each cell (docs/fix_mpm_fluid.md, "Global
 vector"), in a tank at rest (tests/data/in.pressure_max: water 0.2 m deep, 0.2 m wide, free-slip
 faces, 2 x 1 x 2 points per cell). Standard library only.
 

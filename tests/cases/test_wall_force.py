@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Whole-program tests of the fluid's force and torque on mesh walls and of the pressure probes of
-fix mpm/fluid (f_ID[20..], docs/reference/fix_mpm_fluid.md "Wall loads and probes"). Standard library only.
+fix mpm/fluid (f_ID[20..], docs/fix_mpm_fluid.md "Wall loads and probes"). Standard library only.
 
     test_wall_force.py CASE --exe build/liggghts_mpm --work DIR [--mpirun "mpirun ..."]
 

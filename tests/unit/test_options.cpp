@@ -1,5 +1,5 @@
 // The keyword table of fix mpm/fluid (mpm/options.h): it parses, it is what fix_modify accepts, its
-// errors name keyword, expectation and value, and docs/reference/fix_mpm_fluid.md lists exactly its keywords.
+// errors name keyword, expectation and value, and docs/fix_mpm_fluid.md lists exactly its keywords.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -281,7 +281,7 @@ TEST(Options, ReferencePageListsExactlyTheTableKeywords) {
   for (const mpm::Keyword &k : mpm::keywords()) table.push_back(k.name);
   std::sort(page.begin(), page.end());
   std::sort(table.begin(), table.end());
-  EXPECT_EQ(page, table) << "docs/reference/fix_mpm_fluid.md, section Keywords";
+  EXPECT_EQ(page, table) << "docs/fix_mpm_fluid.md, section Keywords";
 }
 
 }  // namespace
