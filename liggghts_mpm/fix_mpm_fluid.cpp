@@ -369,6 +369,13 @@ void FixMpmFluid::subdomain_changed() {
 
 double FixMpmFluid::compute_vector(int n) {
   if (n < 0 || n >= size_vector) return 0.0;
+  const int k = (n - mpm::FluidSolver::kGlobalSize) / 6;
+  if (n >= mpm::FluidSolver::kGlobalSize && k < static_cast<int>(mesh_specs.size()) && !mesh_specs[k].loads) {
+    const std::string m = "Fix mpm/fluid: f_" + std::string(id) + "[" + std::to_string(n + 1) +
+                          "] is a load of mesh_wall " + mesh_specs[k].fix_id +
+                          ", whose loads are off: give it 'loads yes' in the fix command";
+    error->all(FLERR, m.c_str());
+  }
   if (vector_step != update->ntimestep) {
     sync().global_vector(vector_cache.data(), static_cast<int>(mesh_specs.size()));
     vector_step = update->ntimestep;

@@ -41,7 +41,7 @@ using namespace FixConst;
 using mpm::NCOL;
 
 
-/* mesh_wall fix-ID kind [value] [side s] (the meshes are LIGGGHTS fixes; docs/theory/mesh_walls.md) */
+/* mesh_wall fix-ID kind [value] [side s] [loads yes|no] [reference_point x y z] (the meshes are LIGGGHTS fixes; docs/theory/mesh_walls.md) */
 int FixMpmFluid::parse_mesh_wall(int narg, char **arg, int iarg) {
   using mpm::bad_arg;
   using mpm::parse_double;
@@ -75,8 +75,9 @@ int FixMpmFluid::parse_mesh_wall(int narg, char **arg, int iarg) {
       bad_arg("mesh_wall shear", "a fraction f in [0,1] of the wall's tangential velocity", arg[iarg + 1]);
     iarg += 2;
   } else bad_arg("mesh_wall", "noslip, freeslip, partial f, sticky f or shear delta f", k);
-  // optional, in either order: side s, reference_point x y z
-  for (int opt = 0; opt < 2; ++opt) {
+  // optional, in any order: side s, loads yes|no, reference_point x y z
+  bool ref_given = false;
+  for (int opt = 0; opt < 3; ++opt) {
     if (iarg + 1 < narg && strcmp(arg[iarg], "side") == 0) {
       const char *sd = arg[iarg + 1];
       if (strcmp(sd, "auto") == 0) ms.side = mpm::SIDE_AUTO;
@@ -86,8 +87,21 @@ int FixMpmFluid::parse_mesh_wall(int narg, char **arg, int iarg) {
       else bad_arg("mesh_wall side", "auto, normal, opposite or both", sd);
       iarg += 2;
     }
+    if (iarg < narg && strcmp(arg[iarg], "loads") == 0) {
+      const char *v = iarg + 1 < narg ? arg[iarg + 1] : nullptr;
+      if (!v || (strcmp(v, "yes") != 0 && strcmp(v, "no") != 0))
+        bad_arg("mesh_wall loads", "yes or no (the fluid's force and torque on the wall as f_ID[20..])", v);
+      ms.loads = strcmp(v, "yes") == 0;
+      iarg += 2;
+    }
+    const int before = iarg;
     iarg = mpm::parse_reference_point(narg, arg, iarg, ms.ref);
+    ref_given = ref_given || iarg != before;
   }
+  // the torque's reference point is inert without the loads
+  if (ref_given && !ms.loads)
+    throw mpm::Error("Fix mpm/fluid: keyword 'mesh_wall reference_point' of mesh_wall " + ms.fix_id +
+                     " needs 'loads yes' (the wall's loads are off, so the reference point of its torque has no use)");
   mesh_specs.push_back(ms);
   return iarg;
 }

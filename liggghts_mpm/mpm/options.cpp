@@ -438,7 +438,7 @@ const std::vector<Keyword> kTable = {
      "'point x y z' or 'box xlo xhi ylo yhi zlo zhi' (length)", nullptr, 0, 0, false, false, nullptr, parse_probe, false},
     {"probe_window", "real", "time", ">= 0", "0 (each fluid step)", "a time window (time) >= 0 of the probes' average",
      REAL(probe_window), 0.0, kInf, false, true, nullptr, nullptr, false},
-    {"mesh_wall", "fix-ID kind [value] [side s] [reference_point x y z]", "-", "", "none",
+    {"mesh_wall", "fix-ID kind [value] [side s] [loads yes|no] [reference_point x y z]", "-", "", "none",
      "a fix ID and noslip | freeslip | partial f | sticky f | shear delta f",
      nullptr, 0, 0, false, false, nullptr, parse_mesh_wall, false},
 };

@@ -283,7 +283,15 @@ class FluidSolver {
   double wall_time_ = 0.0;
   std::vector<double> probe_sum_, probe_mean_;  // 2 per probe: sum p h (local), sum h
   double probe_time_ = 0.0;
-  bool samples_on() const { return (bc.walls() && bc.walls()->walls() > 0) || !opt.probes.empty(); }
+  // a mesh wall with 'loads yes' or a probe: the sub-steps sample the pressure (else nothing is spent)
+  bool samples_on() const { return walls_with_loads() || !opt.probes.empty(); }
+  bool walls_with_loads() const {
+    const WallGeometry *wg = bc.walls();
+    if (wg)
+      for (int k = 0; k < wg->walls(); ++k)
+        if (wg->wall(k).loads) return true;
+    return false;
+  }
   void node_mass_pressure();
   void surface_pressure();
   double p_surface_ = 0.0;  // pressure projection: the solve's pressure at the free surface (this sub-step)

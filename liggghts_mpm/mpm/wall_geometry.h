@@ -47,6 +47,7 @@ struct WallSpec {
                             // mesh's rotation rate omega (fitted to its triangles' velocities)
   int side = SIDE_NORMAL;  // MeshSide
   double ref[3] = {0.0, 0.0, 0.0};  // reference point of the fluid's torque on the wall (mesh_wall reference_point)
+  bool loads = false;  // mesh_wall loads yes: the fluid's force and torque on the wall are computed
 };
 
 // Checks s (kind and side known, sticky in [0,1], delta > 0 for shear) and forces sticky of the

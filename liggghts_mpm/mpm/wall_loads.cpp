@@ -199,6 +199,7 @@ void FluidSolver::wall_loads(double h) {
   std::vector<double> loc(6 * static_cast<std::size_t>(nw), 0.0);
   for (const WallGeometry::Tri &t : wg.triangles()) {
     const WallSpec &ws = wg.wall(t.mesh);
+    if (!ws.loads) continue;
     double e1[3], e2[3], e3[3];
     for (int d = 0; d < 3; ++d) {
       e1[d] = t.p[1][d] - t.p[0][d];
@@ -365,7 +366,7 @@ void FluidSolver::sample_pressure(double h) {
   }
   node_mass_pressure();
   surface_pressure();
-  if (bc.walls() && bc.walls()->walls() > 0) wall_loads(h);
+  if (walls_with_loads()) wall_loads(h);
   if (!opt.probes.empty()) probe_sums(h);
   wall_time_ += h;
   probe_time_ += h;

@@ -154,6 +154,7 @@ def case_box_projection(r):
     with open(os.path.join(DATA, "in.mesh_walls_box")) as f:
         text = f.read()
     text = text.replace("pressure eos bulk ${bulk} ", "").replace("timestep        ${tstep}", "timestep        1e-3")
+    text = text.replace("side ${fside}", "side ${fside} loads yes")
     text = text.replace("run             ${steps}", "fix             ave all ave/time 1 500 ${steps} f_fluid[20] "
                         "f_fluid[21] f_fluid[22] f_fluid[23] f_fluid[24] f_fluid[25] file wall_force_ave.txt\n"
                         "run             ${steps}")
@@ -287,10 +288,26 @@ def case_bad_input(r):
         ("probe_window_neg", "probe point 0.5 0.5 0.2 probe_window -1", ["keyword 'probe_window' expects a time window",
                                                                           "got '-1'"]),
         ("probe_window_alone", "probe_window 0.1", ["'probe_window'", "needs keyword 'probe'"]),
-        ("reference_point", "mesh_wall w freeslip reference_point 0 0 x",
+        ("reference_point", "mesh_wall w freeslip loads yes reference_point 0 0 x",
          ["keyword 'mesh_wall reference_point' expects three coordinates", "got 'x'"]),
+        ("loads_word", "mesh_wall w freeslip loads maybe", ["keyword 'mesh_wall loads' expects yes or no", "got 'maybe'"]),
+        ("reference_point_without_loads", "mesh_wall w freeslip reference_point 0 0 0",
+         ["'mesh_wall reference_point' of mesh_wall w needs 'loads yes'"]),
     ]:
         r.expect_error(f"bad_{case}", BASE + fix + words + "\nrun 1\n", ["ERROR", "Fix mpm/fluid"] + needles, case)
+    # a wall's loads read while they are off: refused when first read (thermo at step 0), not 0
+    with open(os.path.join(DATA, "in.mesh_walls_box")) as f:
+        text = f.read()
+    text = text.replace("f_fluid[8] f_fluid[10]", "f_fluid[8] f_fluid[10] f_fluid[22]", 1)
+    d = r.fresh("bad_loads_off")
+    import shutil
+    shutil.copy(os.path.join(DATA, "box.stl"), d)
+    with open(os.path.join(d, "in.box"), "w") as f:
+        f.write(text)
+    p = r.execute(d, "in.box", {"dx": 0.05, "steps": 2}, expect_ok=False, timeout=120)
+    msg = next((ln for ln in p.stdout.splitlines() if "ERROR" in ln), "")
+    check(p.returncode != 0 and "f_fluid[22] is a load of mesh_wall" in msg and "give it 'loads yes'" in msg,
+          f"the loads of a wall without 'loads yes' are refused when read (got: {msg.strip()[:160]})")
 
 
 if __name__ == "__main__":
