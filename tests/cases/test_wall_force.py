@@ -5,7 +5,7 @@ fix mpm/fluid (f_ID[20..], docs/fix_mpm_fluid.md "Wall loads and probes"). Stand
     test_wall_force.py CASE --exe build/liggghts_mpm --work DIR [--mpirun "mpirun ..."]
 
 CASE is one of: plate_projection, plate_projection_np2, plate_eos, lifters_projection, box_projection,
-box_probe_projection, probe_projection, probe_eos, bad_input. The inputs are tests/data/in.wall_force_plate,
+box_probe_projection, bad_input (the plate cases also check the probes of the same run). The inputs are tests/data/in.wall_force_plate,
 in.wall_force_lifters and tests/data/in.mesh_walls_box; the STL files are tests/data/box.stl, written here
 (a plane plate) or by tools/make_drum_stl.py (a drum with two lifter bars).
 
@@ -98,8 +98,11 @@ def plate_checks(d, label, tol, tol_force=None):
 
 
 def case_plate_projection(r):
-    """Water at rest against a vertical mesh plate, pressure projection."""
-    plate_checks(r.plate("wall_force_plate_projection", {}), "projection", 0.01)
+    """Water at rest against a vertical mesh plate, pressure projection: the plate's force and
+    torque, and pressure probes (a point and a box) in the same run against rho g depth."""
+    d = probe_run(r, "wall_force_plate_projection", {})
+    plate_checks(d, "projection", 0.01)
+    probe_checks(d, "probe projection", False)
 
 
 def case_plate_projection_np2(r):
@@ -118,8 +121,9 @@ def case_plate_projection_np2(r):
 def case_plate_eos(r):
     """The same with pressure eos (weak water, c = 14 m/s), damped to rest. Measured: force
     +1.36 %, torque +0.80 %; the force's acceptance of 1 % is not met (bound 2 %)."""
-    d = r.plate("wall_force_plate_eos", {"model": EOS, "dt": 1.4e-4, "settle": 4000, "avg": 1000})
+    d = probe_run(r, "wall_force_plate_eos", {"model": EOS, "dt": 1.4e-4, "settle": 4000, "avg": 1000})
     plate_checks(d, "eos", 0.01, tol_force=0.02)
+    probe_checks(d, "probe eos", True)
 
 
 def case_lifters_projection(r):
@@ -255,16 +259,6 @@ def probe_run(r, case, variables):
     write_plate(os.path.join(d, "plate.stl"), 0.2355, 0.05)
     r.execute(d, "in.wall_force_plate", variables)
     return d
-
-
-def case_probe_projection(r):
-    """Pressure probes (a point and a box) in the plate's tank at rest: rho g depth."""
-    probe_checks(probe_run(r, "wall_force_probe_projection", {}), "probe projection", False)
-
-
-def case_probe_eos(r):
-    probe_checks(probe_run(r, "wall_force_probe_eos", {"model": EOS, "dt": 1.4e-4, "settle": 4000, "avg": 1000}),
-                 "probe eos", True)
 
 
 BASE = """atom_style sphere
