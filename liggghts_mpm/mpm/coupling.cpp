@@ -417,24 +417,30 @@ void FluidSolver::weak_pressure_gradient() {
 }
 
 // grad_p weak: nodes on a grid face and padding nodes take the value of the nearest node off the faces
+// Only the nodes a copy writes are visited: the slabs of the patch at or beyond a face (index <= 0
+// or >= ncell along a dimension that is clamped). The node copied from lies in none of them (its
+// clamped indices are inside), so a node in two slabs gets the same copy twice.
 void FluidSolver::weak_face_copy() {
   const GridSpec &gs = opt.grid;
   const IndexBox &pb = grid_.patch();
-  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
-    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
-      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-        int c[3] = {i, j, k};
-        bool moved = false;
-        for (int d = 0; d < 3; ++d) {
-          if (gs.periodic[d] || gs.ncell[d] < 2) continue;
-          const int cc = std::min(std::max(c[d], 1), gs.ncell[d] - 1);
-          moved = moved || cc != c[d];
-          c[d] = cc;
-        }
-        if (!moved || !grid_.in_patch(c[0], c[1], c[2])) continue;
-        const std::size_t n = grid_.index(i, j, k), m = grid_.index(c[0], c[1], c[2]);
-        for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = g_.gw[3 * m + d];
-      }
+  auto copy = [&](int i, int j, int k, std::size_t n) {
+    int c[3] = {i, j, k};
+    for (int d = 0; d < 3; ++d) {
+      if (gs.periodic[d] || gs.ncell[d] < 2) continue;
+      c[d] = std::min(std::max(c[d], 1), gs.ncell[d] - 1);
+    }
+    if (!grid_.in_patch(c[0], c[1], c[2])) return;
+    const std::size_t m = grid_.index(c[0], c[1], c[2]);
+    for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = g_.gw[3 * m + d];
+  };
+  for (int d = 0; d < 3; ++d) {
+    if (gs.periodic[d] || gs.ncell[d] < 2) continue;
+    IndexBox lo = pb, hi = pb;
+    lo.hi[d] = std::min(pb.hi[d], 0);
+    hi.lo[d] = std::max(pb.lo[d], gs.ncell[d]);
+    if (!lo.empty()) grid_.for_box(lo, copy);
+    if (!hi.empty()) grid_.for_box(hi, copy);
+  }
 }
 
 /* grad_p weak, the points' view of the nodal gradient: g_p = sum_i S_ip g_i at the points, then

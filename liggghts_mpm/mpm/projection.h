@@ -131,8 +131,7 @@ class Projection {
                                  bool with_p);
   // its steps: the components along the surface of the first layer's gradient, one layer further
   void gradient_along_surface(std::vector<double> &grad);
-  void extrapolation_pass(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
-                          bool with_p);
+  void extrapolation_pass(std::vector<double> &p, std::vector<double> &grad, bool with_p);
   void extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const;
   // with grains: the padding nodes behind the box walls take the gradient of their mirror node
   // inside (the node their share of the grains' volume is folded to, FluidSolver::fluid_fraction),
@@ -145,6 +144,14 @@ class Projection {
   IndexBox work_, work_prev_;       // this step's work box (the patch when not sparse), the last one
   bool have_prev_ = false;
   std::vector<double> gk_, pk_;     // extrapolate_above_surface: gradient / pressure known
+  // extrapolate_above_surface: the owned EMPTY nodes holding fluid mass (the only ones a pass can
+  // change), in the order of the owned nodes; each pass drops those it can no longer change
+  struct SurfaceNode {
+    std::size_t n;
+    int i, j, k;
+  };
+  std::vector<SurfaceNode> ghost_, ghost_next_;
+  std::vector<std::size_t> gnew_, pnew_;
 
   LocalGrid &grid_;
   const Options &opt_;

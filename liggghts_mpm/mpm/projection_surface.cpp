@@ -355,7 +355,14 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
   grid_.forward(gk_.data(), 1);
   grid_.forward(pk_.data(), 1);
   grid_.forward(grad.data(), 3);
-  for (int pass = 0; pass < 3; ++pass) extrapolation_pass(p2g, mmin, p, grad, with_p);
+  // the owned EMPTY nodes holding fluid, in the order of the owned nodes (the passes visit them only)
+  ghost_.clear();
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] != kEmpty) return;
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    if (m > mmin && m > 0.0) ghost_.push_back({n, i, j, k});
+  });
+  for (int pass = 0; pass < 3; ++pass) extrapolation_pass(p, grad, with_p);
 }
 
 /* An EMPTY node next to the fluid has from pressure_gradient only the components along its faces
@@ -399,16 +406,18 @@ void Projection::gradient_along_surface(std::vector<double> &grad) {
    not known takes the mean of its face neighbours' that are known, and one whose pressure is not
    known the linear continuation from the neighbours whose pressure is (with_p). The nodes that
    become known in a pass are marked after it (the pass reads the flags before it); halos
-   forwarded. */
-void Projection::extrapolation_pass(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
-                                    bool with_p) {
+   forwarded. The pass visits ghost_, the owned EMPTY nodes holding fluid (the nodes every other
+   owned node would return at once), and keeps for the next pass those whose gradient, or
+   pressure with with_p, is still unknown after it (a node with both known changes nothing). */
+void Projection::extrapolation_pass(std::vector<double> &p, std::vector<double> &grad, bool with_p) {
   const double dx = opt_.grid.dx;
   std::vector<double> &gk = gk_, &pk = pk_;
-  std::vector<std::size_t> gnew, pnew;
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (lab_.kind[n] != kEmpty) return;
-    const double m = p2g[P2gRec::N * n + P2gRec::M];
-    if (!(m > mmin && m > 0.0)) return;
+  std::vector<std::size_t> &gnew = gnew_, &pnew = pnew_;
+  gnew.clear();
+  pnew.clear();
+  for (const SurfaceNode &s : ghost_) {
+    const std::size_t n = s.n;
+    const int i = s.i, j = s.j, k = s.k;
     double g[3] = {0, 0, 0}, psum = 0.0;
     int ng = 0, np = 0;
     for (int d = 0; d < 3; ++d)
@@ -433,9 +442,13 @@ void Projection::extrapolation_pass(const double *p2g, double mmin, std::vector<
       p[n] = psum / np;
       pnew.push_back(n);
     }
-  });
+  }
   for (const std::size_t n : gnew) gk[n] = 1.0;
   for (const std::size_t n : pnew) pk[n] = 1.0;
+  ghost_next_.clear();
+  for (const SurfaceNode &s : ghost_)
+    if (gk[s.n] == 0.0 || (with_p && pk[s.n] == 0.0)) ghost_next_.push_back(s);
+  ghost_.swap(ghost_next_);
   grid_.forward(gk.data(), 1);
   grid_.forward(pk.data(), 1);
   grid_.forward(grad.data(), 3);
