@@ -196,29 +196,34 @@ template <int NS>
     // gradient of the nodal pressures
     Row4 uw = {0, 0, 0, 0}, fw = {0, 0, 0, 0};
     double th = 0.0, gradp[3] = {0, 0, 0};
-    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double gx, double gy, double gz) {
-      const double *st = gst + StRec::N * n;
-      uw += w * row4(st + StRec::U);
-      fw += w * row4(st + StRec::FIT);
-      th += w * st[StRec::TH];
-      gradp[0] += st[StRec::P] * gx;
-      gradp[1] += st[StRec::P] * gy;
-      gradp[2] += st[StRec::P] * gz;
-    });
+    if (weak) {
+      // the gradient the fluid itself feels at the nodes (weak_pressure_gradient), interpolated, in
+      // the same pass (the fitted and the nodal gradients below are not read then)
+      const double *const gw = g_.gw.data();
+      for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+        const double *st = gst + StRec::N * n;
+        uw += w * row4(st + StRec::U);
+        th += w * st[StRec::TH];
+        for (int d = 0; d < 3; ++d) gradp[d] += w * gw[3 * n + d];
+      });
+    } else {
+      for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double gx, double gy, double gz) {
+        const double *st = gst + StRec::N * n;
+        uw += w * row4(st + StRec::U);
+        fw += w * row4(st + StRec::FIT);
+        th += w * st[StRec::TH];
+        gradp[0] += st[StRec::P] * gx;
+        gradp[1] += st[StRec::P] * gy;
+        gradp[2] += st[StRec::P] * gz;
+      });
+    }
     const double wet = uw[3], wfit = fw[3];
     double u[3] = {uw[0], uw[1], uw[2]};
     // Pressure gradient at the grain: the fitted nodal gradients interpolated (exact for a linear
     // pressure field, also next to walls where a node's own fit is undetermined: all its points
     // in one layer); the gradient of the interpolated nodal pressures where no fit is determined.
-    if (wfit > 0.5)
+    if (!weak && wfit > 0.5)
       for (int d = 0; d < 3; ++d) gradp[d] = fw[d] / wfit;
-    if (weak) {
-      // the gradient the fluid itself feels at the nodes (weak_pressure_gradient), interpolated
-      gradp[0] = gradp[1] = gradp[2] = 0.0;
-      for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-        for (int d = 0; d < 3; ++d) gradp[d] += w * g_.gw[3 * n + d];
-      });
-    }
     const double d_k = 2.0 * radius[k];
     const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
     double K = 0.0;
