@@ -7,6 +7,7 @@
 #pragma once
 #include <mpi.h>
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -123,7 +124,16 @@ class Projection {
   // with the extended gradient (grad read only with mesh walls), then into the padding nodes
   void extend_for_points(const std::vector<double> &p, const std::vector<double> &grad, const double *p2g,
                          double mmin, std::vector<double> &p_out, std::vector<double> *grad_out);
-  std::size_t wall_node(int i, int j, int k) const;
+  // The node of the box (indices clamped to 0..ncell in non-periodic dimensions) in front of a
+  // padding node (itself if that node is outside the patch). Inline: extend_to_padding calls it
+  // for every padding node.
+  std::size_t wall_node(int i, int j, int k) const {
+    const GridSpec &gs = opt_.grid;
+    int q[3] = {i, j, k};
+    for (int d = 0; d < 3; ++d)
+      if (!gs.periodic[d]) q[d] = std::min(std::max(q[d], 0), gs.ncell[d]);
+    return grid_.in_patch(q[0], q[1], q[2]) ? grid_.index(q[0], q[1], q[2]) : grid_.index(i, j, k);
+  }
   void mirror_normal(double *v, int i, int j, int k, const double *p2g, double mmin) const;
   double folded_mass(int i, int j, int k) const;
   double mirror_sum(const std::vector<double> &a, int i, int j, int k) const;
@@ -150,7 +160,7 @@ class Projection {
     std::size_t n;
     int i, j, k;
   };
-  std::vector<SurfaceNode> ghost_, ghost_next_;
+  std::vector<SurfaceNode> surface_, ghost_, ghost_next_;
   std::vector<std::size_t> gnew_, pnew_;
 
   LocalGrid &grid_;

@@ -275,15 +275,6 @@ void Projection::extend_behind(std::vector<double> &a, int stride, const double 
   }
 }
 
-/* The node of the box (indices clamped to 0..ncell in non-periodic dimensions) in front of a
-   padding node (itself if that node is outside the patch). */
-std::size_t Projection::wall_node(int i, int j, int k) const {
-  const GridSpec &gs = opt_.grid;
-  int q[3] = {i, j, k};
-  for (int d = 0; d < 3; ++d)
-    if (!gs.periodic[d]) q[d] = std::min(std::max(q[d], 0), gs.ncell[d]);
-  return grid_.in_patch(q[0], q[1], q[2]) ? grid_.index(q[0], q[1], q[2]) : grid_.index(i, j, k);
-}
 
 void Projection::mirror_to_padding(const std::vector<double> &a, std::vector<double> &out) const {
   const GridSpec &gs = opt_.grid;
@@ -339,18 +330,32 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
   // to a FLUID one for the gradient (pressure_gradient's one-sided surface face)
   zero_for_sweep(gk_);
   zero_for_sweep(pk_);
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (lab_.kind[n] == kFluid) {
-      gk_[n] = pk_[n] = 1.0;
-      return;
-    }
-    if (lab_.kind[n] != kEmpty) return;
-    for (int d = 0; d < 3; ++d)
-      for (int side = -1; side <= 1; side += 2) {
-        std::size_t m;
-        if (open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kFluid) gk_[n] = 1.0;
-      }
-  });
+  // found from the FLUID side (a face is open from both of its nodes or from neither): the FLUID
+  // nodes of the owned nodes (of the work box) grown by one node, and their EMPTY owned neighbours
+  // across open faces (surface_, the first layer above the surface)
+  const IndexBox ob = grid_.restricted() ? grid_.owned().cut(grid_.work()) : grid_.owned();
+  IndexBox fb = ob;
+  for (int d = 0; d < 3; ++d) {
+    --fb.lo[d];
+    ++fb.hi[d];
+  }
+  fb = fb.cut(grid_.patch());
+  surface_.clear();
+  if (!ob.empty())
+    grid_.for_box(fb, [&](int i, int j, int k, std::size_t n) {
+      if (lab_.kind[n] != kFluid) return;
+      if (ob.contains(i, j, k)) gk_[n] = pk_[n] = 1.0;
+      for (int d = 0; d < 3; ++d)
+        for (int side = -1; side <= 1; side += 2) {
+          int q[3] = {i, j, k};
+          q[d] += side;
+          std::size_t m;
+          if (!ob.contains(q[0], q[1], q[2]) || !open_face(grid_, lab_, i, j, k, d, side, &m)) continue;
+          if (lab_.kind[m] != kEmpty || gk_[m] != 0.0) continue;
+          gk_[m] = 1.0;
+          surface_.push_back({m, q[0], q[1], q[2]});
+        }
+    });
   gradient_along_surface(grad);
   grid_.forward(gk_.data(), 1);
   grid_.forward(pk_.data(), 1);
@@ -374,8 +379,11 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
 void Projection::gradient_along_surface(std::vector<double> &grad) {
   std::vector<std::pair<std::size_t, int>> fill;
   std::vector<double> val;
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (lab_.kind[n] != kEmpty || gk_[n] == 0.0) return;
+  // the owned EMPTY nodes with a known gradient: surface_ (the values come from FLUID nodes only,
+  // and are written after the loop: the order of the nodes does not matter)
+  for (const SurfaceNode &s : surface_) {
+    const std::size_t n = s.n;
+    const int i = s.i, j = s.j, k = s.k;
     for (int d = 0; d < 3; ++d) {
       bool along = false;
       for (int side = -1; side <= 1; side += 2) {
@@ -398,7 +406,7 @@ void Projection::gradient_along_surface(std::vector<double> &grad) {
         val.push_back(sum / cnt);
       }
     }
-  });
+  }
   for (std::size_t q = 0; q < fill.size(); ++q) grad[3 * fill[q].first + fill[q].second] = val[q];
 }
 
