@@ -429,6 +429,19 @@ def section_coupling(a):
     RUNS.append(dict(section="coupling", case="tank_timers", wall_s=wall, loop_s=loop, fluid_s=fluid,
                      coupling_s=cpl, steps=steps))
 
+    # the same segment with the input's defaults: the default pressure model (projection), the
+    # fluid and the coupling every 10 DEM steps
+    cmd = [a.exe, "-in", tank, "-echo", "none"] + short[:10]
+    wall, out, _ = run(cmd, os.path.join(a.out, "coupling", "default"))
+    ft = fix_times(out)
+    fluid = sum(t[0] for t in ft)
+    cpl = sum(t[1] for t in ft)
+    say("    default model (projection, every 10): fluid %.3f s, coupling %.3f s" % (fluid, cpl))
+    add("coupling_overhead_fraction_default", cpl / fluid if fluid else float("nan"), "ratio",
+        "C3 Grid40x8, the same segment with in.tank's defaults (pressure projection, every 10), one rank, "
+        "fix timers: coupling / fluid")
+    RUNS.append(dict(section="coupling", case="tank_timers_default", wall_s=wall, fluid_s=fluid, coupling_s=cpl))
+
     say("== coupling: pure-fluid 3-D dam break under callgrind (hot spots)")
     cmd = [a.exe, "-in", os.path.join(TOP, "inputs", "bench", "in.dambreak3d"), "-echo", "none",
            "-var", "cells", "10", "-var", "warm", "2", "-var", "nsteps", "10"]
