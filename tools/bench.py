@@ -400,8 +400,9 @@ def fix_times(text):
 def section_coupling(a):
     say("== coupling: C3 tank at Grid40 x 8, fix timers (one rank)")
     tank = os.path.join(TOP, "inputs", "tank", "in.tank")
-    short = ["-var", "tdry", "0.0004", "-var", "tsnap", "0.0001", "-var", "tsettle", "0.0005",
-             "-var", "tend", "0.0005", "-var", "tfront", "0.0001"]
+    segment = ["-var", "tdry", "0.0004", "-var", "tsnap", "0.0001", "-var", "tsettle", "0.0005",
+               "-var", "tend", "0.0005", "-var", "tfront", "0.0001"]
+    short = list(segment)
     # the fluid every step with the weakly compressible model, as docs/validation/performance.md measured it
     # (in.tank defaults to the projection with the fluid every 10 DEM steps)
     short += ["-var", "pressure", "eos", "-var", "wallkind", "noslip", "-var", "damp", "100",
@@ -428,6 +429,19 @@ def section_coupling(a):
     add("c3_ms_per_coupled_step", 1e3 * loop / steps, "ms/step", "native, same segment, 1 rank")
     RUNS.append(dict(section="coupling", case="tank_timers", wall_s=wall, loop_s=loop, fluid_s=fluid,
                      coupling_s=cpl, steps=steps))
+
+    # the same segment with the input's defaults: the default pressure model (projection), the
+    # fluid and the coupling every 10 DEM steps
+    cmd = [a.exe, "-in", tank, "-echo", "none"] + segment
+    wall, out, _ = run(cmd, os.path.join(a.out, "coupling", "default"))
+    ft = fix_times(out)
+    fluid = sum(t[0] for t in ft)
+    cpl = sum(t[1] for t in ft)
+    say("    default model (projection, every 10): fluid %.3f s, coupling %.3f s" % (fluid, cpl))
+    add("coupling_overhead_fraction_default", cpl / fluid if fluid else float("nan"), "ratio",
+        "C3 Grid40x8, the same segment with in.tank's defaults (pressure projection, every 10), one rank, "
+        "fix timers: coupling / fluid")
+    RUNS.append(dict(section="coupling", case="tank_timers_default", wall_s=wall, fluid_s=fluid, coupling_s=cpl))
 
     say("== coupling: pure-fluid 3-D dam break under callgrind (hot spots)")
     cmd = [a.exe, "-in", os.path.join(TOP, "inputs", "bench", "in.dambreak3d"), "-echo", "none",

@@ -196,29 +196,34 @@ template <int NS>
     // gradient of the nodal pressures
     Row4 uw = {0, 0, 0, 0}, fw = {0, 0, 0, 0};
     double th = 0.0, gradp[3] = {0, 0, 0};
-    for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double gx, double gy, double gz) {
-      const double *st = gst + StRec::N * n;
-      uw += w * row4(st + StRec::U);
-      fw += w * row4(st + StRec::FIT);
-      th += w * st[StRec::TH];
-      gradp[0] += st[StRec::P] * gx;
-      gradp[1] += st[StRec::P] * gy;
-      gradp[2] += st[StRec::P] * gz;
-    });
+    if (weak) {
+      // the gradient the fluid itself feels at the nodes (weak_pressure_gradient), interpolated, in
+      // the same pass (the fitted and the nodal gradients below are not read then)
+      const double *const gw = g_.gw.data();
+      for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+        const double *st = gst + StRec::N * n;
+        uw += w * row4(st + StRec::U);
+        th += w * st[StRec::TH];
+        for (int d = 0; d < 3; ++d) gradp[d] += w * gw[3 * n + d];
+      });
+    } else {
+      for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double gx, double gy, double gz) {
+        const double *st = gst + StRec::N * n;
+        uw += w * row4(st + StRec::U);
+        fw += w * row4(st + StRec::FIT);
+        th += w * st[StRec::TH];
+        gradp[0] += st[StRec::P] * gx;
+        gradp[1] += st[StRec::P] * gy;
+        gradp[2] += st[StRec::P] * gz;
+      });
+    }
     const double wet = uw[3], wfit = fw[3];
     double u[3] = {uw[0], uw[1], uw[2]};
     // Pressure gradient at the grain: the fitted nodal gradients interpolated (exact for a linear
     // pressure field, also next to walls where a node's own fit is undetermined: all its points
     // in one layer); the gradient of the interpolated nodal pressures where no fit is determined.
-    if (wfit > 0.5)
+    if (!weak && wfit > 0.5)
       for (int d = 0; d < 3; ++d) gradp[d] = fw[d] / wfit;
-    if (weak) {
-      // the gradient the fluid itself feels at the nodes (weak_pressure_gradient), interpolated
-      gradp[0] = gradp[1] = gradp[2] = 0.0;
-      for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-        for (int d = 0; d < 3; ++d) gradp[d] += w * g_.gw[3 * n + d];
-      });
-    }
     const double d_k = 2.0 * radius[k];
     const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
     double K = 0.0;
@@ -417,24 +422,30 @@ void FluidSolver::weak_pressure_gradient() {
 }
 
 // grad_p weak: nodes on a grid face and padding nodes take the value of the nearest node off the faces
+// Only the nodes a copy writes are visited: the slabs of the patch at or beyond a face (index <= 0
+// or >= ncell along a dimension that is clamped). The node copied from lies in none of them (its
+// clamped indices are inside), so a node in two slabs gets the same copy twice.
 void FluidSolver::weak_face_copy() {
   const GridSpec &gs = opt.grid;
   const IndexBox &pb = grid_.patch();
-  for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
-    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
-      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
-        int c[3] = {i, j, k};
-        bool moved = false;
-        for (int d = 0; d < 3; ++d) {
-          if (gs.periodic[d] || gs.ncell[d] < 2) continue;
-          const int cc = std::min(std::max(c[d], 1), gs.ncell[d] - 1);
-          moved = moved || cc != c[d];
-          c[d] = cc;
-        }
-        if (!moved || !grid_.in_patch(c[0], c[1], c[2])) continue;
-        const std::size_t n = grid_.index(i, j, k), m = grid_.index(c[0], c[1], c[2]);
-        for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = g_.gw[3 * m + d];
-      }
+  auto copy = [&](int i, int j, int k, std::size_t n) {
+    int c[3] = {i, j, k};
+    for (int d = 0; d < 3; ++d) {
+      if (gs.periodic[d] || gs.ncell[d] < 2) continue;
+      c[d] = std::min(std::max(c[d], 1), gs.ncell[d] - 1);
+    }
+    if (!grid_.in_patch(c[0], c[1], c[2])) return;
+    const std::size_t m = grid_.index(c[0], c[1], c[2]);
+    for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = g_.gw[3 * m + d];
+  };
+  for (int d = 0; d < 3; ++d) {
+    if (gs.periodic[d] || gs.ncell[d] < 2) continue;
+    IndexBox lo = pb, hi = pb;
+    lo.hi[d] = std::min(pb.hi[d], 0);
+    hi.lo[d] = std::max(pb.lo[d], gs.ncell[d]);
+    if (!lo.empty()) grid_.for_box(lo, copy);
+    if (!hi.empty()) grid_.for_box(hi, copy);
+  }
 }
 
 /* grad_p weak, the points' view of the nodal gradient: g_p = sum_i S_ip g_i at the points, then

@@ -153,12 +153,25 @@ void FluidSolver::fluid_fraction() {
   fold_to_mirror(g_.sol, 1);
   grid_.reverse_sum(g_.sol.data(), 1);
   if (opt.theta_smooth > 0.0) smooth_solid_volume();
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const int mi[3] = {opt.grid.mirror(i, 0), opt.grid.mirror(j, 1), opt.grid.mirror(k, 2)};
-    const double Vj = solid_node_volume(mi[0], mi[1], mi[2]);
-    const std::size_t m = grid_.in_patch(mi[0], mi[1], mi[2]) ? grid_.index(mi[0], mi[1], mi[2]) : n;
-    g_.th[n] = std::min(1.0, std::max(opt.theta_min, 1.0 - g_.sol[m] / Vj));  // (8-11), (8-14)
-  });
+  // the mirror node and its volume of every owned node depend on the patch only: found once
+  if (g_.th_src.size() != grid_.size()) {
+    g_.th_src.assign(grid_.size(), 0);
+    g_.th_vol.assign(grid_.size(), 0.0);
+    grid_.for_owned_all([&](int i, int j, int k, std::size_t n) {
+      const int mi[3] = {opt.grid.mirror(i, 0), opt.grid.mirror(j, 1), opt.grid.mirror(k, 2)};
+      g_.th_vol[n] = solid_node_volume(mi[0], mi[1], mi[2]);
+      g_.th_src[n] = grid_.in_patch(mi[0], mi[1], mi[2]) ? grid_.index(mi[0], mi[1], mi[2]) : n;
+    });
+  }
+  {
+    const std::size_t *const src = g_.th_src.data();
+    const double *const Vj = g_.th_vol.data(), *const sol = g_.sol.data();
+    double *const th = g_.th.data();
+    const double tmin = opt.theta_min;
+    grid_.for_owned([&](int, int, int, std::size_t n) {
+      th[n] = std::min(1.0, std::max(tmin, 1.0 - sol[src[n]] / Vj[n]));  // (8-11), (8-14)
+    });
+  }
   grid_.forward(g_.th.data(), 1);
   const double *const gth = g_.th.data();
   for (const int i : plist_) {

@@ -57,6 +57,10 @@ struct GridFields {
   std::vector<double> wk;       // grad_p weak: WkRec (reverse-summed)
   std::vector<double> gw;       // grad_p weak: the fluid's pressure gradient (3), every patch node
   std::vector<double> rp, rq;   // reaction points: the grains' pressure reaction, its density (3)
+  // fluid_fraction: per owned node the node whose solid volume gives its fraction (its mirror inside
+  // the box walls, or itself) and that node's volume; they depend on the patch only (filled on first use)
+  std::vector<std::size_t> th_src;
+  std::vector<double> th_vol;
 
   // cells: anti-locking (pressure eos); fit: the grains' pressure from the points' least-squares
   // fit (the text's coupling, model yang2016)
@@ -79,6 +83,8 @@ struct GridFields {
       rq.assign(nodes * 3, 0.0);
       vnode.clear();
       vnode_ready = false;
+      th_src.clear();
+      th_vol.clear();
     }
   }
 };

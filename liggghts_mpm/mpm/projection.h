@@ -7,6 +7,7 @@
 #pragma once
 #include <mpi.h>
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -123,7 +124,16 @@ class Projection {
   // with the extended gradient (grad read only with mesh walls), then into the padding nodes
   void extend_for_points(const std::vector<double> &p, const std::vector<double> &grad, const double *p2g,
                          double mmin, std::vector<double> &p_out, std::vector<double> *grad_out);
-  std::size_t wall_node(int i, int j, int k) const;
+  // The node of the box (indices clamped to 0..ncell in non-periodic dimensions) in front of a
+  // padding node (itself if that node is outside the patch). Inline: extend_to_padding calls it
+  // for every padding node.
+  std::size_t wall_node(int i, int j, int k) const {
+    const GridSpec &gs = opt_.grid;
+    int q[3] = {i, j, k};
+    for (int d = 0; d < 3; ++d)
+      if (!gs.periodic[d]) q[d] = std::min(std::max(q[d], 0), gs.ncell[d]);
+    return grid_.in_patch(q[0], q[1], q[2]) ? grid_.index(q[0], q[1], q[2]) : grid_.index(i, j, k);
+  }
   void mirror_normal(double *v, int i, int j, int k, const double *p2g, double mmin) const;
   double folded_mass(int i, int j, int k) const;
   double mirror_sum(const std::vector<double> &a, int i, int j, int k) const;
@@ -131,8 +141,7 @@ class Projection {
                                  bool with_p);
   // its steps: the components along the surface of the first layer's gradient, one layer further
   void gradient_along_surface(std::vector<double> &grad);
-  void extrapolation_pass(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
-                          bool with_p);
+  void extrapolation_pass(std::vector<double> &p, std::vector<double> &grad, bool with_p);
   void extend_to_padding(const std::vector<double> &a, std::vector<double> &out, int stride) const;
   // with grains: the padding nodes behind the box walls take the gradient of their mirror node
   // inside (the node their share of the grains' volume is folded to, FluidSolver::fluid_fraction),
@@ -145,6 +154,14 @@ class Projection {
   IndexBox work_, work_prev_;       // this step's work box (the patch when not sparse), the last one
   bool have_prev_ = false;
   std::vector<double> gk_, pk_;     // extrapolate_above_surface: gradient / pressure known
+  // extrapolate_above_surface: the owned EMPTY nodes holding fluid mass (the only ones a pass can
+  // change), in the order of the owned nodes; each pass drops those it can no longer change
+  struct SurfaceNode {
+    std::size_t n;
+    int i, j, k;
+  };
+  std::vector<SurfaceNode> surface_, ghost_, ghost_next_;
+  std::vector<std::size_t> gnew_, pnew_;
 
   LocalGrid &grid_;
   const Options &opt_;

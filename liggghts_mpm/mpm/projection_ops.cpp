@@ -84,17 +84,6 @@ double face_flux(const NodeLabels &lab, std::size_t n, const Face &f, int d, con
 
 }  // namespace
 
-bool open_face(const LocalGrid &grid, const NodeLabels &labels, int i, int j, int k, int d, int side,
-               std::size_t *m) {
-  int q[3] = {i, j, k};
-  q[d] += side;
-  if (!grid.in_patch(q[0], q[1], q[2])) return false;  // beyond the grid: the halo covers all else
-  const std::size_t n = grid.index(i, j, k), nb = grid.index(q[0], q[1], q[2]);
-  *m = nb;
-  const std::size_t lower = side > 0 ? n : nb;
-  return !((labels.closed[lower] >> d) & 1u) && labels.kind[n] != kSolid && labels.kind[nb] != kSolid;
-}
-
 void NodeLabels::reset(const LocalGrid &grid, const IndexBox *work) {
   const GridSpec &g = grid.spec();
   const IndexBox &pb = grid.patch();

@@ -131,8 +131,17 @@ inline double surface_weight(const NodeLabels &labels, std::size_t n, std::size_
 // True if the face of node (i, j, k) towards (i, j, k) + side e_d (side = -1 or
 // +1) is open: both nodes in the patch, neither SOLID, not flagged closed.
 // *m: the neighbour's flat index when it lies in the patch.
-bool open_face(const LocalGrid &grid, const NodeLabels &labels, int i, int j, int k, int d, int side,
-               std::size_t *m);
+// (inline: it is called for every face of every node in most of the projection's sweeps)
+inline bool open_face(const LocalGrid &grid, const NodeLabels &labels, int i, int j, int k, int d, int side,
+                      std::size_t *m) {
+  int q[3] = {i, j, k};
+  q[d] += side;
+  if (!grid.in_patch(q[0], q[1], q[2])) return false;  // beyond the grid: the halo covers all else
+  const std::size_t n = grid.index(i, j, k), nb = grid.index(q[0], q[1], q[2]);
+  *m = nb;
+  const std::size_t lower = side > 0 ? n : nb;
+  return !((labels.closed[lower] >> d) & 1u) && labels.kind[n] != kSolid && labels.kind[nb] != kSolid;
+}
 
 // The integrated divergence of theta u at the owned non-SOLID nodes:
 // D_n = sum over the faces of n of (area x outward flux) / dx, per dx^3 (the

@@ -275,15 +275,6 @@ void Projection::extend_behind(std::vector<double> &a, int stride, const double 
   }
 }
 
-/* The node of the box (indices clamped to 0..ncell in non-periodic dimensions) in front of a
-   padding node (itself if that node is outside the patch). */
-std::size_t Projection::wall_node(int i, int j, int k) const {
-  const GridSpec &gs = opt_.grid;
-  int q[3] = {i, j, k};
-  for (int d = 0; d < 3; ++d)
-    if (!gs.periodic[d]) q[d] = std::min(std::max(q[d], 0), gs.ncell[d]);
-  return grid_.in_patch(q[0], q[1], q[2]) ? grid_.index(q[0], q[1], q[2]) : grid_.index(i, j, k);
-}
 
 void Projection::mirror_to_padding(const std::vector<double> &a, std::vector<double> &out) const {
   const GridSpec &gs = opt_.grid;
@@ -339,23 +330,44 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
   // to a FLUID one for the gradient (pressure_gradient's one-sided surface face)
   zero_for_sweep(gk_);
   zero_for_sweep(pk_);
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (lab_.kind[n] == kFluid) {
-      gk_[n] = pk_[n] = 1.0;
-      return;
-    }
-    if (lab_.kind[n] != kEmpty) return;
-    for (int d = 0; d < 3; ++d)
-      for (int side = -1; side <= 1; side += 2) {
-        std::size_t m;
-        if (open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kFluid) gk_[n] = 1.0;
-      }
-  });
+  // found from the FLUID side (a face is open from both of its nodes or from neither): the FLUID
+  // nodes of the owned nodes (of the work box) grown by one node, and their EMPTY owned neighbours
+  // across open faces (surface_, the first layer above the surface)
+  const IndexBox ob = grid_.restricted() ? grid_.owned().cut(grid_.work()) : grid_.owned();
+  IndexBox fb = ob;
+  for (int d = 0; d < 3; ++d) {
+    --fb.lo[d];
+    ++fb.hi[d];
+  }
+  fb = fb.cut(grid_.patch());
+  surface_.clear();
+  if (!ob.empty())
+    grid_.for_box(fb, [&](int i, int j, int k, std::size_t n) {
+      if (lab_.kind[n] != kFluid) return;
+      if (ob.contains(i, j, k)) gk_[n] = pk_[n] = 1.0;
+      for (int d = 0; d < 3; ++d)
+        for (int side = -1; side <= 1; side += 2) {
+          int q[3] = {i, j, k};
+          q[d] += side;
+          std::size_t m;
+          if (!ob.contains(q[0], q[1], q[2]) || !open_face(grid_, lab_, i, j, k, d, side, &m)) continue;
+          if (lab_.kind[m] != kEmpty || gk_[m] != 0.0) continue;
+          gk_[m] = 1.0;
+          surface_.push_back({m, q[0], q[1], q[2]});
+        }
+    });
   gradient_along_surface(grad);
   grid_.forward(gk_.data(), 1);
   grid_.forward(pk_.data(), 1);
   grid_.forward(grad.data(), 3);
-  for (int pass = 0; pass < 3; ++pass) extrapolation_pass(p2g, mmin, p, grad, with_p);
+  // the owned EMPTY nodes holding fluid, in the order of the owned nodes (the passes visit them only)
+  ghost_.clear();
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (lab_.kind[n] != kEmpty) return;
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    if (m > mmin && m > 0.0) ghost_.push_back({n, i, j, k});
+  });
+  for (int pass = 0; pass < 3; ++pass) extrapolation_pass(p, grad, with_p);
 }
 
 /* An EMPTY node next to the fluid has from pressure_gradient only the components along its faces
@@ -367,8 +379,11 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
 void Projection::gradient_along_surface(std::vector<double> &grad) {
   std::vector<std::pair<std::size_t, int>> fill;
   std::vector<double> val;
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (lab_.kind[n] != kEmpty || gk_[n] == 0.0) return;
+  // the owned EMPTY nodes with a known gradient: surface_ (the values come from FLUID nodes only,
+  // and are written after the loop: the order of the nodes does not matter)
+  for (const SurfaceNode &s : surface_) {
+    const std::size_t n = s.n;
+    const int i = s.i, j = s.j, k = s.k;
     for (int d = 0; d < 3; ++d) {
       bool along = false;
       for (int side = -1; side <= 1; side += 2) {
@@ -391,7 +406,7 @@ void Projection::gradient_along_surface(std::vector<double> &grad) {
         val.push_back(sum / cnt);
       }
     }
-  });
+  }
   for (std::size_t q = 0; q < fill.size(); ++q) grad[3 * fill[q].first + fill[q].second] = val[q];
 }
 
@@ -399,16 +414,18 @@ void Projection::gradient_along_surface(std::vector<double> &grad) {
    not known takes the mean of its face neighbours' that are known, and one whose pressure is not
    known the linear continuation from the neighbours whose pressure is (with_p). The nodes that
    become known in a pass are marked after it (the pass reads the flags before it); halos
-   forwarded. */
-void Projection::extrapolation_pass(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
-                                    bool with_p) {
+   forwarded. The pass visits ghost_, the owned EMPTY nodes holding fluid (the nodes every other
+   owned node would return at once), and keeps for the next pass those whose gradient, or
+   pressure with with_p, is still unknown after it (a node with both known changes nothing). */
+void Projection::extrapolation_pass(std::vector<double> &p, std::vector<double> &grad, bool with_p) {
   const double dx = opt_.grid.dx;
   std::vector<double> &gk = gk_, &pk = pk_;
-  std::vector<std::size_t> gnew, pnew;
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (lab_.kind[n] != kEmpty) return;
-    const double m = p2g[P2gRec::N * n + P2gRec::M];
-    if (!(m > mmin && m > 0.0)) return;
+  std::vector<std::size_t> &gnew = gnew_, &pnew = pnew_;
+  gnew.clear();
+  pnew.clear();
+  for (const SurfaceNode &s : ghost_) {
+    const std::size_t n = s.n;
+    const int i = s.i, j = s.j, k = s.k;
     double g[3] = {0, 0, 0}, psum = 0.0;
     int ng = 0, np = 0;
     for (int d = 0; d < 3; ++d)
@@ -433,9 +450,13 @@ void Projection::extrapolation_pass(const double *p2g, double mmin, std::vector<
       p[n] = psum / np;
       pnew.push_back(n);
     }
-  });
+  }
   for (const std::size_t n : gnew) gk[n] = 1.0;
   for (const std::size_t n : pnew) pk[n] = 1.0;
+  ghost_next_.clear();
+  for (const SurfaceNode &s : ghost_)
+    if (gk[s.n] == 0.0 || (with_p && pk[s.n] == 0.0)) ghost_next_.push_back(s);
+  ghost_.swap(ghost_next_);
   grid_.forward(gk.data(), 1);
   grid_.forward(pk.data(), 1);
   grid_.forward(grad.data(), 3);
