@@ -245,6 +245,23 @@ def case_restart_roundtrip(r):
         check(rel < 1e-10, f"{k}: continued run matches uninterrupted run (rel. diff {rel:.1e})")
 
 
+def case_every_restart(r):
+    """Coupled, the fluid every 4 DEM steps, the restart file written two steps after a fluid step:
+    the resumed run continues the uninterrupted one (the grains' force of the last fluid step is in
+    the restart file and acts until the next fluid step)."""
+    inp = os.path.join(DATA, "in.every_restart")
+    d0, _ = r.run("every_restart/full", inp, {"mode": 0})
+    d1, _ = r.run("every_restart/split", inp, {"mode": 1})
+    p = r.execute(d1, "in.every_restart", {"mode": 2}, expect_ok=False, timeout=300)
+    check(p.returncode == 0, "restarted run finished")
+    a = read_csv(os.path.join(d0, "state.csv"))
+    b = read_csv(os.path.join(d1, "state.csv"))
+    check(a["ffluid"][0] > 0.0, f"the fluid holds the grains up (sum of their fluid force {a['ffluid'][0]:.3e} N)")
+    for k in a:
+        rel = abs(a[k][0] - b[k][0]) / max(abs(a[k][0]), 1e-300)
+        check(rel < 1e-10, f"{k}: continued run matches uninterrupted run (rel. diff {rel:.1e})")
+
+
 def case_bad_input(r):
     """Bad fix arguments stop with an error naming the keyword and what was expected."""
     base = ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1")
