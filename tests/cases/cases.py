@@ -624,8 +624,8 @@ def case_theta_smooth(r):
 
 
 def case_every(r):
-    """'every N': the fluid advances every N-th step by N dt and the grain gets the impulse of the N
-    steps at the fluid step; C1 terminal velocity still within 2 % (DEM step N times smaller)."""
+    """'every N': the fluid advances every N-th step by N dt and the grain gets its force on each of
+    the N steps; C1 terminal velocity still within 2 % (DEM step N times smaller)."""
     inp = os.path.join(r.inputs, "settling", "in.settling")
     d, _ = r.run("every/heavy", inp, dict(SETTLING_EOS, every=4))
     sim = read_csv(os.path.join(d, "settling.csv"))
@@ -896,8 +896,8 @@ def case_porewave(r):
     decays("every2", dt=6e-6, every=2)
     fails("every2_7e-6", ("Fix mpm/fluid", "fluid step (every x timestep) 1.4e-05", "of the fluid coupled"),
           dt=7e-6, every=2)
-    # every 3 at cfl 1: the impulse of the 3 steps given at once is a symplectic step of 3 dt and
-    # decays; keeping the force for the 3 steps (before) blew up here to 0.7 MPa in 1200 steps
+    # every 3 at cfl 1: the force kept for the 3 steps, taken with the grains halfway through them,
+    # is a symplectic map and decays; taken at the fluid step it blows up here (0.43 MPa)
     decays("every3_cfl1", dt=8e-6, every=3, extra="cfl 1.0", nsteps=1500, nout=30)
 
 
