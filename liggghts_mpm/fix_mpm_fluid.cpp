@@ -198,6 +198,13 @@ void FixMpmFluid::refresh_walls() {
 }
 
 void FixMpmFluid::setup(int) {
+  // The points have radius 0: LIGGGHTS' granular walls (fix wall/gran, mesh or primitive) act on
+  // every atom within its radius of a wall whatever the fix's group, and a point of finite radius
+  // got contact forces from them (a turning drum's lifters pushed the water's points with the beads'
+  // contact law, and the drum's stress output counted them). A restart file of an earlier build
+  // holds points of finite radius: set here for every run.
+  for (int i = 0; i < atom->nlocal; ++i)
+    if (is_point(i)) atom->radius[i] = 0.0;
   mpm::FluidSolver &s = sync();
   s.setup_grid(domain->sublo, domain->subhi, neighbor->skin);
   check_gate_side();

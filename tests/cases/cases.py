@@ -262,6 +262,27 @@ def case_every_restart(r):
         check(rel < 1e-10, f"{k}: continued run matches uninterrupted run (rel. diff {rel:.1e})")
 
 
+def case_every_bed(r):
+    """A DEM output with the fluid every 20 DEM steps (tests/data/in.every_bed, the default pressure
+    projection): a bed of 363 grains at rest on a frictionless mesh floor in water. The floor force
+    (fix mesh/surface/stress) averaged over the fluid steps equals its average over every step (the
+    grains receive the fluid force on every step; measured 0.07 % apart, 2.0 % with the whole impulse
+    on the fluid step), and the bed's buoyant weight n m g (1 - rho_f/rho_p) within 5 % (measured
+    -1.4 %). No LIGGGHTS wall acts on the material points (radius 0): their force at the end of a
+    step is their weight."""
+    d, _ = r.run("every_bed", os.path.join(DATA, "in.every_bed"), {"every": 20},
+                 extra_files=(os.path.join(DATA, "box.stl"),))
+    f = read_csv(os.path.join(d, "every_bed.csv"))
+    w, fall, ffl = f["weight"][0], f["floor_all"][0], f["floor_fluid"][0]
+    print(f"  n {f['n'][0]:.0f}: floor force over every step {fall:.5e} N, over fluid steps {ffl:.5e} N, "
+          f"buoyant weight {w:.5e} N; points' force less their weight {f['points_extra'][0]:.1e} of it")
+    rel = abs(ffl - fall) / fall
+    check(rel < 0.01, f"floor force on fluid steps within 1 % of its mean over every step ({rel:.2e})")
+    dw = (fall - w) / w
+    check(abs(dw) < 0.05, f"floor force within 5 % of the bed's buoyant weight ({dw:+.3f})")
+    check(abs(f["points_extra"][0]) < 1e-9, f"no wall force on the points ({f['points_extra'][0]:.1e})")
+
+
 def case_bad_input(r):
     """Bad fix arguments stop with an error naming the keyword and what was expected."""
     base = ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1")
