@@ -198,9 +198,9 @@ void FixMpmFluid::refresh_walls() {
 }
 
 void FixMpmFluid::setup(int) {
-  // The points have radius 0: LIGGGHTS' granular walls (fix wall/gran, mesh or primitive) act on
-  // every atom within its radius of a wall whatever the fix's group, and a point of finite radius
-  // got contact forces from them (a turning drum's lifters pushed the water's points with the beads'
+  // The points have radius 0: a LIGGGHTS mesh wall (fix wall/gran ... mesh) acts on every atom
+  // within its radius of the wall whatever the wall fix's group (a primitive one of group all as
+  // well), and a point of finite radius got contact forces from them (a turning drum's lifters pushed the water's points with the beads'
   // contact law, and the drum's stress output counted them). A restart file of an earlier build
   // holds points of finite radius: set here for every run.
   for (int i = 0; i < atom->nlocal; ++i)

@@ -283,6 +283,72 @@ def case_every_bed(r):
     check(abs(f["points_extra"][0]) < 1e-9, f"no wall force on the points ({f['points_extra'][0]:.1e})")
 
 
+EVERY_INSERT = """atom_style sphere
+atom_modify map array sort 0 0
+boundary f f f
+newton off
+communicate single vel yes
+units si
+region box block 0 0.024 0 0.024 0 0.03 units box
+create_box 2 box
+neighbor 0.0006 bin
+neigh_modify delay 0 every 1 check yes exclude type 1 1 exclude type 1 2
+region water block 0 0.024 0 0.024 0 0.027 units box
+group grains type 2
+group fluid type 1
+fix fluid fluid mpm/fluid cell 0.003 density 1000 pressure eos bulk 2.2e5 viscosity 1e-3 boundary all noslip &
+    fill water 2 2 2 type 1 hydrostatic z 0.027 9.81 transfer apic couple grains every 4
+lattice sc 0.004
+region gr block 0.006 0.018 0.006 0.018 0.016 0.022 units box
+create_atoms 2 region gr
+set type 2 diameter 0.001 density 2500
+group grains type 2
+fix grav all gravity 9.81 vector 0.0 0.0 -1.0
+fix integr grains nve/sphere
+timestep 2e-5
+variable ntag equal count(all)+1
+run 6
+print "NEWTAG ${ntag}"
+group gone id 4620
+delete_atoms group gone compress no
+create_atoms 2 single 0.003 0.003 0.02 units box
+set atom ${ntag} diameter 0.001 density 2500
+group grains type 2
+variable fnew equal fz[${ntag}]
+variable mg equal -mass[${ntag}]*9.81
+variable fold equal fz[4625]
+variable mgold equal -mass[4625]*9.81
+thermo_style custom step v_fnew v_mg v_fold v_mgold
+thermo 1
+run 1
+print "AFTER7 ${fnew} ${mg} ${fold} ${mgold}"
+run 1
+print "AFTER8 ${fnew} ${mg} ${fold} ${mgold}"
+"""
+
+
+def case_every_insert(r):
+    """every 4: a grain deleted and a grain created between two fluid steps (step 6; fluid steps 4
+    and 8). LIGGGHTS moves the last atom, a grain, into the deleted one's slot and puts the new grain
+    in the slot it vacated: the new grain receives no fluid force until the fluid step 8 (the fluid
+    did not see it), the moved grain keeps its own. Without the vacated row cleared the new grain
+    got the moved grain's force at step 7."""
+    p, msg = r.run_script("every_insert", EVERY_INSERT)
+    check(p.returncode == 0, f"the run ends normally ({msg.strip()[:160]})")
+    rows = {ln.split()[0]: [float(x) for x in ln.split()[1:]] for ln in p.stdout.splitlines()
+            if ln.startswith("AFTER")}
+    if set(rows) != {"AFTER7", "AFTER8"}:
+        check(False, f"AFTER7 and AFTER8 printed ({sorted(rows)})")
+        return
+    fnew7, mg, fold7, mgold = rows["AFTER7"]
+    fnew8 = rows["AFTER8"][0]
+    print(f"  new grain fz at step 7 {fnew7:.6e} N (weight {mg:.6e}), at step 8 {fnew8:.6e}; moved grain at step 7 "
+          f"{fold7:.6e} (weight {mgold:.6e})")
+    check(abs(fnew7 - mg) <= 1e-12 * abs(mg), "step 7: the new grain's force is its weight alone")
+    check(abs(fold7 - mgold) > 0.1 * abs(mgold), "step 7: the moved grain keeps its fluid force")
+    check(abs(fnew8 - mg) > 0.1 * abs(mg), "step 8 (a fluid step): the new grain receives a fluid force")
+
+
 def case_bad_input(r):
     """Bad fix arguments stop with an error naming the keyword and what was expected."""
     base = ("cell 0.5 density 1000 pressure eos bulk 2e6 fill col 2 2 2 type 1")
