@@ -198,6 +198,13 @@ void FixMpmFluid::refresh_walls() {
 }
 
 void FixMpmFluid::setup(int) {
+  // The points have radius 0: a LIGGGHTS mesh wall (fix wall/gran ... mesh) acts on every atom
+  // within its radius of the wall whatever the wall fix's group (a primitive one of group all as
+  // well), and a point of finite radius got contact forces from them (a turning drum's lifters pushed the water's points with the beads'
+  // contact law, and the drum's stress output counted them). A restart file of an earlier build
+  // holds points of finite radius: set here for every run.
+  for (int i = 0; i < atom->nlocal; ++i)
+    if (is_point(i)) atom->radius[i] = 0.0;
   mpm::FluidSolver &s = sync();
   s.setup_grid(domain->sublo, domain->subhi, neighbor->skin);
   check_gate_side();
@@ -227,12 +234,10 @@ void FixMpmFluid::setup(int) {
     print(s.check_timestep(true));
   });
   // LIGGGHTS recomputed the grains' forces for this run; the fluid force of the last fluid step
-  // (kept in the state rows, also across restart files) belongs to them as it did at the end of
-  // that step, so that run N; run M (or a restart between them) equals run N+M
-  if (s.opt.coupled && update->ntimestep % s.opt.fluid_every == 0)
-    for (int k = 0; k < atom->nlocal; ++k)
-      if (atom->mask[k] & couple_groupbit)
-        for (int d = 0; d < 3; ++d) atom->f[k][d] += s.opt.fluid_every * pdata[k][mpm::C_FGRAIN + d];
+  // (kept in the state rows, also across restart files) acts on them on this step as it did when
+  // the step was first taken, so that run N; run M (or a restart between them, on a fluid step or
+  // between two) equals run N+M
+  add_grain_force();
   if (s.opt.out_every > 0 && update->ntimestep % s.opt.out_every == 0) guarded([&] { s.write_output(); });
   mark_run_start();
 }
@@ -339,26 +344,71 @@ void FixMpmFluid::pre_final_integrate() {
     os << "fix mpm/fluid: gate removed at time " << sim_time() << " (step " << update->ntimestep << ")\n";
     print(os.str());
   }
-  // between two fluid steps the grains get no fluid force: the fluid step gave them the
-  // whole impulse of its N steps at once (FluidSolver::step)
-  if (s.opt.fluid_every > 1 && update->ntimestep % s.opt.fluid_every != 0) return;
-  guarded([&] { print(s.check_timestep(false)); });
-  refresh_walls();
-  guarded([&] { s.step(); });
-  if (!sealed_noted && s.pressure_sealed_nodes() > 0) {
-    sealed_noted = true;
-    std::ostringstream os;
-    os << "fix mpm/fluid: at step " << update->ntimestep << " " << s.pressure_sealed_nodes()
-       << " fluid nodes in " << s.pressure_sealed_sets()
-       << " pocket(s) are sealed off from the free surface by closed wall faces: each pocket's pressure is "
-          "solved with its own mean (the water in it cannot be compressed; noted once)\n";
-    print(os.str());
+  // the fluid advances on every N-th step by N dt (keyword every); the grains receive the force of
+  // the last fluid step on each DEM step, this one included
+  if (s.opt.fluid_every == 1 || update->ntimestep % s.opt.fluid_every == 0) {
+    guarded([&] { print(s.check_timestep(false)); });
+    refresh_walls();
+    if (s.opt.coupled && s.opt.fluid_every > 1) {
+      // the fluid sees the grains (N-1)/2 steps ahead, where they are halfway through the N steps
+      // that will receive its force: see fluid_step_ahead
+      fluid_step_ahead(s);
+    } else {
+      guarded([&] { s.step(); });
+    }
+    if (!sealed_noted && s.pressure_sealed_nodes() > 0) {
+      sealed_noted = true;
+      std::ostringstream os;
+      os << "fix mpm/fluid: at step " << update->ntimestep << " " << s.pressure_sealed_nodes()
+         << " fluid nodes in " << s.pressure_sealed_sets()
+         << " pocket(s) are sealed off from the free surface by closed wall faces: each pocket's pressure is "
+            "solved with its own mean (the water in it cannot be compressed; noted once)\n";
+      print(os.str());
+    }
+    if (s.opt.coupled && fix_dragforce)
+      for (int k = 0; k < atom->nlocal; ++k)
+        if (atom->mask[k] & couple_groupbit)
+          for (int d = 0; d < 3; ++d) fix_dragforce->array_atom[k][d] = s.grain_force()[3 * k + d];
+    vector_step = -1;
   }
-  if (s.opt.coupled && fix_dragforce)
-    for (int k = 0; k < atom->nlocal; ++k)
-      if (atom->mask[k] & couple_groupbit)
-        for (int d = 0; d < 3; ++d) fix_dragforce->array_atom[k][d] = s.grain_force()[3 * k + d];
-  vector_step = -1;
+  add_grain_force();
+}
+
+/* every N > 1: the fluid step at step n gives its force F to the N DEM steps n .. n+N-1. With F
+   taken at the grains' positions of step n, a force F(x) kept for N steps is not a symplectic map
+   (det = 1 + N(N-1)/2 (w dt)^2 for F/m = -w^2 x; docs/theory/coupled_stability.md, "every N"): the
+   coupled pore-pressure oscillation grows. Taken at x + (N-1)/2 dt v, where the grains are halfway
+   through those steps, the map over the N steps has det = 1 (the midpoint rule of the N steps):
+   the grains are moved there for the fluid step and put back after it. Their velocities are
+   unchanged; with N = 1 the shift is 0 and the fluid step sees the grains where they are. */
+void FixMpmFluid::fluid_step_ahead(mpm::FluidSolver &s) {
+  const double ahead = 0.5 * (s.opt.fluid_every - 1) * update->dt;
+  const int nlocal = atom->nlocal;
+  double **x = atom->x, **v = atom->v;
+  shifted.resize(3 * static_cast<std::size_t>(nlocal));
+  for (int k = 0; k < nlocal; ++k)
+    for (int d = 0; d < 3; ++d) {
+      shifted[3 * k + d] = x[k][d];
+      if (atom->mask[k] & couple_groupbit) x[k][d] += ahead * v[k][d];
+    }
+  guarded([&] { s.step(); });
+  for (int k = 0; k < nlocal; ++k)
+    if (atom->mask[k] & couple_groupbit)
+      for (int d = 0; d < 3; ++d) x[k][d] = shifted[3 * k + d];
+}
+
+/* The fluid force on the grains, F of the last fluid step (state rows, C_FGRAIN), added on each DEM
+   step: with every N the fluid step at step n covers the steps n .. n+N-1, and velocity Verlet turns
+   the N forces into the impulse N dt F that the fluid gave up in its step. A grain that came to
+   this rank carries its F in its row (pack_exchange); one inserted after the fluid step has F = 0
+   until the next one (rows are zeroed when made or vacated: grow_arrays, copy_arrays), as the fluid
+   did not see it either. */
+void FixMpmFluid::add_grain_force() {
+  if (!solver->opt.coupled) return;
+  double **f = atom->f;
+  for (int k = 0; k < atom->nlocal; ++k)
+    if (atom->mask[k] & couple_groupbit)
+      for (int d = 0; d < 3; ++d) f[k][d] += pdata[k][mpm::C_FGRAIN + d];
 }
 
 double FixMpmFluid::busy_seconds() const { return solver ? solver->busy_seconds() : 0.0; }
@@ -409,7 +459,13 @@ void FixMpmFluid::grow_arrays(int nmax) {
   array_atom = pdata;
 }
 
-void FixMpmFluid::copy_arrays(int i, int j, int) { std::copy(pdata[i], pdata[i] + NCOL, pdata[j]); }
+// LIGGGHTS copies atom i into the slot j and vacates i (exchange and deletion: the last atom into
+// the slot of one that left, itself when it is the one that left; sorting): i's grain force is
+// cleared, so that an atom inserted into the vacated slot starts with none
+void FixMpmFluid::copy_arrays(int i, int j, int) {
+  if (i != j) std::copy(pdata[i], pdata[i] + NCOL, pdata[j]);
+  std::fill(pdata[i] + mpm::C_FGRAIN, pdata[i] + mpm::C_FGRAIN + 3, 0.0);
+}
 
 void FixMpmFluid::set_arrays(int i) { std::fill(pdata[i], pdata[i] + NCOL, 0.0); }
 

@@ -81,6 +81,9 @@ class FixMpmFluid : public Fix {
   void finish_fill(int nlocal_before, double vol);
   void check_fill_memory(class Region *region, const int lo[3], const int hi[3]);
   void refresh_walls();
+  void add_grain_force();
+  void fluid_step_ahead(mpm::FluidSolver &s);  // every N > 1: the fluid step with the grains (N-1)/2 steps ahead
+  std::vector<double> shifted;  // the grains' positions while fluid_step_ahead moved them  // F of the last fluid step onto the coupled grains' f (every DEM step)
   void check_gate_side();
   mpm::FluidSolver &sync();  // the solver with views of the current atom arrays and clock
   template <class Fn> void guarded(Fn &&fn);  // runs fn, translating the solver's errors

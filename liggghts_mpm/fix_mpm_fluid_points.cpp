@@ -254,7 +254,7 @@ void FixMpmFluid::fill_points() {
 }
 
 /* One material point at x of volume vol, at rest, in the fix's group (the other fixes' per-atom
-   arrays set as for any new atom). */
+   arrays set as for any new atom), of radius 0. */
 void FixMpmFluid::create_point(const double *x, double vol) {
   const mpm::Options &o = solver->opt;
   const double *spacing = solver->state.spacing;
@@ -270,7 +270,7 @@ void FixMpmFluid::create_point(const double *x, double vol) {
   atom->mask[n] |= groupbit;
   atom->v[n][0] = atom->v[n][1] = atom->v[n][2] = 0.0;
   atom->rmass[n] = solver->init_point(x, vol, pdata[n]);
-  atom->radius[n] = 0.5 * std::min(spacing[0], std::min(spacing[1], spacing[2]));
+  atom->radius[n] = 0.0;  // no LIGGGHTS contact: see FixMpmFluid::setup
   if (atom->density_flag && atom->density) atom->density[n] = o.eos.rho0;
 }
 

@@ -155,17 +155,12 @@ void FluidSolver::step() {
   for (int s = 0; s < state.nsub; ++s) substep(h, s == 0 ? vc_time : 0.0);
   if (samples) end_samples();
   if (!opt.coupled) return;
-  // fluid force on the grains (mean over the sub-steps), for the host's integrator. With every N
-  // the grains get the impulse of the N steps, N h F, in this step (force N F): velocity Verlet
-  // then advances them as one symplectic step of N dt. Keeping F for N steps instead spreads the
-  // kick over the drift and makes every undamped coupled oscillation grow
-  // (docs/theory/coupled_stability.md, "every N").
+  // fluid force on the grains (mean over the sub-steps): kept in the state rows, from which the host
+  // adds it to the grains' forces on each of the N DEM steps this fluid step covers (with every N;
+  // FixMpmFluid::add_grain_force), so that the grains receive the impulse N dt F the fluid gave up
   for (int k = 0; k < pts.nlocal; ++k) {
     if (!is_grain(k)) continue;
-    for (int d = 0; d < 3; ++d) {
-      pts.f[k][d] += opt.fluid_every * grain_force_[3 * k + d];
-      pts.state[k][C_FGRAIN + d] = grain_force_[3 * k + d];
-    }
+    for (int d = 0; d < 3; ++d) pts.state[k][C_FGRAIN + d] = grain_force_[3 * k + d];
   }
 }
 

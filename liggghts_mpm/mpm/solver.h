@@ -89,8 +89,10 @@ class FluidSolver {
   // Time-step check of the current state (collective, throws mpm::Error): the number of fluid
   // sub-steps of the next step (state.nsub); returns a log line when it changed at setup.
   std::string check_timestep(bool at_setup);
+
   // One fluid step of fluid_every * dt in state.nsub sub-steps; with couple, the fluid force on
-  // the grains (mean over the sub-steps) is added to their f and state rows (grain_force()).
+  // the grains (mean over the sub-steps) goes to their state rows (C_FGRAIN) and grain_force(): the
+  // host adds it to the grains' forces on each DEM step until the next fluid step.
   void step();
   const std::vector<double> &grain_force() const { return grain_force_; }
 
