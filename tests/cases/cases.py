@@ -21,6 +21,16 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, "..", "data")  # input scripts and STL files of the cases
 FAILURES = []
 
+# The first lines of the inputs the tests write: spheres, SI units, a closed box, no Newton's third
+# law across ranks, velocities communicated (what fix mpm/fluid needs).
+PREAMBLE = """atom_style sphere
+atom_modify map array sort 0 0
+boundary f f f
+newton off
+communicate single vel yes
+units si
+"""
+
 
 def check(cond, what):
     print(("ok    " if cond else "FAIL  ") + what)
@@ -230,16 +240,20 @@ def case_np2_vs_np1(r):
     dambreak_np2_vs_np1(r, "np2_vs_np1", 1e-8, "round-off", tend=2.0)
 
 
+def restart_pair(r, case, name):
+    """Runs tests/data/NAME whole (-var mode 0) and in two halves (mode 1 writes a restart file, mode 2
+    continues from it in the same folder); returns the state.csv rows of the whole and the split run."""
+    inp = os.path.join(DATA, name)
+    d0, _ = r.run(f"{case}/full", inp, {"mode": 0})
+    d1, _ = r.run(f"{case}/split", inp, {"mode": 1})
+    p = r.execute(d1, name, {"mode": 2}, expect_ok=False, timeout=300)
+    check(p.returncode == 0, "restarted run finished")
+    return read_csv(os.path.join(d0, "state.csv")), read_csv(os.path.join(d1, "state.csv"))
+
+
 def case_restart_roundtrip(r):
     """write_restart / read_restart continue a run exactly."""
-    inp = os.path.join(DATA, "in.restart")
-    d0, _ = r.run("restart/full", inp, {"mode": 0})
-    d1, _ = r.run("restart/split", inp, {"mode": 1})
-    # the second half runs in the same folder, from restart.mpm
-    p = r.execute(d1, "in.restart", {"mode": 2}, expect_ok=False, timeout=300)
-    check(p.returncode == 0, "restarted run finished")
-    a = read_csv(os.path.join(d0, "state.csv"))
-    b = read_csv(os.path.join(d1, "state.csv"))
+    a, b = restart_pair(r, "restart", "in.restart")
     for k in a:
         rel = abs(a[k][0] - b[k][0]) / max(abs(a[k][0]), 1e-300)
         check(rel < 1e-10, f"{k}: continued run matches uninterrupted run (rel. diff {rel:.1e})")
@@ -249,13 +263,7 @@ def case_every_restart(r):
     """Coupled, the fluid every 4 DEM steps, the restart file written two steps after a fluid step:
     the resumed run continues the uninterrupted one (the grains' force of the last fluid step is in
     the restart file and acts until the next fluid step)."""
-    inp = os.path.join(DATA, "in.every_restart")
-    d0, _ = r.run("every_restart/full", inp, {"mode": 0})
-    d1, _ = r.run("every_restart/split", inp, {"mode": 1})
-    p = r.execute(d1, "in.every_restart", {"mode": 2}, expect_ok=False, timeout=300)
-    check(p.returncode == 0, "restarted run finished")
-    a = read_csv(os.path.join(d0, "state.csv"))
-    b = read_csv(os.path.join(d1, "state.csv"))
+    a, b = restart_pair(r, "every_restart", "in.every_restart")
     check(a["ffluid"][0] > 0.0, f"the fluid holds the grains up (sum of their fluid force {a['ffluid'][0]:.3e} N)")
     for k in a:
         rel = abs(a[k][0] - b[k][0]) / max(abs(a[k][0]), 1e-300)
@@ -283,13 +291,7 @@ def case_every_bed(r):
     check(abs(f["points_extra"][0]) < 1e-9, f"no wall force on the points ({f['points_extra'][0]:.1e})")
 
 
-EVERY_INSERT = """atom_style sphere
-atom_modify map array sort 0 0
-boundary f f f
-newton off
-communicate single vel yes
-units si
-region box block 0 0.024 0 0.024 0 0.03 units box
+EVERY_INSERT = PREAMBLE + """region box block 0 0.024 0 0.024 0 0.03 units box
 create_box 2 box
 neighbor 0.0006 bin
 neigh_modify delay 0 every 1 check yes exclude type 1 1 exclude type 1 2

@@ -12,17 +12,12 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import cases  # noqa: E402
 from cases import check, driver_main, read_csv  # noqa: E402
 
 # A water column on the floor of a box; grains of type 2 may be added; granular contacts between
 # grains (pair gran); {pre} before the fix (exclusion lines), {fixargs} more keywords.
-COLUMN = """atom_style sphere
-atom_modify map array sort 0 0
-boundary f f f
-newton off
-communicate single vel yes
-units si
-region box block 0 0.4 0 0.05 0 0.3 units box
+COLUMN = cases.PREAMBLE + """region box block 0 0.4 0 0.05 0 0.3 units box
 create_box 2 box
 neighbor 0.005 bin
 neigh_modify delay 0 every 1 check yes
@@ -88,13 +83,7 @@ def case_theta_smooth_bound(r):
 
 
 # A few grains in a fluid-filled box (coupled); {d} grain diameter
-GRAINS = """atom_style sphere
-atom_modify map array sort 0 0
-boundary f f f
-newton off
-communicate single vel yes
-units si
-region box block 0 0.04 0 0.04 0 0.04 units box
+GRAINS = cases.PREAMBLE + """region box block 0 0.04 0 0.04 0 0.04 units box
 create_box 2 box
 neighbor 0.001 bin
 neigh_modify delay 0 every 1 check yes exclude type 1 1 exclude type 1 2
