@@ -61,17 +61,9 @@ def case_rest(r):
         check(s["corrections"][-1] == 0, f"{label}: no point put back (none reached the wall)")
         # hydrostatic: one pressure per row of points (the rows next to the wall included; measured
         # 0.22 dx of water off before the linear extension behind the wall), rho g dz between rows
-        rows = defaultdict(list)
-        for x, z, pp, vx, vz in points(d).values():
-            rows[round(z, 9)].append(pp)
-        rg = s["rho"][0] * s["g"][0]
-        dx = s["dx"][0]
-        spread = max(max(v) - min(v) for v in rows.values()) / (rg * dx)
-        # the lowest row reads the padding nodes under the box floor (the floor node's pressure
-        # copied: 0.94 rho g dz to the next row, as without mesh walls), the highest the surface
-        zs = sorted(rows)[1:-1]
-        means = [sum(rows[z]) / len(rows[z]) for z in zs]
-        step = max(abs((a - b) / (rg * (z1 - z0)) - 1.0) for a, b, z0, z1 in zip(means, means[1:], zs, zs[1:]))
+        # (the lowest row reads the padding nodes under the box floor, the floor node's pressure
+        # copied: 0.94 rho g dz to the next row, as without mesh walls; row_pressures leaves it out)
+        spread, step = row_pressures(d, s)
         print(f"  {label}: row spread {spread:.2e} rho g dx, rows apart by rho g dz to {step:.2e}")
         check(spread < 1e-6, f"{label}: one pressure per row of points, next to the wall too ({spread:.2e} rho g dx)")
         check(step < 1e-6, f"{label}: hydrostatic between the rows below the surface row ({step:.2e})")
@@ -82,14 +74,7 @@ def case_pressure_output(r):
     pressure is hydrostatic as the multiplier's (one pressure per row, rows apart by rho g dz), the
     nodes behind the wall extrapolated linearly with the acceleration pressure's own gradient."""
     d, p, s = run(r, "pressure_output30", angle=30, xw=0.4137, extra="pressure_output acceleration")
-    rows = defaultdict(list)
-    for x, z, pp, vx, vz in points(d).values():
-        rows[round(z, 9)].append(pp)
-    rg, dx = s["rho"][0] * s["g"][0], s["dx"][0]
-    spread = max(max(v) - min(v) for v in rows.values()) / (rg * dx)
-    zs = sorted(rows)[1:-1]
-    means = [sum(rows[z]) / len(rows[z]) for z in zs]
-    step = max(abs((a - b) / (rg * (z1 - z0)) - 1.0) for a, b, z0, z1 in zip(means, means[1:], zs, zs[1:]))
+    spread, step = row_pressures(d, s)
     print(f"  acceleration pressure beside a 30 degree wall: row spread {spread:.2e} rho g dx, rows apart by rho g dz "
           f"to {step:.2e}")
     check(spread < 1e-6 and step < 1e-6, "the acceleration pressure is hydrostatic beside the mesh wall")
