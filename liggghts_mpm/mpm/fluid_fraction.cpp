@@ -97,11 +97,7 @@ void FluidSolver::init_theta() {
    its integrator, whose stencil would index far outside the grid. */
 void FluidSolver::check_grain(int k) const {
   const double *x = pts.x[k], *v = pts.v[k];
-  const char *what = nullptr;
-  if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))) what = "position";
-  else if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))) what = "velocity";
-  else if (!(std::isfinite(pts.radius[k]) && pts.radius[k] > 0.0)) what = "radius";
-  else if (!(std::isfinite(pts.rmass[k]) && pts.rmass[k] > 0.0)) what = "mass";
+  const char *what = first_bad(x, v, &pts.radius[k], pts.rmass[k]);
   if (!what) return;
   std::ostringstream os;
   os << "Fix mpm/fluid: the " << what << " of grain " << pts.tag[k] << " (group '" << opt.couple_group

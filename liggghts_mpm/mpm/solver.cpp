@@ -270,12 +270,17 @@ long FluidSolver::nonzero_outside_active() const {
 }
 
 // What the step reads of point i (position, velocity, mass) is finite, the mass positive.
+const char *FluidSolver::first_bad(const double *x, const double *v, const double *radius, double mass) {
+  if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))) return "position";
+  if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))) return "velocity";
+  if (radius && !(std::isfinite(*radius) && *radius > 0.0)) return "radius";
+  if (!(std::isfinite(mass) && mass > 0.0)) return "mass";
+  return nullptr;
+}
+
 void FluidSolver::bad_point(int i) const {
   const double *x = pts.x[i], *v = pts.v[i];
-  const char *what = nullptr;
-  if (!(std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]))) what = "position";
-  else if (!(std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]))) what = "velocity";
-  else if (!(std::isfinite(pts.rmass[i]) && pts.rmass[i] > 0.0)) what = "mass";
+  const char *what = first_bad(x, v, nullptr, pts.rmass[i]);
   if (!what) return;
   std::ostringstream os;
   os << "Fix mpm/fluid: the " << what << " of material point " << pts.tag[i] << " is not finite"

@@ -272,6 +272,9 @@ class FluidSolver {
   }
   void bad_point(int i) const;
   void check_grain(int k) const;      // finite position, velocity, radius, mass (fluid_fraction)
+  // the first of position, velocity, radius (when given) and mass that is not finite, or (radius,
+  // mass) not positive; nullptr if none (bad_point, check_grain)
+  static const char *first_bad(const double *x, const double *v, const double *radius, double mass);
   std::unique_ptr<Hdf5Series> series_;
   std::unique_ptr<Projection> proj_;  // pressure projection (opt.projection)
   // the pressure solver's time, solves and PCG iterations of the Projections of earlier patches
