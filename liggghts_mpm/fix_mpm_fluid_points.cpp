@@ -257,7 +257,6 @@ void FixMpmFluid::fill_points() {
    arrays set as for any new atom), of radius 0. */
 void FixMpmFluid::create_point(const double *x, double vol) {
   const mpm::Options &o = solver->opt;
-  const double *spacing = solver->state.spacing;
   atom->avec->create_atom(o.fill_type, const_cast<double *>(x));
   const int n = atom->nlocal - 1;
   for (int m = 0; m < modify->nfix; ++m) {
