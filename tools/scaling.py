@@ -84,29 +84,35 @@ def parse_stat(rec, line):
         rec["wait"] = [float(m.group(4)), float(m.group(5))]
 
 
-def read_results(paths):
-    """RESULTS files -> list of run dicts (model, np, rc, loop, steps, npoints, statistics)."""
+def read_results_text(text, source="text"):
+    """RESULTS lines -> list of run dicts (model, np, rc, loop, steps, npoints, statistics)."""
     runs, by = [], {}
+    for line in text.splitlines():
+        m = RE_STAT.match(line)
+        if m:
+            key = (m.group(1), int(m.group(2)))
+            if key in by:
+                parse_stat(by[key], m.group(3))
+            continue
+        m = RE_RUN.match(line)
+        if not m:
+            continue
+        rec = {"model": m.group(1), "np": int(m.group(2)), "rc": m.group(3), "source": source}
+        rec["loop"] = float(m.group(4)) if m.group(4) else float("nan")
+        r = re.search(r"RESULT n (\S+) points (\S+) steps (\S+)", m.group(5))
+        if r:
+            rec["n"], rec["npoints"], rec["steps"] = float(r.group(1)), float(r.group(2)), int(r.group(3))
+        by[(rec["model"], rec["np"])] = rec
+        runs.append(rec)
+    return runs
+
+
+def read_results(paths):
+    """RESULTS files -> list of run dicts (read_results_text of each)."""
+    runs = []
     for p in paths:
         with open(p) as f:
-            for line in f:
-                line = line.rstrip("\n")
-                m = RE_STAT.match(line)
-                if m:
-                    key = (p, m.group(1), int(m.group(2)))
-                    if key in by:
-                        parse_stat(by[key], m.group(3))
-                    continue
-                m = RE_RUN.match(line)
-                if not m:
-                    continue
-                rec = {"model": m.group(1), "np": int(m.group(2)), "rc": m.group(3), "source": p}
-                rec["loop"] = float(m.group(4)) if m.group(4) else float("nan")
-                r = re.search(r"RESULT n (\S+) points (\S+) steps (\S+)", m.group(5))
-                if r:
-                    rec["n"], rec["npoints"], rec["steps"] = float(r.group(1)), float(r.group(2)), int(r.group(3))
-                by[(p, rec["model"], rec["np"])] = rec
-                runs.append(rec)
+            runs += read_results_text(f.read(), p)
     return runs
 
 
