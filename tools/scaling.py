@@ -5,7 +5,8 @@
         [--steps-eos 50] [--steps-projection 30] [--warm 5] [--balance 1] [--exe build/liggghts_mpm]
         [--mpirun mpirun] [--out scaling-out] [--fit FIT.json] [--check]
   tools/python tools/scaling.py report RESULTS.txt ... [--out DIR] [--fit FIT.json] [--check]
-  tools/python tools/scaling.py fit RESULTS.txt ... --json FIT.json [--uniform RESULTS.txt ...]
+  tools/python tools/scaling.py fit RESULTS.txt ... --json FIT.json
+  tools/python tools/scaling.py merge TIMES.txt COUNTS.txt > MERGED.txt
   tools/python tools/scaling.py predict --fit FIT.json --counts RESULTS.txt ... [--ceiling 16 0.77]
         [--measured eos 21.13 0.87 0.73 0.57 0.45] [--out DIR]
 
@@ -20,9 +21,10 @@ core, peak memory per rank, exchanges per step, messages / bytes / wait per exch
 rank), points and patch nodes on the largest rank) and a plot of efficiency against ranks
 (OUT/scaling_efficiency.png), with the model's prediction when --fit is given.
 
-fit: the model's constants (docs/scaling.md) from runs at 1 and 2 ranks: per point and per patch
-node cost of the fluid's work per step, the rest of the step (LIGGGHTS) per point, message latency
-and bandwidth. predict: the efficiency curve of the model for the counts of RESULTS runs
+fit: the model's constants (docs/scaling.md) from runs at 1 and 2 ranks (balanced and uniform cuts):
+per point and per patch node cost of the fluid's work per step, the rest of the step (LIGGGHTS) per
+point, message latency and bandwidth. merge: the runs of TIMES with the counts of the runs of COUNTS
+with the same model and ranks (a build or machine that printed no counts). predict: the efficiency curve of the model for the counts of RESULTS runs
 (oversubscribed runs count the same as runs on real cores), against measured efficiencies.
 
 --check: the statistics must be consistent (bytes and messages sent summed over the ranks equal
@@ -239,7 +241,9 @@ def per_step(r):
 def ceiling(p, table):
     """The machine's rate per core with p busy cores: linear in p between the measured points
     (table: {p: factor}, 1: 1.0)."""
-    pts = sorted(dict(table, **{1: 1.0}).items())
+    t = dict(table)
+    t[1] = 1.0
+    pts = sorted(t.items())
     for (p0, f0), (p1, f1) in zip(pts, pts[1:]):
         if p0 <= p <= p1:
             return f0 + (f1 - f0) * (p - p0) / (p1 - p0)
@@ -254,40 +258,86 @@ def model_time(c, k, p, table):
 
 
 def do_fit(a):
-    """Constants per model from 1- and 2-rank runs (balanced), and the uniform 2-rank runs."""
-    runs = [r for r in read_results(a.results) if r["rc"] == "0"]
-    uni = [r for r in read_results(a.uniform) if r["rc"] == "0"] if a.uniform else []
-    out = {"ceiling_note": "machine rate per core with P busy cores, given to predict"}
-    # latency and bandwidth: the least wait per exchange over the ranks at 2 ranks (the last rank to
-    # arrive waits only for the transfer), against messages and bytes per exchange; a least-squares
-    # line through the 2-rank runs of both models (and the uniform ones)
-    pts = [(r["msgs_per_x"][2], r["bytes_per_x"][2], r["wait_per_x"][0]) for r in runs + uni if r["np"] == 2]
+    """Constants per model (docs/scaling.md) from runs at 1 and 2 ranks with balanced cuts:
+    b (s per patch node and step): the two ranks of a balanced 2-rank run hold the same points and
+    different patch nodes: (largest - least busy time per step) / (largest - least patch nodes);
+    busy = the fluid's and the coupling's time less the waits for halo messages.
+    a (s per point and step): the rest of the 1-rank fluid time per step, (T1 - b G) / N.
+    o (s per point and step): the rest of the 1-rank loop (LIGGGHTS: neighbour lists, integration,
+    point migration), (loop - fluid) / steps / N.
+    lat, bw: the least wait per exchange over the ranks of each uniform-cut 2-rank run (the rank
+    with more points is the last to arrive in every phase and waits only for the transfer) against
+    its messages and bytes per exchange (fit_comm).
+    Several runs of a kind: their mean. Uniform-cut 2-rank runs, if given, are predicted (largest and
+    least busy rank) as a check of the constants."""
+    import numpy as np
+    runs = [r for r in read_results(a.results) if r["rc"] == "0" and "points" in r and "fluid_s" in r]
+    out = {}
+    # the transfer alone: the 2-rank runs with uniform cuts, where one rank holds more points and is
+    # the slower in every phase, so that its wait is the transfer; balanced runs (the ranks take
+    # turns being slower, phase by phase) only without uniform ones
+    two = [r for r in runs if r["np"] == 2 and "wait" in r and r.get("exchanges")]
+    uneven = [r for r in two if r["points"][2] - r["points"][0] >= 1e-3 * r["points"][2]]
+    pts = [(r["msgs_per_x"][2], r["bytes_per_x"][2], r["wait"][0] / r["exchanges"][2]) for r in (uneven or two)]
     lat, bw = fit_comm(pts)
-    out["comm"] = {"lat": lat, "bw": bw, "from": [list(p) for p in pts]}
+    out["comm"] = {"lat": lat, "bw": bw, "from (messages, bytes, least wait per exchange)": pts}
     for model in sorted({r["model"] for r in runs}):
-        one = [r for r in runs if r["model"] == model and r["np"] == 1]
-        two = [r for r in uni if r["model"] == model and r["np"] == 2]
-        if not one or not two:
+        rs = [q for q in runs if q["model"] == model]
+        ones = [q for q in rs if q["np"] == 1]
+        bal = [q for q in rs if q["np"] == 2 and "busy" in q and q["points"][2] - q["points"][0] < 1e-3 * q["points"][2]]
+        uni = [q for q in rs if q["np"] == 2 and "busy" in q and q not in bal]
+        if not ones or not bal:
             continue
-        r1, r2 = one[0], two[0]
-        # per point: the two ranks of the uniform cut hold different numbers of points and the same
-        # number of patch nodes (up to one layer): busy_max - busy_min = a (pts_max - pts_min) +
-        # b (nodes_max - nodes_min); per node: the 1-rank fluid time = a N + b G; o: the rest of the
-        # 1-rank loop (LIGGGHTS: neighbour lists, integration, point migration) per point
-        s1, s2 = r1["steps"], r2["steps"]
-        dB = (r2["busy"][1] - r2["busy"][0]) / s2
-        dP, dN = r2["points"][2] - r2["points"][0], r2["patch"][2] - r2["patch"][0]
-        T1, N, G = r1["fluid_s"] / s1, r1["points"][2], r1["patch"][2]
-        det = dP * G - dN * N
-        aa = (dB * G - dN * T1) / det
-        bb = (dP * T1 - N * dB) / det
-        o = (r1["loop"] - r1["fluid_s"]) / s1 / N
-        out[model] = {"a": aa, "b": bb, "o": o, "lat": lat, "bw": bw,
-                      "from": {"T1_fluid_per_step": T1, "T1_loop_per_step": r1["loop"] / s1, "N": N, "G": G,
-                               "uniform_2rank_busy_diff_per_step": dB, "points_diff": dP, "nodes_diff": dN}}
+        b = float(np.mean([(q["busy"][1] - q["busy"][0]) / q["steps"] / (q["patch"][2] - q["patch"][0]) for q in bal]))
+        N, G = ones[0]["points"][0], ones[0]["patch"][0]
+        T1 = float(np.mean([q["fluid_s"] / q["steps"] for q in ones]))
+        aa = (T1 - b * G) / N
+        o = float(np.mean([(q["loop"] - q["fluid_s"]) / q["steps"] / N for q in ones]))
+        c = {"a": aa, "b": b, "o": o, "lat": lat, "bw": bw, "N": N, "G": G, "T1_fluid_per_step": T1,
+             "from": [q["source"] + ": " + q["model"] + " np " + str(q["np"]) for q in ones + bal]}
+        c["uniform_check (busy per step: measured least, largest; model least, largest)"] = [
+            [q["busy"][0] / q["steps"], q["busy"][1] / q["steps"], aa * q["points"][0] + b * q["patch"][0],
+             aa * q["points"][2] + b * q["patch"][2]] for q in uni]
+        out[model] = c
     with open(a.json, "w") as f:
         json.dump(out, f, indent=1)
     print(json.dumps(out, indent=1))
+    return 0
+
+
+def do_merge(a):
+    """The runs of TIMES (loop and wall-time lines) with the halo-exchange and work lines of the runs
+    of COUNTS of the same model and ranks (the same cuts: the same n and balance), to stdout: counts
+    of oversubscribed runs with the times of a build or machine that did not print them."""
+    counts, csteps = {}, {}
+    with open(a.counts) as f:
+        for line in f:
+            m = RE_STAT.match(line)
+            if m and ("halo exchanges" in line or "work per rank" in line):
+                counts.setdefault((m.group(1), int(m.group(2))), []).append(line.rstrip("\n"))
+            m = RE_RUN.match(line)
+            r = re.search(r"RESULT n \S+ points \S+ steps (\d+)", line)
+            if m and r:
+                csteps[(m.group(1), int(m.group(2)))] = int(r.group(1))
+    with open(a.times) as f:
+        for line in f:
+            m = RE_STAT.match(line)
+            if m and ("halo exchanges" in line or "work per rank" in line):
+                continue
+            print(line.rstrip("\n"))
+            m = RE_RUN.match(line)
+            r = re.search(r"RESULT n \S+ points \S+ steps (\d+)", line)
+            if m and r:
+                key = (m.group(1), int(m.group(2)))
+                for c in counts.get(key, []):
+                    # the exchanges of the counting run scaled to this run's steps (the same per step)
+                    x = re.search(r"exchanges " + TRIPLE, c)
+                    if x:
+                        f = int(r.group(1)) / csteps[key]
+                        c = c.replace(x.group(0), "exchanges %g/%g/%g" % tuple(float(v) * f for v in x.groups()))
+                    # the counting run's waits are not this run's
+                    c = re.sub(r"wait " + TRIPLE + " s;", "wait nan/nan/nan s;", c)
+                    print(c)
     return 0
 
 
@@ -434,8 +484,10 @@ def main():
         q.add_argument("--check", action="store_true")
     f = sub.add_parser("fit")
     f.add_argument("results", nargs="+")
-    f.add_argument("--uniform", nargs="+", default=[])
     f.add_argument("--json", required=True)
+    g = sub.add_parser("merge")
+    g.add_argument("times")
+    g.add_argument("counts")
     d = sub.add_parser("predict")
     d.add_argument("--fit", required=True)
     d.add_argument("--counts", nargs="+", required=True)
@@ -457,6 +509,8 @@ def main():
         return do_report(a)
     if a.mode == "fit":
         return do_fit(a)
+    if a.mode == "merge":
+        return do_merge(a)
     return do_predict(a)
 
 
