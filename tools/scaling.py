@@ -421,7 +421,7 @@ def plot(out, pred, meas, label, runs_eff=None):
     models = sorted({k[0] for k in list(pred) + list(meas) + list(runs_eff or {})})
     for m in models:
         col = colors.get(m, None)
-        for data, style, what in ((meas, "o-", "measured (16 cores)"), (runs_eff or {}, "s-", "measured (this run)"),
+        for data, style, what in ((meas, "o-", "measured (--measured)"), (runs_eff or {}, "s-", "measured (runs)"),
                                   (pred, "x--", label)):
             xs = sorted(k[1] for k in data if k[0] == m and isinstance(k[1], int))
             if xs:
@@ -438,7 +438,29 @@ def plot(out, pred, meas, label, runs_eff=None):
     print("wrote", png)
 
 
+def ceiling_table(paths):
+    """`ceiling P K loop T` lines (P independent 1-rank runs, one per core): {P: (mean, slowest)}
+    rate of the P runs against the run alone (P = 1)."""
+    loops = {}
+    for p in paths:
+        with open(p) as f:
+            for line in f:
+                m = re.match(r"ceiling (\d+) (\d+) loop (\S+)", line)
+                if m:
+                    loops.setdefault(int(m.group(1)), []).append(float(m.group(3)))
+    if 1 not in loops:
+        return {}
+    t1 = loops[1][0]
+    return {p: (t1 * len(v) / sum(v), t1 / max(v)) for p, v in sorted(loops.items())}
+
+
 def do_report(a):
+    ceil = ceiling_table(a.results)
+    if ceil:
+        print("machine ceiling (P independent 1-rank runs, one per core; rate against one alone):")
+        print("| P | mean | slowest |\n|---|---|---|")
+        for p, (mean, slow) in ceil.items():
+            print("| %d | %.3f | %.3f |" % (p, mean, slow))
     runs = read_results(a.results)
     pred = None
     if a.fit:
