@@ -11,8 +11,10 @@
 set -u
 tarball=$1; IN=$(realpath "$2"); N=${3:-50}; PS=${4:-"1 2 4 8 16"}; SE=${5:-50}; SP=${6:-30}; BAL=${7:-1}; CN=${8:-0}
 O=${OUT:-/tmp/out}; mkdir -p $O
-[ -d /opt/bundle ] || tar -xJf "$tarball" -C /opt || exit 1
-B=/opt/bundle
+# the bundle is unpacked into $BUNDLE_DIR (default /opt) once
+BD=${BUNDLE_DIR:-/opt}; mkdir -p "$BD"
+[ -d "$BD/bundle" ] || tar -xJf "$tarball" -C "$BD" || exit 1
+B=$BD/bundle
 export LD_LIBRARY_PATH=$B/lib OPAL_PREFIX=$B/ompi OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_btl=self,vader OMPI_MCA_pml=ob1 OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_mtl=^ofi OMPI_MCA_osc=^ucx,pt2pt
 run() { # model ranks steps
@@ -32,7 +34,7 @@ if [ "$CN" -gt 0 ]; then
   for p in $PS; do
     for k in $(seq 0 $((p - 1))); do
       d=/tmp/c-$p-$k; mkdir -p $d
-      (cd $d && taskset -c $k $B/bin/liggghts_mpm -in $IN -var n $CN -var nsteps $SE -echo none -log none > screen.txt 2>&1) &
+      (cd $d && $B/bin/orterun -np 1 --bind-to none taskset -c $k $B/bin/liggghts_mpm -in $IN -var n $CN -var nsteps $SE -echo none -log none > screen.txt 2>&1) &
     done
     wait
     for k in $(seq 0 $((p - 1))); do
