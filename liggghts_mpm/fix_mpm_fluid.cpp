@@ -283,6 +283,7 @@ void FixMpmFluid::mark_run_start() {
   run_time_start[5] = s.time_output;
   run_time_start[6] = static_cast<double>(s.n_outputs);
   run_time_start[7] = s.grid().wait_seconds();
+  run_stats_start = mpm::run_stats_start(s.grid());
 }
 
 /* Where the fix's time went in the run just finished (slowest rank), next
@@ -318,7 +319,9 @@ void FixMpmFluid::post_run() {
     os << "; per rank: busy " << -rg[1] << " to " << rg[0] << " s (max/mean " << (mean > 0.0 ? rg[0] / mean : 1.0)
        << "), waits for halo messages " << -rg[3] << " to " << rg[2] << " s";
   }
-  os << "\n";
+  long npoints = 0;  // this rank's material points
+  for (int i = 0; i < atom->nlocal; ++i) npoints += is_point(i) ? 1 : 0;
+  os << "\n" << mpm::run_stats_lines(world, s.grid(), run_stats_start, npoints);
   print(os.str());
   mark_run_start();
 }

@@ -22,6 +22,7 @@ FixStyle(mpm/fluid,FixMpmFluid)
 #include <vector>
 
 #include "mesh_walls.h"
+#include "mpm/run_stats.h"
 #include "mpm/solver.h"
 
 namespace LAMMPS_NS {
@@ -68,6 +69,7 @@ class FixMpmFluid : public Fix {
   bool filled = false;
   // the solver's fluid, coupling and pressure-solver wall time, solves and PCG iterations at the setup of the run
   double run_time_start[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};  // [7]: halo waits (this rank)
+  mpm::RunStatsStart run_stats_start;  // the halo exchanges' counters at the setup of the run (mpm/run_stats.h)
   void mark_run_start();
   double **pdata = nullptr;  // per-point state rows (mpm::Column)
   int pdata_rows = 0;

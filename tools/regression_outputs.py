@@ -71,7 +71,9 @@ def thermo_lines(path):
     keep = []
     with open(path, errors="replace") as f:
         for line in f:
-            if TIMING.search(line) or line.startswith("fix mpm/fluid: wall time"):
+            # the fix's end-of-run lines: wall times, waits and peak memory (and builds without them)
+            if TIMING.search(line) or line.startswith(("fix mpm/fluid: wall time", "fix mpm/fluid: halo exchanges",
+                                                       "fix mpm/fluid: work per rank")):
                 continue
             keep.append(line.rstrip("\n"))
     return keep

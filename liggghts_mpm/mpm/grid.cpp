@@ -187,6 +187,7 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   // both sides, since every rank's work box is one global box cut to its patch (the whole patch
   // along periodic dimensions); outside it both sides hold the value of a node without fluid
   auto box_of = [&](const Transfer &t) { return restricted_ ? t.mine.cut(work_) : t.mine; };
+  ++counts_.exchanges;
 
   // the boxes' rows to and from the buffers (pack_box, unpack_box)
   auto pack = [&](const IndexBox &b, double *buf) { return pack_box(*this, data, b, buf, sv, row_step); };
@@ -252,11 +253,15 @@ void LocalGrid::exchange_peers(const std::vector<Transfer> &send, const std::vec
     if (recvcount[q] > 0) {
       req_.emplace_back();
       MPI_Irecv(recvbuf_.data() + roff[q], recvcount[q], MPI_DOUBLE, q, 7301, comm_, &req_.back());
+      ++counts_.msgs_recv;
+      counts_.bytes_recv += (long long)recvcount[q] * sizeof(double);
     }
   for (int q = 0; q < np; ++q)
     if (sendcount[q] > 0) {
       req_.emplace_back();
       MPI_Isend(sendbuf_.data() + soff[q], sendcount[q], MPI_DOUBLE, q, 7301, comm_, &req_.back());
+      ++counts_.msgs_sent;
+      counts_.bytes_sent += (long long)sendcount[q] * sizeof(double);
     }
   const double tw = MPI_Wtime();
   MPI_Waitall(int(req_.size()), req_.data(), MPI_STATUSES_IGNORE);

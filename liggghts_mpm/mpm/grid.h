@@ -169,6 +169,14 @@ class LocalGrid {
   // wall time this rank waited for its peers' halo messages (MPI_Waitall of the exchanges), summed
   // since construction (fix balance/mpm measured: the work is the time minus the waits)
   double wait_seconds() const { return wait_seconds_; }
+  // What the exchanges moved on this rank since construction (tools/scaling.py, docs/scaling.md):
+  // calls of reverse_sum() and forward() (one exchange each, counted on one rank too), messages
+  // and bytes to and from other ranks (periodic self images are copies, not messages).
+  struct ExchangeCounts {
+    long exchanges = 0, msgs_sent = 0, msgs_recv = 0;
+    long long bytes_sent = 0, bytes_recv = 0;
+  };
+  const ExchangeCounts &exchange_counts() const { return counts_; }
 
  private:
   struct Transfer {      // one box of nodes exchanged with one peer
@@ -196,6 +204,7 @@ class LocalGrid {
   IndexBox work_;
   bool restricted_ = false;
   double wait_seconds_ = 0.0;
+  ExchangeCounts counts_;
 };
 
 // The sparse grid (keyword sparse, docs/validation/performance.md): blocks of kSize^3 nodes of a rank's patch

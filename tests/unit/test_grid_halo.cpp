@@ -2,7 +2,8 @@
 // halo exchanges neither lose nor duplicate anything, for uneven subdomains,
 // walls with padding nodes and periodic images; and the reverse sum adds the
 // images in a fixed order (bit for bit, the results do not depend on how the
-// exchange packs its messages). Run with 1 and 2 MPI ranks.
+// exchange packs its messages); the exchange counters match the nodes counted from the boxes, for
+// halo widths 1 to 5. Run with 1 and 2 MPI ranks.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -256,3 +257,65 @@ TEST(GridHaloOrder, PeriodicAcrossRanks) { run_order_case({{9, 4, 3}, {true, fal
 TEST(GridHaloOrder, PeriodicAllStride1) { run_order_case({{5, 3, 2}, {true, true, true}, 1, 3, 0.5}, 1); }
 
 }  // namespace
+
+namespace {
+
+// The exchange counters (LocalGrid::exchange_counts) against the nodes counted from the boxes
+// alone: in a reverse sum each rank sends every node of its patch (each periodic image apart)
+// that the other rank owns, stride doubles per node, in one message to that rank; a forward moves
+// the same nodes back. Periodic images on the same rank are copies: no message, no byte. The count
+// follows the patch, so it holds for every halo width.
+void run_count_case(const Case &c, int stride) {
+  mpm::GridSpec g;
+  mpm::LocalGrid grid;
+  setup_case(c, g, grid);
+  int me, np;
+  MPI_Comm_rank(MPI_COMM_WORLD, &me);
+  MPI_Comm_size(MPI_COMM_WORLD, &np);
+  const mpm::IndexBox &ob = grid.owned(), &pb = grid.patch();
+  int mine[6] = {ob.lo[0], ob.lo[1], ob.lo[2], ob.hi[0], ob.hi[1], ob.hi[2]}, all[12] = {};
+  MPI_Allgather(mine, 6, MPI_INT, all, 6, MPI_INT, MPI_COMM_WORLD);
+  long long halo = 0;  // my patch nodes that the other rank owns
+  if (np == 2) {
+    const int *o = all + 6 * (1 - me);
+    for (int k = pb.lo[2]; k <= pb.hi[2]; ++k)
+      for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+        for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
+          int idx[3] = {i, j, k};
+          bool in = true;
+          for (int d = 0; d < 3; ++d) {
+            if (g.periodic[d]) idx[d] = wrap(idx[d], g.ncell[d]);
+            in = in && idx[d] >= o[d] && idx[d] <= o[3 + d];
+          }
+          halo += in ? 1 : 0;
+        }
+  }
+  std::vector<double> a(grid.size() * stride, 1.0);
+  const mpm::LocalGrid::ExchangeCounts c0 = grid.exchange_counts();
+  grid.reverse_sum(a.data(), stride);
+  const mpm::LocalGrid::ExchangeCounts c1 = grid.exchange_counts();
+  grid.forward(a.data(), stride);
+  const mpm::LocalGrid::ExchangeCounts c2 = grid.exchange_counts();
+  const long long bytes = 8LL * stride * halo;
+  EXPECT_EQ(c1.exchanges - c0.exchanges, 1);
+  EXPECT_EQ(c2.exchanges - c1.exchanges, 1);
+  EXPECT_EQ(c1.bytes_sent - c0.bytes_sent, bytes);
+  EXPECT_EQ(c1.msgs_sent - c0.msgs_sent, halo > 0 ? 1 : 0);
+  EXPECT_EQ(c2.bytes_recv - c1.bytes_recv, bytes);
+  EXPECT_EQ(c2.msgs_recv - c1.msgs_recv, halo > 0 ? 1 : 0);
+  if (np == 2) EXPECT_GT(halo, 0);
+  long long sr[4] = {c2.bytes_sent - c0.bytes_sent, c2.bytes_recv - c0.bytes_recv, c2.msgs_sent - c0.msgs_sent,
+                     c2.msgs_recv - c0.msgs_recv},
+            tot[4];
+  MPI_Allreduce(sr, tot, 4, MPI_LONG_LONG, MPI_SUM, MPI_COMM_WORLD);
+  EXPECT_EQ(tot[0], tot[1]);
+  EXPECT_EQ(tot[2], tot[3]);
+}
+
+}  // namespace
+
+TEST(GridHaloCounts, WallsHalo1) { run_count_case({{12, 5, 4}, {false, false, false}, 1, 1, 0.5}, 3); }
+TEST(GridHaloCounts, WallsUnevenHalo2) { run_count_case({{12, 5, 4}, {false, false, false}, 1, 2, 0.3717}, 1); }
+TEST(GridHaloCounts, WallsHalo5) { run_count_case({{16, 5, 4}, {false, false, false}, 1, 5, 0.5}, 4); }
+TEST(GridHaloCounts, PeriodicThinSlabHalo4) { run_count_case({{10, 1, 6}, {false, true, false}, 1, 4, 0.45}, 2); }
+TEST(GridHaloCounts, PeriodicAcrossRanksHalo3) { run_count_case({{9, 4, 3}, {true, false, true}, 1, 3, 0.61}, 5); }
