@@ -56,7 +56,7 @@ IndexBox owned_box(const GridSpec &g, const double sublo[3], const double subhi[
 }
 
 void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3],
-                      const double subhi[3], int halo) {
+                      const double subhi[3], const int halo[2]) {
   spec_ = spec;
   comm_ = comm;
   MPI_Comm_rank(comm, &me_);
@@ -71,8 +71,8 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
       lo = first_node_at_or_above(spec, d, sublo[d]);
       hi = lo - 1;
     }
-    patch_.lo[d] = lo - halo;
-    patch_.hi[d] = hi + halo;
+    patch_.lo[d] = lo - halo[0];
+    patch_.hi[d] = hi + halo[1];
     if (!spec.periodic[d]) {
       patch_.lo[d] = std::max(patch_.lo[d], spec.node_lo(d));
       patch_.hi[d] = std::min(patch_.hi[d], spec.node_hi(d));

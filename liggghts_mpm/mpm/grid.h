@@ -87,9 +87,14 @@ IndexBox owned_box(const GridSpec &g, const double sublo[3], const double subhi[
 
 class LocalGrid {
  public:
-  // Collective over comm. halo: node layers added around the owned box.
+  // Collective over comm. halo: node layers added below (halo[0]) and above (halo[1]) the owned
+  // box along every dimension.
   void setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3], const double subhi[3],
-             int halo);
+             const int halo[2]);
+  void setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3], const double subhi[3], int halo) {
+    const int h[2] = {halo, halo};
+    setup(spec, comm, sublo, subhi, h);
+  }
 
   const GridSpec &spec() const { return spec_; }
   const IndexBox &patch() const { return patch_; }
