@@ -206,7 +206,7 @@ void FixMpmFluid::setup(int) {
   for (int i = 0; i < atom->nlocal; ++i)
     if (is_point(i)) atom->radius[i] = 0.0;
   mpm::FluidSolver &s = sync();
-  s.setup_grid(domain->sublo, domain->subhi, neighbor->skin);
+  s.setup_grid(domain->sublo, domain->subhi, neighbor->skin, !mesh_specs.empty());
   check_gate_side();
   if (!mesh_specs.empty()) {
     const bool first = !mesh_walls;  // the sides given in the fix command are checked at the first setup
@@ -337,7 +337,7 @@ void FixMpmFluid::pre_final_integrate() {
   if (!s.grid_ready()) {
     // a new grid patch inside a run (fix balance/mpm every N): as at the setup of a run, the
     // projection's last solve goes on into it and theta_transport takes its nodal reference again
-    s.setup_grid(domain->sublo, domain->subhi, neighbor->skin);
+    s.setup_grid(domain->sublo, domain->subhi, neighbor->skin, !mesh_specs.empty());
     guarded([&] { s.setup_coupling(); });
   }
   mpm::Gate &gate = s.opt.gate;

@@ -131,11 +131,11 @@ void FluidSolver::grain_pressure_inputs(bool proj, bool weak) {
       std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
       pressure_moments<NS, true>();
       fold_to_mirror(g_.rq, 3);
-      grid_.reverse_sum(g_.rq.data(), 3);
     } else {
       pressure_moments<NS, false>();
     }
-    grid_.reverse_sum(g_.pfit.data(), PfitRec::N);
+    // (the points' volume with reaction points, summed in the same exchange)
+    grid_.reverse_sum({{g_.pfit.data(), PfitRec::N}, {opt.reaction_points ? g_.rq.data() : nullptr, 3}});
   }
 }
 
@@ -351,9 +351,9 @@ void FluidSolver::couple_kernel(double h) {
         for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
       });
     fold_to_mirror(g_.rp, 3);
-    grid_.reverse_sum(g_.rp.data(), 3);
   }
-  grid_.reverse_sum(g_.dr.data(), DrRec::N);
+  // (the grains' pressure reaction with reaction points, summed in the same exchange)
+  grid_.reverse_sum({{g_.dr.data(), DrRec::N}, {opt.reaction_points && !proj ? g_.rp.data() : nullptr, 3}});
 
   drag_exchange(dbox, h);
   if (opt.reaction_points && !proj) route_reaction<NS>();
@@ -392,9 +392,9 @@ void FluidSolver::point_sums() {
     std::fill(g_.rq.begin(), g_.rq.end(), 0.0);
     for (std::size_t n = 0; n < grid_.size(); ++n) g_.rq[3 * n] = wk[WkRec::N * n + WkRec::V];
     fold_to_mirror(g_.rq, 3);
-    grid_.reverse_sum(g_.rq.data(), 3);
   }
-  grid_.reverse_sum(g_.wk.data(), WkRec::N);
+  // (the volume folded at the faces with reaction points, summed in the same exchange)
+  grid_.reverse_sum({{g_.wk.data(), WkRec::N}, {opt.reaction_points ? g_.rq.data() : nullptr, 3}});
 }
 
 /* grad_p weak: the pressure gradient the fluid itself feels at node i, -(internal force + wall

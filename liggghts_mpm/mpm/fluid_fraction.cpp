@@ -136,10 +136,6 @@ void FluidSolver::fluid_fraction() {
       g_.need[n] = 1.0;
     });
   }
-  grid_.reverse_sum(g_.need.data(), 1);  // nodes some grain reads (fit of the pressure only there)
-  // and back to the halo copies: a point of this rank must add its pressure moments to a node
-  // that only another rank's grain reads (else np 2 differs from np 1 with 'grad_p fit')
-  grid_.forward(g_.need.data(), 1);
   // Walls: the solid volume mapped to a node outside a grid face is folded onto its mirror node
   // inside (reflected shape functions), so that no node has the sliver volume that (8-13) gives
   // the padding nodes (1/48 of a cell for the B-spline: one grain near the wall would swing its
@@ -147,7 +143,11 @@ void FluidSolver::fluid_fraction() {
   // K dtheta/theta). Node volumes: half a cell on the wall, full inside; a padding node takes the
   // fraction of its mirror.
   fold_to_mirror(g_.sol, 1);
-  grid_.reverse_sum(g_.sol.data(), 1);
+  // the solid volume and the nodes some grain reads (fit of the pressure only there), summed in
+  // one exchange; need goes back to the halo copies with theta below: a point of this rank must
+  // add its pressure moments to a node that only another rank's grain reads (else np 2 differs
+  // from np 1 with 'grad_p fit')
+  grid_.reverse_sum({{g_.need.data(), 1}, {g_.sol.data(), 1}});
   if (opt.theta_smooth > 0.0) smooth_solid_volume();
   // the mirror node and its volume of every owned node depend on the patch only: found once
   if (g_.th_src.size() != grid_.size()) {
@@ -168,7 +168,7 @@ void FluidSolver::fluid_fraction() {
       th[n] = std::min(1.0, std::max(tmin, 1.0 - sol[src[n]] / Vj[n]));  // (8-11), (8-14)
     });
   }
-  grid_.forward(g_.th.data(), 1);
+  grid_.forward({{g_.th.data(), 1}, {g_.need.data(), 1}});
   const double *const gth = g_.th.data();
   for (const int i : plist_) {
     double th = 0.0;

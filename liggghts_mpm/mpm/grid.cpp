@@ -56,7 +56,7 @@ IndexBox owned_box(const GridSpec &g, const double sublo[3], const double subhi[
 }
 
 void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3],
-                      const double subhi[3], int halo) {
+                      const double subhi[3], const int halo[2]) {
   spec_ = spec;
   comm_ = comm;
   MPI_Comm_rank(comm, &me_);
@@ -71,8 +71,8 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
       lo = first_node_at_or_above(spec, d, sublo[d]);
       hi = lo - 1;
     }
-    patch_.lo[d] = lo - halo;
-    patch_.hi[d] = hi + halo;
+    patch_.lo[d] = lo - halo[0];
+    patch_.hi[d] = hi + halo[1];
     if (!spec.periodic[d]) {
       patch_.lo[d] = std::max(patch_.lo[d], spec.node_lo(d));
       patch_.hi[d] = std::min(patch_.hi[d], spec.node_hi(d));
@@ -136,8 +136,20 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
   }
 }
 
-void LocalGrid::reverse_sum(double *data, int stride) { exchange(data, stride, true); }
-void LocalGrid::forward(double *data, int stride) { exchange(data, stride, false); }
+void LocalGrid::reverse_sum(double *data, int stride) {
+  const Field f{data, stride};
+  exchange(&f, 1, true);
+}
+void LocalGrid::forward(double *data, int stride) {
+  const Field f{data, stride};
+  exchange(&f, 1, false);
+}
+void LocalGrid::reverse_sum(std::initializer_list<Field> fields) {
+  exchange(fields.begin(), static_cast<int>(fields.size()), true);
+}
+void LocalGrid::forward(std::initializer_list<Field> fields) {
+  exchange(fields.begin(), static_cast<int>(fields.size()), false);
+}
 
 namespace {
 
@@ -177,12 +189,23 @@ const double *unpack_box(const LocalGrid &g, double *data, const IndexBox &b, co
 
 }  // namespace
 
-void LocalGrid::exchange(double *data, int stride, bool reverse) {
+void LocalGrid::exchange(const Field *fields, int nfields, bool reverse) {
   // reverse: halo boxes are packed and sent, owner boxes receive and add.
   // forward: owner boxes are packed and sent, halo boxes receive and store.
   const std::vector<Transfer> &send = reverse ? halo_side_ : owner_side_;
   const std::vector<Transfer> &recv = reverse ? owner_side_ : halo_side_;
-  const std::size_t sv = std::size_t(stride), row_step = std::size_t(n_[0]) * sv;
+  // the arrays in use; stride: the doubles per node of all of them (a box's part of a message:
+  // its rows of the first array, then of the next, ...)
+  Field f[8];
+  int nf = 0, stride = 0;
+  for (int q = 0; q < nfields; ++q)
+    if (fields[q].data) {
+      if (nf == 8) throw std::logic_error("LocalGrid::exchange: more than 8 arrays at once");
+      f[nf++] = fields[q];
+      stride += fields[q].stride;
+    }
+  if (nf == 0) return;
+  const std::size_t sv = std::size_t(stride);
   // with a work box (the projection's sweeps) only its part of each box moves: the same part on
   // both sides, since every rank's work box is one global box cut to its patch (the whole patch
   // along periodic dimensions); outside it both sides hold the value of a node without fluid
@@ -190,9 +213,16 @@ void LocalGrid::exchange(double *data, int stride, bool reverse) {
   ++counts_.exchanges;
 
   // the boxes' rows to and from the buffers (pack_box, unpack_box)
-  auto pack = [&](const IndexBox &b, double *buf) { return pack_box(*this, data, b, buf, sv, row_step); };
+  // (each array's values of a node see the same additions in the same order as alone)
+  auto pack = [&](const IndexBox &b, double *buf) {
+    for (int q = 0; q < nf; ++q)
+      buf = pack_box(*this, f[q].data, b, buf, std::size_t(f[q].stride), std::size_t(n_[0]) * f[q].stride);
+    return buf;
+  };
   auto unpack = [&](const IndexBox &b, const double *buf) {
-    return unpack_box(*this, data, b, buf, sv, row_step, reverse);
+    for (int q = 0; q < nf; ++q)
+      buf = unpack_box(*this, f[q].data, b, buf, std::size_t(f[q].stride), std::size_t(n_[0]) * f[q].stride, reverse);
+    return buf;
   };
 
   // Self images (periodic wrap on this rank): through a buffer, in the same order.

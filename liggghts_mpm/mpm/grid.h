@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cstddef>
+#include <initializer_list>
 #include <vector>
 
 namespace mpm {
@@ -87,9 +88,14 @@ IndexBox owned_box(const GridSpec &g, const double sublo[3], const double subhi[
 
 class LocalGrid {
  public:
-  // Collective over comm. halo: node layers added around the owned box.
+  // Collective over comm. halo: node layers added below (halo[0]) and above (halo[1]) the owned
+  // box along every dimension.
   void setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3], const double subhi[3],
-             int halo);
+             const int halo[2]);
+  void setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3], const double subhi[3], int halo) {
+    const int h[2] = {halo, halo};
+    setup(spec, comm, sublo, subhi, h);
+  }
 
   const GridSpec &spec() const { return spec_; }
   const IndexBox &patch() const { return patch_; }
@@ -163,6 +169,16 @@ class LocalGrid {
   void reverse_sum(double *data, int stride);
   // Copies owned values into every rank's halo images.
   void forward(double *data, int stride);
+  // One array of an exchange of several (stride doubles per node; data null: left out, on every
+  // rank alike).
+  struct Field {
+    double *data;
+    int stride;
+  };
+  // reverse_sum() and forward() of several arrays at once: one message per peer carries them all
+  // (the same sums, each node's in the same order, and the same copies as one call per array)
+  void reverse_sum(std::initializer_list<Field> fields);
+  void forward(std::initializer_list<Field> fields);
   // The boxes of patch nodes that reverse_sum() and forward() read or write (halo and owner side,
   // all peers, periodic self images included).
   std::vector<IndexBox> exchanged_boxes() const;
@@ -184,7 +200,7 @@ class LocalGrid {
     IndexBox mine;       // node indices in my patch (halo side) or my owned box (owner side)
     int shift[3];        // peer index = my index - shift (halo side)
   };
-  void exchange(double *data, int stride, bool reverse);
+  void exchange(const Field *fields, int nfields, bool reverse);
   template <class BoxOf, class Pack, class Unpack>
   void exchange_peers(const std::vector<Transfer> &send, const std::vector<Transfer> &recv, int stride,
                       BoxOf &&box_of, Pack &&pack, Unpack &&unpack);

@@ -131,7 +131,15 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   work_prev_ = work_;
   have_prev_ = true;
   LocalGrid::WorkScope scope(grid_, work ? &work_ : nullptr);
-  make_labels(p2g, mmin, theta, bc.walls());
+  // u* as it is; every wall condition comes after the projection: the wall's reaction is the
+  // pressure, and a wall node's velocity zeroed before it (normal or, no-slip, tangential) would
+  // be moved again by the correction (measured: the F1 column at rest, docs/theory/projection.md).
+  // Forwarded with the labels (one exchange), for solve_pressure.
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    const double *v = vel + VelRec::N * n + VelRec::V_NEW;
+    for (int d = 0; d < 3; ++d) u_[3 * n + d] = v[d];
+  });
+  make_labels(p2g, mmin, theta, bc.walls(), {u_.data(), 3});
   const double hs = solve_pressure(vel, p2g, mmin, theta, h, step);
   correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), hs, u_.data());
   grid_.forward(u_.data(), 3);
@@ -147,14 +155,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
 double Projection::solve_pressure(const double *vel, const double *p2g, double mmin, const double *theta, double h,
                                   long step) {
   const double *theta_prev = theta && have_theta_last_ ? theta_last_.data() : nullptr;
-  // u* as it is; every wall condition comes after the projection: the wall's reaction is the
-  // pressure, and a wall node's velocity zeroed before it (normal or, no-slip, tangential) would
-  // be moved again by the correction (measured: the F1 column at rest, docs/theory/projection.md)
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    const double *v = vel + VelRec::N * n + VelRec::V_NEW;
-    for (int d = 0; d < 3; ++d) u_[3 * n + d] = v[d];
-  });
-  grid_.forward(u_.data(), 3);
+  // u_: u* on the owned nodes and halos (project, with the labels)
   const double *th = theta ? theta : theta_.data();
   theta_now_ = theta;
   if (theta)

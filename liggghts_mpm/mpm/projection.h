@@ -87,7 +87,9 @@ class Projection {
   long iterations_summed() const { return iterations_summed_; }
 
  private:
-  void make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls);
+  // with: an array forwarded with the labels (NodeLabels::exchange)
+  void make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls,
+                   LocalGrid::Field with = {nullptr, 0});
   // project's steps. solve_pressure: u* from vel into u_, the solve into p_, its gradient grad_ and
   // the points' and grains' copies (p_ext_, grad_ext_); returns the step of the correction,
   // h / (1 + h damping). set_velocities: the projected velocity with the wall conditions into

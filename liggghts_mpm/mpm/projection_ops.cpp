@@ -108,15 +108,18 @@ void NodeLabels::close_face(const LocalGrid &grid, int i, int j, int k, int d, d
   if (!wall_u.empty()) wall_u[3 * n + d] = wall_velocity;
 }
 
-void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm) {
-  // One forward of small integers packed in doubles (exact), and of the wall
-  // velocities when some rank has moving walls.
+void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm, LocalGrid::Field with) {
+  // One forward of small integers packed in doubles (exact), with the wall velocities when some
+  // rank has moving walls and the level set when there is one, all in one message per peer.
   // Only the nodes the forward reads or writes are packed and unpacked (a surface, not the patch).
+  int moving = wall_u.empty() ? 0 : 1, any = 0;
+  MPI_Allreduce(&moving, &any, 1, MPI_INT, MPI_MAX, comm);
+  if (any && wall_u.empty()) wall_u.assign(3 * grid.size(), 0.0);
   buf_.resize(grid.size());
   const std::vector<IndexBox> boxes = grid.exchanged_boxes();
   for (const IndexBox &b : boxes)
     grid.for_box(b, [&](int, int, int, std::size_t n) { buf_[n] = kind[n] + 4.0 * closed[n] + (wet.empty() ? 0.0 : 256.0 * wet[n]); });
-  grid.forward(buf_.data(), 1);
+  grid.forward({{buf_.data(), 1}, {any ? wall_u.data() : nullptr, 3}, {level.empty() ? nullptr : level.data(), 1}, with});
   for (const IndexBox &b : boxes)
     grid.for_box(b, [&](int, int, int, std::size_t n) {
       const int v = static_cast<int>(buf_[n]);
@@ -124,13 +127,6 @@ void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm) {
       closed[n] = std::uint8_t((v >> 2) & 63);
       if (!wet.empty()) wet[n] = std::uint8_t(v >> 8);
     });
-  int moving = wall_u.empty() ? 0 : 1, any = 0;
-  MPI_Allreduce(&moving, &any, 1, MPI_INT, MPI_MAX, comm);
-  if (any) {
-    if (wall_u.empty()) wall_u.assign(3 * grid.size(), 0.0);
-    grid.forward(wall_u.data(), 3);
-  }
-  if (!level.empty()) grid.forward(level.data(), 1);
 }
 
 void flux_divergence(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,

@@ -53,8 +53,9 @@ struct NodeLabels {
   // its size and values (the caller sets it in the box).
   void reset(const LocalGrid &grid, const IndexBox *work = nullptr);
   void close_face(const LocalGrid &grid, int i, int j, int k, int d, double wall_velocity = 0.0);
-  // Copies the owned nodes' labels into the halos (collective over the grid's comm).
-  void exchange(LocalGrid &grid, MPI_Comm comm);
+  // Copies the owned nodes' labels into the halos (collective over the grid's comm); with: one
+  // more array forwarded in the same messages (none if its data is null).
+  void exchange(LocalGrid &grid, MPI_Comm comm, LocalGrid::Field with = {nullptr, 0});
 
  private:
   std::vector<double> buf_;  // exchange: kind and closed packed (only the exchanged nodes used)

@@ -60,7 +60,8 @@ double surface_distance(double f, ShapeKind shape) {
    EMPTY elsewhere (the free surface: p = 0), SOLID padding behind the box walls (NodeLabels::reset). The closed gate is a
    wall at rest: the face between the last node on the fluid side and the next one (a gate through
    a node plane leaves that node on the fluid side, like a box wall through its nodes). */
-void Projection::make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls) {
+void Projection::make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls,
+                             LocalGrid::Field with) {
   const bool sparse = grid_.restricted();
   lab_.reset(grid_, sparse ? &work_ : nullptr);
   mesh_ = walls != nullptr;
@@ -111,7 +112,7 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     plane.hi[g.dim] = std::min(plane.hi[g.dim], lo);
     grid_.for_box(plane, [&](int i, int j, int k, std::size_t) { lab_.close_face(grid_, i, j, k, g.dim); });
   }
-  lab_.exchange(grid_, comm_);
+  lab_.exchange(grid_, comm_, with);
 }
 
 /* The node mass with the mass of its mirror images behind the box walls added (the padding nodes
@@ -357,9 +358,7 @@ void Projection::extrapolate_above_surface(const double *p2g, double mmin, std::
         }
     });
   gradient_along_surface(grad);
-  grid_.forward(gk_.data(), 1);
-  grid_.forward(pk_.data(), 1);
-  grid_.forward(grad.data(), 3);
+  grid_.forward({{gk_.data(), 1}, {pk_.data(), 1}, {grad.data(), 3}});
   // the owned EMPTY nodes holding fluid, in the order of the owned nodes (the passes visit them only)
   ghost_.clear();
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -457,10 +456,7 @@ void Projection::extrapolation_pass(std::vector<double> &p, std::vector<double> 
   for (const SurfaceNode &s : ghost_)
     if (gk[s.n] == 0.0 || (with_p && pk[s.n] == 0.0)) ghost_next_.push_back(s);
   ghost_.swap(ghost_next_);
-  grid_.forward(gk.data(), 1);
-  grid_.forward(pk.data(), 1);
-  grid_.forward(grad.data(), 3);
-  if (with_p) grid_.forward(p.data(), 1);
+  grid_.forward({{gk.data(), 1}, {pk.data(), 1}, {grad.data(), 3}, {with_p ? p.data() : nullptr, 1}});
 }
 
 }  // namespace mpm

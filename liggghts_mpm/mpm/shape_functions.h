@@ -2,6 +2,7 @@
 // node (i,j,k) is the product wx[i]*wy[j]*wz[k], its gradient the product rule.
 // Coordinates are in cell units: xi = (x - origin)/dx.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -24,6 +25,24 @@ struct Shape1D {
 };
 
 inline int support(ShapeKind k) { return k == ShapeKind::Linear ? 2 : 3; }
+
+// Node layers the stencil of a point reaches beyond the owned nodes of its rank, below (reach[0])
+// and above (reach[1]) them, for a point at most delta cells outside the rank's subdomain [a, b)
+// (x in [a - delta, b + delta)), wherever a and b lie (docs/design.md, "The halo"). The owned
+// nodes are ceil(a) .. ceil(b) - 1, except that owned_box() gives a node within 1e-9 cells below
+// a face to the rank above it: so a stencil may reach one layer more above the owned nodes than
+// below them when delta sits on a step of the count (kTol covers that and round-off in delta).
+// Quadratic B-spline: nodes floor(x + 1/2) - 1 .. floor(x + 1/2) + 1; linear: floor(x), floor(x) + 1.
+inline void stencil_reach(ShapeKind k, double delta, int reach[2]) {
+  constexpr double kTol = 1e-6;
+  if (k == ShapeKind::Linear) {
+    reach[0] = 1 + static_cast<int>(std::ceil(delta));
+    reach[1] = 2 + static_cast<int>(std::floor(delta + kTol));
+  } else {
+    reach[0] = 2 + std::max(0, static_cast<int>(std::ceil(delta - 0.5)));
+    reach[1] = 2 + static_cast<int>(std::floor(delta + 0.5 + kTol));
+  }
+}
 
 // Linear (tent) function of the text, eq. (8-8): nodes floor(xi), floor(xi)+1.
 inline void shape_linear(double xi, Shape1D &s) {

@@ -77,8 +77,18 @@ double FluidSolver::init_point(const double x[3], double vol, double *s) const {
   return m;
 }
 
-void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], double skin) {
-  const int halo = support(opt.shape) + static_cast<int>(std::ceil(skin / opt.grid.dx)) + 1;
+void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], double skin, bool mesh_walls) {
+  // The halo (docs/design.md, "The halo"): a point lies at most `skin` outside its rank's subdomain
+  // (the host re-neighbours once a point moved more than skin/2; the other half is the room for
+  // what it moves within one fluid step), its stencil reaches stencil_reach() node layers beyond
+  // the owned nodes, and with mesh walls the traction at a point's nearest wall point reads the
+  // stencil of that point, up to one node beyond the point's own.
+  int reach[2];
+  stencil_reach(opt.shape, skin / opt.grid.dx, reach);
+  const int beyond = mesh_walls ? 1 : 0;
+  const int halo[2] = {reach[0] + beyond, reach[1] + beyond};
+  halo_skin_ = skin;
+  for (int d = 0; d < 3; ++d) sub_lo_[d] = sublo[d], sub_hi_[d] = subhi[d];
   // projection: the last solve goes on into the new patch (the warm start, the grains' pressure
   // gradient, the d(theta)/dt source), so that run N; run M equals run N+M: from the old
   // Projection (its owned box, or the whole grid if a rank's box changed), else from a
@@ -99,8 +109,13 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
       c.origin[d] = gs.origin[d];
       c.ncell[d] = gs.ncell[d];
       c.periodic[d] = gs.periodic[d];
-      c.lo[d] = grid_.patch().lo[d];
-      c.hi[d] = grid_.patch().hi[d];
+      // the guard of shape_at: a stencil grown by the layers read beyond it stays in the patch
+      // (at a non-periodic face the patch ends with the grid's padding, which no stencil passes)
+      const IndexBox &pb = grid_.patch();
+      const bool lo_face = !gs.periodic[d] && pb.lo[d] == gs.node_lo(d);
+      const bool hi_face = !gs.periodic[d] && pb.hi[d] == gs.node_hi(d);
+      c.lo[d] = pb.lo[d] + (lo_face ? 0 : beyond);
+      c.hi[d] = pb.hi[d] - (hi_face ? 0 : beyond);
     }
   }
   g_.assign(grid_.size(), opt.musl, !opt.projection, opt.coupled, opt.grad_p == GradP::Fit);
@@ -322,9 +337,15 @@ bool FluidSolver::shape_at(const double *x, Stencil &ps) const {
 }
 
 void FluidSolver::outside_patch(const double *x) const {
+  const ShapeCtx &c = shape_ctx_;
   std::ostringstream os;
-  os << "Fix mpm/fluid: atom at (" << x[0] << ", " << x[1] << ", " << x[2] << ") is outside the grid patch of rank "
-     << me_ << "; it moved too far between re-neighbourings (use neigh_modify every 1 check yes)";
+  os << "Fix mpm/fluid: atom at (" << x[0] << ", " << x[1] << ", " << x[2] << ") is farther than the neighbor skin ("
+     << halo_skin_ << ") outside the subdomain [" << sub_lo_[0] << ", " << sub_hi_[0] << "] x [" << sub_lo_[1] << ", "
+     << sub_hi_[1] << "] x [" << sub_lo_[2] << ", " << sub_hi_[2] << "] of rank " << me_
+     << ": its stencil leaves the rank's grid patch (stencil nodes " << c.lo[0] << ".." << c.hi[0] << " x " << c.lo[1]
+     << ".." << c.hi[1] << " x " << c.lo[2] << ".." << c.hi[2]
+     << "); it moved too far between re-neighbourings (use neigh_modify every 1 check yes, or a larger "
+        "neighbor skin)";
   throw LocalError(os.str());
 }
 

@@ -72,10 +72,10 @@ class FluidSolver {
   // returns its mass.
   double init_point(const double x[3], double vol, double *row) const;
 
-  // Grid patch of this rank's subdomain, with a halo of the shape functions' support plus the
-  // distance a point may travel before the host re-neighbours and migrates it (the skin, in cells
-  // rounded up, plus one).
-  void setup_grid(const double sublo[3], const double subhi[3], double skin);
+  // Grid patch of this rank's subdomain, with a halo of the node layers that the stencil of a
+  // point at most `skin` outside the subdomain reaches (stencil_reach), one more with mesh walls
+  // (docs/design.md, "The halo"). A point farther out stops the run (outside_patch).
+  void setup_grid(const double sublo[3], const double subhi[3], double skin, bool mesh_walls = false);
   bool grid_ready() const { return grid_ready_; }
   // the host moved the subdomain cuts inside a run (fix balance/mpm every N): setup_grid again
   void invalidate_grid() { grid_ready_ = false; }
@@ -203,8 +203,11 @@ class FluidSolver {
     double origin[3] = {0, 0, 0};
     double ncell[3] = {0, 0, 0};
     bool periodic[3] = {false, false, false};
-    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // the patch; a stencil's last node within hi
+    // the nodes a stencil may use: the patch less the layers read beyond a stencil (mesh walls)
+    // where the patch does not end at a grid face; a stencil's last node within hi
+    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   } shape_ctx_;
+  double halo_skin_ = 0.0, sub_lo_[3] = {0, 0, 0}, sub_hi_[3] = {0, 0, 0};  // setup_grid's (outside_patch)
   // anti-locking: the node index of the cell that holds point i (clamped at non-periodic faces)
   std::size_t cell_node(int i) const;
   // anti-locking: point i's share of its cell's sums (CellRec) for the stress update, velocity

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "mpm/grid.h"
+#include "mpm/shape_functions.h"
 
 namespace {
 
@@ -22,7 +24,8 @@ struct Case {
   bool periodic[3];
   int pad;
   int halo;
-  double split;  // where rank 0's subdomain ends, fraction of x (2 ranks)
+  double split;      // where rank 0's subdomain ends, fraction of x (2 ranks)
+  int halo_hi = -1;  // node layers above the owned box when they differ from those below (halo)
 };
 
 int wrap(int i, int n) { return ((i % n) + n) % n; }
@@ -48,7 +51,8 @@ void setup_case(const Case &c, mpm::GridSpec &g, mpm::LocalGrid &grid) {
     const double cut = g.origin[0] + c.split * (g.upper(0) - g.origin[0]);
     if (me == 0) subhi[0] = cut; else sublo[0] = cut;
   }
-  grid.setup(g, MPI_COMM_WORLD, sublo, subhi, c.halo);
+  const int halo[2] = {c.halo, c.halo_hi < 0 ? c.halo : c.halo_hi};
+  grid.setup(g, MPI_COMM_WORLD, sublo, subhi, halo);
 }
 
 void run_case(const Case &c) {
@@ -115,6 +119,8 @@ TEST(GridHalo, UnevenSplitOffNode) { run_case({{12, 5, 4}, {false, false, false}
 TEST(GridHalo, PeriodicThinSlab) { run_case({{10, 1, 6}, {false, true, false}, 1, 4, 0.45}); }
 TEST(GridHalo, PeriodicAcrossRanks) { run_case({{9, 4, 3}, {true, false, true}, 1, 3, 0.61}); }
 TEST(GridHalo, LinearNoPadding) { run_case({{8, 3, 3}, {false, false, false}, 0, 2, 0.5}); }
+TEST(GridHalo, UnequalSides) { run_case({{12, 5, 4}, {false, false, false}, 1, 1, 0.3717, 3}); }
+TEST(GridHalo, UnequalSidesPeriodic) { run_case({{9, 4, 3}, {true, false, true}, 1, 3, 0.61, 2}); }
 
 // Every rank's owned and patch box and its patch values (stride per node), gathered.
 struct AllPatches {
@@ -255,6 +261,52 @@ TEST(GridHaloOrder, WallsUnevenSplit) { run_order_case({{12, 5, 4}, {false, fals
 TEST(GridHaloOrder, PeriodicThinSlabManyImages) { run_order_case({{10, 1, 6}, {false, true, false}, 1, 4, 0.45}, 4); }
 TEST(GridHaloOrder, PeriodicAcrossRanks) { run_order_case({{9, 4, 3}, {true, false, true}, 1, 3, 0.61}, 5); }
 TEST(GridHaloOrder, PeriodicAllStride1) { run_order_case({{5, 3, 2}, {true, true, true}, 1, 3, 0.5}, 1); }
+TEST(GridHaloOrder, UnequalSidesPeriodic) { run_order_case({{9, 4, 3}, {true, false, true}, 1, 2, 0.61, 3}, 4); }
+
+// stencil_reach (the halo, docs/design.md "The halo") against every point of a fine sweep: for
+// subdomains [a, b) anywhere between the nodes (also on a node and half-way) and points in
+// [a - delta, b + delta), the stencil's nodes lie within the reach below and above the owned
+// nodes (owned_box), and some point needs all of it (the halo is no wider than it must be).
+void check_reach(mpm::ShapeKind kind, double delta) {
+  int reach[2];
+  mpm::stencil_reach(kind, delta, reach);
+  mpm::GridSpec g;
+  g.dx = 1.0;
+  g.ncell[0] = g.ncell[1] = g.ncell[2] = 64;
+  g.pad = mpm::support(kind) - 2;
+  int need[2] = {0, 0};
+  const int ns = mpm::support(kind);
+  // the faces' places between two nodes: on a node and half-way, within owned_box's rounding
+  // (1e-9 cells) and a little farther on either side of them, and a sweep
+  std::vector<double> off = {0.0, 1e-10, -1e-10, 1e-7, -1e-7, 0.5, 0.5 + 1e-10, 0.5 - 1e-10, 0.5 + 1e-7, 0.5 - 1e-7};
+  for (int q = 1; q < 40; ++q) off.push_back(q / 40.0);
+  for (const double fa : off)
+    for (const double fb : off) {
+      const double sublo[3] = {20.0 + fa, 20.0, 20.0}, subhi[3] = {30.0 + fb, 30.0, 30.0};
+      const mpm::IndexBox ob = mpm::owned_box(g, sublo, subhi);
+      const int m = 400;
+      for (int q = 0; q <= m; ++q) {
+        // from a - delta to just below b + delta
+        double x = (sublo[0] - delta) + (subhi[0] - sublo[0] + 2.0 * delta) * q / m;
+        if (q == m) x = std::nextafter(subhi[0] + delta, 0.0);
+        mpm::Shape1D s;
+        mpm::shape_eval(kind, x, s);
+        need[0] = std::max(need[0], ob.lo[0] - s.base);
+        need[1] = std::max(need[1], s.base + ns - 1 - ob.hi[0]);
+      }
+    }
+  for (int side = 0; side < 2; ++side) {
+    EXPECT_LE(need[side], reach[side]) << mpm::shape_name(kind) << " delta " << delta << " side " << side;
+    EXPECT_EQ(need[side], reach[side]) << mpm::shape_name(kind) << " delta " << delta << " side " << side;
+  }
+}
+
+TEST(HaloReach, BSpline) {
+  for (double delta : {0.0, 0.1, 0.2, 0.45, 0.5, 0.55, 0.9, 1.0, 1.2, 1.5, 1.7, 2.3}) check_reach(mpm::ShapeKind::QuadraticBSpline, delta);
+}
+TEST(HaloReach, Linear) {
+  for (double delta : {0.0, 0.1, 0.2, 0.45, 0.5, 0.55, 0.9, 1.0, 1.2, 1.5, 1.7, 2.3}) check_reach(mpm::ShapeKind::Linear, delta);
+}
 
 }  // namespace
 

@@ -70,7 +70,9 @@ struct Column {
     pt.nlocal = n, pt.x = x.data(), pt.v = v.data(), pt.f = f.data(), pt.rmass = rmass.data();
     pt.radius = radius.data(), pt.mask = mask.data(), pt.tag = tag.data(), pt.type = type.data();
     pt.state = state.data(), pt.point_bit = 1;
-    solver->setup_grid(sublo, subhi, 0.1);  // halo 6 nodes: the points stay in their rank's patch
+    // skin 4 cells: a halo of 6 nodes (stencil_reach), in which the points stay (they are not
+    // migrated) and whose blocks the moving fluid leaves again
+    solver->setup_grid(sublo, subhi, 0.2);
   }
   void substep(double h) {
     for (std::size_t q = 0; q < rmass.size(); ++q) fs[3 * q] = fs[3 * q + 1] = 0.0, fs[3 * q + 2] = -9.81 * rmass[q];

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "mpm/error.h"
 #include "mpm/options.h"
 #include "mpm/solver.h"
 #include "mpm/transfer.h"
@@ -217,6 +218,42 @@ TEST(TransferReference, G2pBSplineApic) { check_g2p("shape bspline2 transfer api
 TEST(TransferReference, G2pBSplineFlip) { check_g2p("shape bspline2 transfer flip 0.9 update usl"); }
 TEST(TransferReference, G2pLinearApic) { check_g2p("shape linear transfer apic"); }
 TEST(TransferReference, G2pLinearPic) { check_g2p("shape linear transfer pic update usl"); }
+
+// The halo (docs/design.md, "The halo"): a rank with the subdomain [0.3, 0.6)^3 of the 10^3 grid
+// (owned nodes 3..5) and a skin of 0.2 cells has 2 node layers on each side (3 with mesh walls);
+// a point 0.199 cells outside the subdomain is stepped, one whose stencil leaves the patch (or,
+// with mesh walls, would leave it if grown by the layer the wall traction reads) stops the run
+// with the error that names the skin and the subdomain.
+void check_halo(bool mesh_walls, int layers) {
+  Scene sc("shape bspline2 transfer apic", 1);
+  const double lo[3] = {0.3, 0.3, 0.3}, hi[3] = {0.6, 0.6, 0.6};
+  sc.solver->setup_grid(lo, hi, 0.02, mesh_walls);
+  const mpm::IndexBox &ob = sc.solver->grid().owned(), &pb = sc.solver->grid().patch();
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_EQ(ob.lo[d], 3);
+    EXPECT_EQ(ob.hi[d], 5);
+    EXPECT_EQ(pb.lo[d], ob.lo[d] - layers) << d;
+    EXPECT_EQ(pb.hi[d], ob.hi[d] + layers) << d;
+  }
+  for (const double x : {0.3 - 0.0199, 0.6 + 0.0199}) {
+    sc.xs = {x, x, x};
+    EXPECT_NO_THROW(sc.solver->compute_shapes()) << x;
+  }
+  for (const double x : {0.1499, 0.6501}) {  // the stencils 0..2 and 6..8
+    sc.xs = {x, 0.45, 0.45};
+    try {
+      sc.solver->compute_shapes();
+      ADD_FAILURE() << "no error for a point at x = " << x;
+    } catch (const mpm::LocalError &e) {
+      EXPECT_NE(std::string(e.what()).find("farther than the neighbor skin (0.02) outside the subdomain [0.3, 0.6]"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(Halo, PatchAndGuard) { check_halo(false, 2); }
+TEST(Halo, PatchAndGuardMeshWalls) { check_halo(true, 3); }
 
 // The scalar form the kernels had before the 4-wide rows: d[r] = sum_e mC[3 r + e] o[e][.].
 void affine_momentum(const double mC[9], const double o[3][3], int a, int b, int c, double d[3]) {
