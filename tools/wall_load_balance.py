@@ -15,6 +15,7 @@ from the points (sum of m v, LIGGGHTS' compute reduce), not from the loads; over
 
 so the table compares the momentum change with the impulse gravity and the loads give. The
 figure that matters is the gap relative to M g t (the impulse the walls must supply on average).
+Standard library only: tests/cases/test_wall_force.py (case tank_balance_*) runs balance() below.
 """
 import argparse
 import os
@@ -22,8 +23,6 @@ import re
 import shutil
 import subprocess
 import sys
-
-import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.path.join(HERE, "..", "tests", "data")
@@ -48,6 +47,35 @@ def make_input(model, width):
     return s
 
 
+def balance(exe, model="projection", dx=0.025, time=0.6, width=0.4, work="wall_load_balance", mpirun=()):
+    """Runs the tank and returns (M, dt, steps, rows): rows (t, dP, J, gap_z / (M g t)) at five times,
+    dP the points' momentum change and J = gravity's impulse + the walls' (-integral of the loads)."""
+    os.makedirs(work, exist_ok=True)
+    with open(os.path.join(work, "in.tank"), "w") as f:
+        f.write(make_input(model, width))
+    shutil.copy(os.path.join(DATA, "box.stl"), work)
+    # eos: the weak water of the input (c = 14 m/s), a step within its acoustic limit
+    dt = 1e-3 * dx / 0.025 if model == "projection" else 2e-4 * dx / 0.025
+    steps = int(round(time / dt))
+    cmd = list(mpirun) + [os.path.abspath(exe), "-in", "in.tank", "-echo", "none", "-var", "dx", str(dx),
+                          "-var", "fill", "0.2", "-var", "dt", repr(dt), "-var", "steps", str(steps)]
+    p = subprocess.run(cmd, cwd=work, capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"run failed:\n{p.stdout[-2000:]}\n{p.stderr[-2000:]}")
+    M = float(next(m.group(1) for m in (re.match(r"\s*0\s+0\s+(\S+)", ln) for ln in p.stdout.splitlines()) if m))
+    d = [[float(v) for v in ln.split()] for ln in open(os.path.join(work, "momentum.txt"))
+         if ln.strip() and not ln.startswith("#")]
+    P, F = [r[1:4] for r in d], [r[4:7] for r in d]
+    g = 9.81
+    rows = []
+    for k in sorted({steps // 6, steps // 3, steps // 2, 2 * steps // 3, steps}):
+        J = [-sum(F[s][c] for s in range(1, k + 1)) * dt for c in range(3)]
+        J[2] -= M * g * k * dt
+        dP = [P[k][c] - P[0][c] for c in range(3)]
+        rows.append((k * dt, dP, J, (dP[2] - J[2]) / (M * g * k * dt)))
+    return M, dt, steps, rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--exe", required=True)
@@ -58,32 +86,16 @@ def main():
                     help="the column's width as a fraction of the box (1: water at rest, the tool's own check)")
     ap.add_argument("--work", default="wall_load_balance")
     a = ap.parse_args()
-    os.makedirs(a.work, exist_ok=True)
-    with open(os.path.join(a.work, "in.tank"), "w") as f:
-        f.write(make_input(a.model, a.width))
-    shutil.copy(os.path.join(DATA, "box.stl"), a.work)
-    # eos: the weak water of the input (c = 14 m/s), a step within its acoustic limit
-    dt = 1e-3 * a.dx / 0.025 if a.model == "projection" else 2e-4 * a.dx / 0.025
-    steps = int(round(a.time / dt))
-    cmd = [os.path.abspath(a.exe), "-in", "in.tank", "-echo", "none", "-var", "dx", str(a.dx), "-var", "fill", "0.2",
-           "-var", "dt", repr(dt), "-var", "steps", str(steps)]
-    p = subprocess.run(cmd, cwd=a.work, capture_output=True, text=True)
-    if p.returncode != 0:
-        sys.exit(f"run failed:\n{p.stdout[-2000:]}\n{p.stderr[-2000:]}")
-    M = float(next(m.group(1) for m in (re.match(r"\s*0\s+0\s+(\S+)", ln) for ln in p.stdout.splitlines()) if m))
-    d = np.loadtxt(os.path.join(a.work, "momentum.txt"))
-    P, F = d[:, 1:4], d[:, 4:7]
-    g = 9.81
+    try:
+        M, dt, steps, rows = balance(a.exe, a.model, a.dx, a.time, a.width, a.work)
+    except RuntimeError as e:
+        sys.exit(str(e))
     print(f"{a.model}, dx {a.dx} m, step {dt:g} s, {steps} steps; water mass M = {M:.4g} kg")
     print(f"{'t (s)':>7} {'dP_x':>9} {'J_x':>9} {'dP_z':>9} {'J_z':>9} {'gap_z / (M g t)':>16}")
     worst = 0.0
-    for k in sorted({steps // 6, steps // 3, steps // 2, 2 * steps // 3, steps}):
-        J = -F[1:k + 1].sum(axis=0) * dt
-        J[2] -= M * g * k * dt
-        dP = P[k] - P[0]
-        rel = (dP[2] - J[2]) / (M * g * k * dt)
+    for t, dP, J, rel in rows:
         worst = max(worst, abs(rel))
-        print(f"{k * dt:7.3f} {dP[0]:9.4f} {J[0]:9.4f} {dP[2]:9.4f} {J[2]:9.4f} {rel:16.3%}")
+        print(f"{t:7.3f} {dP[0]:9.4f} {J[0]:9.4f} {dP[2]:9.4f} {J[2]:9.4f} {rel:16.3%}")
     print(f"largest gap in z over the run: {worst:.2%} of M g t (acceptance: 1 %)")
 
 

@@ -20,7 +20,7 @@ void Boundaries::walls_moved() {
   }
 }
 
-void Boundaries::apply(double *vel, int i, int j, int k, double h) {
+void Boundaries::apply(double *vel, int i, int j, int k, double h, double m) {
   const GridSpec &gs = opt_->grid;
   const int idx[3] = {i, j, k};
   for (int d = 0; d < 3; ++d) {
@@ -45,7 +45,20 @@ void Boundaries::apply(double *vel, int i, int j, int k, double h) {
     // per fluid step): the grid update and the MUSL remap, and every sub-step, reuse the node's
     // constraints (node_walls).
     const std::size_t n = node_walls(i, j, k);
-    WallGeometry::impose(cache_.data() + first_[n], count_[n], vel, h);
+    if (rec_on_ && m > 0.0 && count_[n] > 0) {
+      // one condition at a time, each one's change of momentum to its wall
+      const double xn[3] = {gs.origin[0] + i * gs.dx, gs.origin[1] + j * gs.dx, gs.origin[2] + k * gs.dx};
+      for (int c = 0; c < count_[n]; ++c) {
+        const WallConstraint &wc = cache_[first_[n] + c];
+        const double v0[3] = {vel[0], vel[1], vel[2]};
+        WallGeometry::impose(&wc, 1, vel, h);
+        const double ms = m * rec_s_;
+        const double J[3] = {ms * (vel[0] - v0[0]), ms * (vel[1] - v0[1]), ms * (vel[2] - v0[2])};
+        add_impulse(wc.wall, xn, J);
+      }
+    } else {
+      WallGeometry::impose(cache_.data() + first_[n], count_[n], vel, h);
+    }
   }
   const Gate &g = opt_->gate;
   if (g.active) {
@@ -137,7 +150,8 @@ void Boundaries::add_face_traction(const Stencil &ps, const double *xp, double V
 void Boundaries::add_mesh_traction(const double *xp, double V, double p, double *p2g) {
   const GridSpec &gs = opt_->grid;
   double q[3], nrm[3];
-  if (p == 0.0 || !near_wall(xp) || !walls_->nearest_face(xp, gs.dx, q, nrm)) return;
+  int wall = -1;
+  if (p == 0.0 || !near_wall(xp) || !walls_->nearest_face(xp, gs.dx, q, nrm, &wall)) return;
   const double inv = 1.0 / gs.dx;
   const IndexBox &pb = grid_->patch();
   int base[3];
@@ -152,6 +166,10 @@ void Boundaries::add_mesh_traction(const double *xp, double V, double p, double 
     for (int a = 0; a < 3; ++a) w[d][a] = sh.w[a];
   }
   const double push = p * V * inv;
+  if (rec_on_) {
+    const double J[3] = {rec_h_ * push * nrm[0], rec_h_ * push * nrm[1], rec_h_ * push * nrm[2]};
+    add_impulse(wall, q, J);
+  }
   for (int c = 0; c < 3; ++c)
     for (int b = 0; b < 3; ++b)
       for (int a = 0; a < 3; ++a) {
@@ -161,11 +179,21 @@ void Boundaries::add_mesh_traction(const double *xp, double V, double p, double 
       }
 }
 
-int Boundaries::put_back(double x[3], double v[3], const double xold[3]) {
+int Boundaries::put_back(double x[3], double v[3], const double xold[3], double m) {
   const GridSpec &gs = opt_->grid;
   const double eps = 1e-6 * gs.dx;
   int n = 0;
-  if (walls_ && near_wall(x) && walls_->push_back(x, v, 1.0 * gs.dx, xold)) ++n;
+  if (walls_ && near_wall(x)) {
+    const double v0[3] = {v[0], v[1], v[2]};
+    int wall = -1;
+    if (walls_->push_back(x, v, 1.0 * gs.dx, xold, &wall)) {
+      ++n;
+      if (rec_on_ && m > 0.0) {
+        const double J[3] = {m * (v[0] - v0[0]), m * (v[1] - v0[1]), m * (v[2] - v0[2])};
+        add_impulse(wall, x, J);
+      }
+    }
+  }
   for (int d = 0; d < 3; ++d) {
     if (gs.periodic[d]) continue;
     const double lo = gs.origin[d], hi = gs.upper(d);
@@ -190,6 +218,94 @@ int Boundaries::put_back(double x[3], double v[3], const double xold[3]) {
     }
   }
   return n;
+}
+
+void Boundaries::record_loads(double h) {
+  const int nw = walls_ ? walls_->walls() : 0;
+  if (rec_.size() != 6 * static_cast<std::size_t>(nw)) rec_.assign(6 * static_cast<std::size_t>(nw), 0.0);
+  rec_on_ = nw > 0;
+  rec_h_ = h;
+  rec_s_ = 1.0 + h * opt_->damping;
+}
+
+void Boundaries::add_impulse(int k, const double *x, const double *J) {
+  if (k < 0 || !walls_->wall(k).loads) return;
+  const double *ref = walls_->wall(k).ref;
+  const double r[3] = {x[0] - ref[0], x[1] - ref[1], x[2] - ref[2]};
+  double *o = &rec_[6 * static_cast<std::size_t>(k)];
+  o[0] += J[0];
+  o[1] += J[1];
+  o[2] += J[2];
+  o[3] += r[1] * J[2] - r[2] * J[1];
+  o[4] += r[2] * J[0] - r[0] * J[2];
+  o[5] += r[0] * J[1] - r[1] * J[0];
+}
+
+int Boundaries::load_wall(int i, int j, int k) {
+  if (!walls_) return -1;
+  const std::size_t n = grid_->index(i, j, k);
+  if (lw_stamp_.size() != grid_->size()) {
+    lw_stamp_.assign(grid_->size(), -1);
+    lw_.assign(grid_->size(), -1);
+  }
+  if (lw_stamp_[n] != epoch_) {
+    const GridSpec &gs = opt_->grid;
+    const int idx[3] = {i, j, k};
+    const double xn[3] = {gs.origin[0] + i * gs.dx, gs.origin[1] + j * gs.dx, gs.origin[2] + k * gs.dx};
+    double dist = 0.0;
+    int w = walls_->nearest_wall(xn, 3.0 * gs.dx, &dist);
+    if (w < 0) {
+      // farther in: the nearest wall at any distance (all triangles; once per wall position)
+      double diag = 0.0;
+      for (int d = 0; d < 3; ++d) diag += (gs.ncell[d] + 1.0) * (gs.ncell[d] + 1.0);
+      w = walls_->nearest_wall(xn, std::sqrt(diag) * gs.dx, &dist);
+    }
+    for (int d = 0; d < 3 && w >= 0; ++d)
+      if (!gs.periodic[d] && std::min(idx[d], gs.ncell[d] - idx[d]) * gs.dx < dist) w = -1;
+    lw_[n] = w;
+    lw_stamp_[n] = epoch_;
+  }
+  return lw_[n];
+}
+
+int Boundaries::line_wall(int i, int j, int k, const double x[3], int d, double sign) {
+  if (!walls_) return -1;
+  const std::size_t n = grid_->index(i, j, k);
+  if (ln_stamp_.size() != 3 * grid_->size()) {
+    ln_stamp_.assign(3 * grid_->size(), -1);
+    ln_.assign(6 * grid_->size(), -1);
+    lt_.assign(6 * grid_->size(), 0.0);
+  }
+  const std::size_t c = 3 * n + d;
+  if (ln_stamp_[c] != epoch_) {
+    const GridSpec &gs = opt_->grid;
+    for (int s = 0; s < 2; ++s) {
+      const int side = s ? 1 : -1;
+      // the grid face along the ray (none along a periodic d)
+      double face = HUGE_VAL;
+      if (!gs.periodic[d]) face = side > 0 ? gs.upper(d) - x[d] : x[d] - gs.origin[d];
+      const double len = std::isfinite(face) ? std::max(face, 0.0) + gs.dx : (gs.ncell[d] + 1.0) * gs.dx;
+      double t = len;
+      int w = walls_->ray_wall(x, d, side, len, &t);
+      if (w >= 0 && !(t <= face)) w = -1, t = face;
+      if (w < 0) t = face;
+      ln_[2 * c + s] = w;
+      lt_[2 * c + s] = t;
+    }
+    ln_stamp_[c] = epoch_;
+  }
+  const double tl = lt_[2 * c], th = lt_[2 * c + 1];
+  // nearer side; on a tie the side the impulse points away from (sign > 0: the wall below)
+  const bool low = tl < th || (tl == th && sign > 0.0);
+  return ln_[2 * c + (low ? 0 : 1)];
+}
+
+void Boundaries::take_loads(std::vector<double> &out) {
+  if (out.size() < rec_.size()) out.resize(rec_.size(), 0.0);
+  for (std::size_t c = 0; c < rec_.size(); ++c) {
+    out[c] += rec_[c];
+    rec_[c] = 0.0;
+  }
 }
 
 }  // namespace mpm

@@ -32,7 +32,9 @@ class Boundaries {
 
   // Velocity of node (i, j, k) after the momentum update; h: the update's time step (the stress
   // of shear walls acts over it).
-  void apply(double *vel, int i, int j, int k, double h);
+  // m > 0 with record_loads on: the momentum each mesh-wall condition gives the node's mass m,
+  // m (v after - v before), is added to its wall's load (owned nodes only, so each counts once).
+  void apply(double *vel, int i, int j, int k, double h, double m = 0.0);
   // (8-23) of one point (P2G, after its own scatter so that each node sums in point order):
   // grid faces and mesh walls, into the force rows of the P2G records.
   void add_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g) {
@@ -50,7 +52,40 @@ class Boundaries {
   }
   // A point moved from xold to x: put back on the fluid side of a mesh wall, a grid face or the
   // closed gate. Returns the number of corrections.
-  int put_back(double x[3], double v[3], const double xold[3]);
+  // m > 0 with record_loads on: the momentum a mesh wall gives the point, m (v after - v before),
+  // is added to that wall's load.
+  int put_back(double x[3], double v[3], const double xold[3], double m = 0.0);
+
+  // Wall loads (mesh_wall ... loads yes; docs/theory/mesh_walls.md, "Force and torque on a mesh"):
+  // the momentum the mesh walls give the fluid, per wall 6 values (impulse, and its moment about
+  // the wall's reference point), summed from record_loads(h) until take_loads. h: the sub-step of
+  // the (8-23) traction, a force. Off (no cost) until record_loads is called.
+  // With grid damping c a velocity change dv made after the update's division by s = 1 + h c is
+  // the impulse m s dv (s u_new = u_old + h (f + f_wall) / m: the damping acts on the final
+  // velocity, not on the wall's share), so apply records m s dv (load_scale: s).
+  void record_loads(double h);
+  bool recording() const { return rec_on_; }
+  double load_scale() const { return rec_s_; }
+  // adds the impulse J that wall k gives the fluid at x (nothing for a wall without loads)
+  void add_impulse(int k, const double *x, const double *J);
+  // the normal (towards the fluid) of the first mesh-wall condition of node (i, j, k); false: none
+  bool node_normal(int i, int j, int k, double n[3]) {
+    if (!walls_) return false;
+    const std::size_t c = node_walls(i, j, k);
+    if (count_[c] == 0) return false;
+    for (int d = 0; d < 3; ++d) n[d] = cache_[first_[c]].n[d];
+    return true;
+  }
+  // the mesh wall whose load the pressure terms of node (i, j, k) belong to: the nearest one,
+  // unless a grid face (non-periodic) is nearer; -1: none (cached per wall position)
+  int load_wall(int i, int j, int k);
+  // The mesh wall that takes an impulse along d of sign 'sign' at x (node (i, j, k); cached per
+  // wall position): the boundary the grid line through x along d meets first on either side, a
+  // triangle or a grid face (non-periodic); on a tie the one on the side the impulse points away
+  // from. -1: a grid face, or none.
+  int line_wall(int i, int j, int k, const double x[3], int d, double sign);
+  // adds the sums since record_loads to out (6 per wall) and zeroes them
+  void take_loads(std::vector<double> &out);
 
  private:
   void add_face_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g);
@@ -68,6 +103,15 @@ class Boundaries {
   std::vector<long> stamp_;
   std::vector<int> first_, count_;
   std::vector<char> near_;
+  bool rec_on_ = false;
+  double rec_h_ = 0.0;
+  double rec_s_ = 1.0;
+  std::vector<double> rec_;
+  std::vector<long> lw_stamp_;
+  std::vector<int> lw_;
+  std::vector<long> ln_stamp_;
+  std::vector<int> ln_;      // per node and d: wall below, wall above (-1 grid face / none)
+  std::vector<double> lt_;   // their distances
 };
 
 }  // namespace mpm

@@ -149,7 +149,43 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
     drift_.clear();
   if (acceleration_on()) acceleration_pressure(vel, theta ? theta : theta_.data(), h, p2g, mmin, step);
   average_pressure(h);
+  if (bc.recording()) load_terms(vel, p2g, mmin, theta, h, h / hs);
   set_velocities(vel, p2g, mmin, theta, h, hs, bc);
+}
+
+/* The pressure correction's momentum as nodal terms (load_coefficients): J_n = -m_n h / rho_n g_n
+   (s = 1 + h damping times the velocity change m_n (u_n - u*_n), u* and the correction both
+   divided by s; Boundaries::record_loads) with g_n,d = sum_side c_side side (p_m - p_n) / dx
+   (gradient_weights): p_n gets +m_n h / rho_n c side / dx, p_m the opposite, so that the coefficients sum to 0 over all nodes (halo parts
+   summed to their owners). A node whose gradient is not of that form keeps its J in load_rest. */
+void Projection::load_terms(const double *vel, const double *p2g, double mmin, const double *theta, double h, double s) {
+  lc_.assign(3 * grid_.size(), 0.0);
+  lr_.assign(3 * grid_.size(), 0.0);
+  const double inv_dx = 1.0 / opt_.grid.dx;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    if (!(m > mmin && m > 0.0) || lab_.kind[n] == kSolid) return;
+    const double *us = vel + VelRec::N * n + VelRec::V_NEW;  // u*
+    const double mu = m * h * inv_rho_[n];
+    for (int d = 0; d < 3; ++d) {
+      double c[2];
+      std::size_t nb[2];
+      gradient_weights(grid_, lab_, theta, i, j, k, n, d, c, nb);
+      double g = 0.0;
+      for (int q = 0; q < 2; ++q) g += c[q] * (q ? 1.0 : -1.0) * (load_pressure(nb[q]) - load_pressure(n)) * inv_dx;
+      const double J = s * m * (u_[3 * n + d] - us[d]);
+      if (std::fabs(g - grad_[3 * n + d]) > 1e-9 * (std::fabs(g) + std::fabs(grad_[3 * n + d])) + 1e-300) {
+        lr_[3 * n + d] += J;
+        continue;
+      }
+      for (int q = 0; q < 2; ++q) {
+        const double a = mu * c[q] * (q ? 1.0 : -1.0) * inv_dx;
+        lc_[3 * n + d] += a;
+        lc_[3 * nb[q] + d] -= a;
+      }
+    }
+  });
+  grid_.reverse_sum(lc_.data(), 3);
 }
 
 double Projection::solve_pressure(const double *vel, const double *p2g, double mmin, const double *theta, double h,
@@ -197,8 +233,11 @@ void Projection::set_velocities(double *vel, const double *p2g, double mmin, con
     const double m = p2g[P2gRec::N * n + P2gRec::M];
     if (!(m > mmin && m > 0.0)) return;  // no fluid: velocity stays 0
     if (mesh_ && behind_mesh(i, j, k, n)) {
+      // the node takes the velocity of the fluid in front: its change of momentum, a wall's (load_rest)
+      if (!lr_.empty())
+        for (int d = 0; d < 3; ++d) lr_[3 * n + d] += bc.load_scale() * m * (u_ext_[3 * n + d] - v[d]);
       for (int d = 0; d < 3; ++d) v[d] = u_ext_[3 * n + d];
-      bc.apply(v, i, j, k, h);
+      bc.apply(v, i, j, k, h, m);
       return;
     }
     if (lab_.kind[n] == kSolid) {
@@ -206,7 +245,7 @@ void Projection::set_velocities(double *vel, const double *p2g, double mmin, con
       return;
     }
     for (int d = 0; d < 3; ++d) v[d] = u_[3 * n + d];
-    bc.apply(v, i, j, k, h);
+    bc.apply(v, i, j, k, h, m);
   });
 }
 

@@ -50,6 +50,20 @@ class Projection {
   // writes from them (the surface's gradient and extrapolation 1, deep_inside 2) and one more
   static constexpr int kWorkMargin = 4;
 
+  // Wall loads (Boundaries::recording; docs/theory/mesh_walls.md, "Force and torque on a mesh"):
+  // the momentum the pressure correction of the last project() gave the fluid, sum over the owned
+  // nodes n of J_n = m_n (u_n - u*_n), written as sum_n p_n c_n + r_n: load_coefficients() holds
+  // c_n (3 per node, owned nodes: the weight of p_n in the J of all nodes, pressure_gradient's
+  // face weights; sum over all nodes 0), load_rest() r_n (the whole J_n of a node whose gradient
+  // is not of that form: filled next to a wall, extrapolated above the surface), load_pressure(n)
+  // p_n (the solve's at FLUID nodes, 0 at the others). Sized only while loads are recorded.
+  const std::vector<double> &load_coefficients() const { return lc_; }
+  const std::vector<double> &load_rest() const { return lr_; }
+  double load_pressure(std::size_t n) const { return lab_.kind[n] == kFluid ? p_[n] : 0.0; }
+  // whether node (i, j, k) = n lies behind a mesh wall (its J in load_rest is the change to the
+  // velocity of the fluid in front, set_velocities)
+  bool load_behind(int i, int j, int k, std::size_t n) const { return behind_mesh(i, j, k, n); }
+
   // The state of the last solve on this rank's owned nodes (ProjectionState, projection_state.h).
   void save(ProjectionState &s) const;
   // Takes the state of an earlier solve (s.box must hold every owned node; collective: fills
@@ -96,6 +110,8 @@ class Projection {
   // vel's V_NEW at the owned nodes holding mass (behind mesh walls and in the padding too);
   // padding_velocity: that of one padding node behind the box walls (grains: theta given)
   double solve_pressure(const double *vel, const double *p2g, double mmin, const double *theta, double h, long step);
+  void load_terms(const double *vel, const double *p2g, double mmin, const double *theta, double h, double s);
+  std::vector<double> lc_, lr_;
   void set_velocities(double *vel, const double *p2g, double mmin, const double *theta, double h, double hs,
                       Boundaries &bc);
   void padding_velocity(double *v, int i, int j, int k, bool grains, double h, double hs, Boundaries &bc,

@@ -239,6 +239,42 @@ void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const do
   });
 }
 
+bool gradient_weights(const LocalGrid &grid, const NodeLabels &labels, const double *theta, int i, int j, int k,
+                      std::size_t n, int d, double c[2], std::size_t m[2]) {
+  c[0] = c[1] = 0.0;
+  m[0] = m[1] = n;
+  if (labels.kind[n] == kSolid || empty_away_from_fluid(grid, labels, i, j, k, n)) return false;
+  double den = 0.0;
+  for (int side = -1; side <= 1; side += 2) {
+    std::size_t nb = n;
+    if (!open_face(grid, labels, i, j, k, d, side, &nb)) continue;
+    const int q = side > 0;
+    m[q] = nb;
+    const std::uint8_t a = labels.kind[n], b = labels.kind[nb];
+    const double s = 1.0 / surface_scale(labels, n, nb);
+    if (a == kFluid) {
+      const double th = theta ? 0.5 * (theta[n] + theta[nb]) : 1.0;
+      const double w = th * (b == kFluid ? 0.5 : 1.0 - surface_weight(labels, n, nb));
+      c[q] = w;
+      den += w * s;
+    } else if (b == kFluid && !labels.wet.empty() && labels.wet[n]) {
+      const double w = (theta ? 0.5 * (theta[n] + theta[nb]) : 1.0) * surface_weight(labels, n, nb);
+      c[q] = w;
+      den += w * s;
+    } else if (b == kFluid) {
+      c[q] = 1.0 / s;
+      den += 1.0;
+    }
+  }
+  if (!(den > 0.0)) {
+    c[0] = c[1] = 0.0;
+    return true;
+  }
+  c[0] /= den;
+  c[1] /= den;
+  return true;
+}
+
 void correct_velocity(const LocalGrid &grid, const NodeLabels &labels, const double *grad,
                       const double *inv_rho, double dt, double *u) {
   grid.for_owned([&](int, int, int, std::size_t n) {

@@ -198,6 +198,13 @@ void corrected_flux_divergence(const LocalGrid &grid, const NodeLabels &labels,
 void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const double *p, double *grad,
                        const double *theta = nullptr);
 
+// pressure_gradient's gradient at node (i, j, k) = n along d as weights of its two faces:
+// g_d = sum over side = -1, +1 of c[side > 0] side (p[m] - p[n]) / dx, m[side > 0] the neighbour
+// (c = 0 for a face that is not open). False where pressure_gradient gives 0 (SOLID node, EMPTY
+// node away from the fluid). For the wall loads (FluidSolver::wall_pressure_loads).
+bool gradient_weights(const LocalGrid &grid, const NodeLabels &labels, const double *theta, int i, int j, int k,
+                      std::size_t n, int d, double c[2], std::size_t m[2]);
+
 // u -= dt inv_rho grad at the owned non-SOLID nodes (inv_rho per node).
 void correct_velocity(const LocalGrid &grid, const NodeLabels &labels, const double *grad,
                       const double *inv_rho, double dt, double *u);

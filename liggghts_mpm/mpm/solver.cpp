@@ -166,6 +166,7 @@ void FluidSolver::step() {
     if ((clock.step / opt.fluid_every) % every == 0) vc_time = every * hf;
   }
   const bool samples = samples_on();
+  if (walls_with_loads()) bc.record_loads(h);
   if (samples) begin_samples();
   for (int s = 0; s < state.nsub; ++s) substep(h, s == 0 ? vc_time : 0.0);
   if (samples) end_samples();
@@ -368,7 +369,7 @@ void FluidSolver::update_grid(double h, double vc_time) {
       vnew[d] = (gv[VelRec::V_OLD + d] + h * f * inv) / (1.0 + h * opt.damping);
     }
     // projection: u* here; the wall conditions come with the projection (Projection::project)
-    if (!opt.projection) bc.apply(vnew, i, j, k, h);
+    if (!opt.projection) bc.apply(vnew, i, j, k, h, g[P2gRec::M]);
     for (int d = 0; d < 3; ++d) gv[VelRec::V_NEW + d] = vnew[d];
   });
   if (opt.projection) {
@@ -540,7 +541,7 @@ void FluidSolver::advance_positions(double h) {
     if (box_only && xi[0] >= lo[0] && xi[0] <= hi[0] && xi[1] >= lo[1] && xi[1] <= hi[1] && xi[2] >= lo[2] &&
         xi[2] <= hi[2])
       continue;
-    state.n_clamped += bc.put_back(xi, v[i], xold);
+    state.n_clamped += bc.put_back(xi, v[i], xold, pts.rmass[i]);
   }
 }
 

@@ -102,13 +102,14 @@ class FluidSolver {
   // wall time in the pressure solver (part of the fluid's)
   static constexpr int kGlobalSize = 19;
   // then, from index kGlobalSize (f_ID[20] on): per mesh wall k (in the order of the fix command)
-  // the fluid's force on it (3) and its torque about the wall's reference point (3), averaged over
-  // the sub-steps of the last fluid step (wall_loads.cpp); then per probe the pressure averaged
+  // the fluid's force on it (3) and its torque about the wall's reference point (3): minus the
+  // momentum the wall gave the fluid over the last fluid step per time (wall_loads.cpp); then per probe the pressure averaged
   // over the last completed probe window. walls: the number of mesh walls of the host.
   static int global_size(int walls, int probes) { return kGlobalSize + 6 * walls + probes; }
   void global_vector(double *out, int walls);
-  // wall_loads.cpp: the pressure field the walls and probes read in this sub-step, added to the
-  // mesh walls' loads and the probes' sums with weight h (after update_grid; collective)
+  // wall_loads.cpp: the pressure field the probes read in this sub-step, added to the probes' sums
+  // with weight h, and (projection) the pressure correction's momentum to the mesh walls' loads
+  // (after update_grid; collective)
   void sample_pressure(double h);
   // HDF5 + XDMF output of the points (and grid) fields of keyword output (collective).
   void write_output();
@@ -305,7 +306,7 @@ class FluidSolver {
   double p_surface_ = 0.0;  // pressure projection: the solve's pressure at the free surface (this sub-step)
   bool pressure_at(const double *x, double &p, double *vel);
   bool owns_sample(const double *x) const;
-  void wall_loads(double h);
+  void wall_pressure_loads();
   void probe_sums(double h);
   void begin_samples();
   void end_samples();

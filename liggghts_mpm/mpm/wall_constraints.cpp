@@ -239,12 +239,13 @@ int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_f
       o.rate = walls_[k].kind == WALL_SHEAR ? wall_layer_rate(nu_, layer_thickness(static_cast<int>(k)), reach_fluid) : 0.0;
       o.behind = behind;
       o.imposed = walls_[k].kind == WALL_STICKY;
+      o.wall = static_cast<int>(k);
     }
   }
   return nout;
 }
 
-bool WallGeometry::nearest_face(const double x[3], double reach, double q[3], double n[3]) const {
+bool WallGeometry::nearest_face(const double x[3], double reach, double q[3], double n[3], int *wall) const {
   if (tris_.empty()) return false;
   const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
   const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
@@ -283,13 +284,64 @@ bool WallGeometry::nearest_face(const double x[3], double reach, double q[3], do
     q[k] = bh.p[k];
     n[k] = sg * t.n[k];
   }
+  if (wall) *wall = t.mesh;
   return true;
+}
+
+int WallGeometry::nearest_wall(const double x[3], double reach, double *dist) const {
+  *dist = reach;
+  if (tris_.empty()) return -1;
+  const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
+  const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+  double best = reach * reach;
+  int bw = -1;
+  for (int c = 0; c < ncand; ++c) {
+    const Tri &t = tris_[cand ? (*cand)[c] : c];
+    if (beyond_box(t, x, reach)) continue;
+    double a[3];
+    sub3(x, t.p[0], a);
+    const double pd = dot3(a, t.n);
+    if (pd * pd >= best) continue;
+    Hit h;
+    closest_point(t, x, h);
+    if (h.dist2 >= best) continue;
+    best = h.dist2;
+    bw = t.mesh;
+  }
+  if (bw >= 0) *dist = std::sqrt(best);
+  return bw;
+}
+
+int WallGeometry::ray_wall(const double x[3], int d, int side, double len, double *t) const {
+  int bw = -1;
+  double best = len;
+  for (const Tri &tr : tris_) {
+    if (tr.n[d] == 0.0) continue;
+    // box test across the ray
+    bool out = false;
+    for (int e = 0; e < 3 && !out; ++e)
+      if (e != d) out = x[e] < tr.lo[e] - 1e-12 * len || x[e] > tr.hi[e] + 1e-12 * len;
+    if (out) continue;
+    double a[3];
+    sub3(tr.p[0], x, a);
+    const double s = side * dot3(a, tr.n) / tr.n[d];  // distance along the ray to the plane
+    if (!(s >= -1e-12 * len) || s >= best) continue;
+    double y[3] = {x[0], x[1], x[2]};
+    y[d] += side * s;
+    Hit h;
+    closest_point(tr, y, h);
+    if (h.dist2 > 1e-18 * len * len) continue;
+    best = s;
+    bw = tr.mesh;
+  }
+  *t = best;
+  return bw;
 }
 
 // ---------------------------------------------------------------------------------------------
 // Material points
 
-bool WallGeometry::push_back(double x[3], double v[3], double reach, const double *x_old) const {
+bool WallGeometry::push_back(double x[3], double v[3], double reach, const double *x_old, int *wall) const {
   if (tris_.empty()) return false;
   const double off = 1e-3 * reach;
   bool moved = false;
@@ -297,14 +349,14 @@ bool WallGeometry::push_back(double x[3], double v[3], double reach, const doubl
   // (a) crossings of the segment x_old -> x
   if (x_old) {
     for (int iter = 0; iter < 4; ++iter) {
-      if (!push_across(x, v, x_old, off)) break;
+      if (!push_across(x, v, x_old, off, wall)) break;
       moved = true;
     }
   }
 
   // (b) one-sided meshes: a point behind the mesh (push_from_behind)
   for (int iter = 0; iter < 4; ++iter) {
-    if (!push_from_behind(x, v, reach, off)) break;
+    if (!push_from_behind(x, v, reach, off, wall)) break;
     moved = true;
   }
   return moved;
@@ -313,7 +365,7 @@ bool WallGeometry::push_back(double x[3], double v[3], double reach, const doubl
 // push_back (a), one crossing: the first crossing of the segment x_old -> x from the fluid side
 // of a triangle; x goes back to the fluid side, 'off' from the plane, and v loses its normal
 // velocity relative to the wall. Returns false if there is none.
-bool WallGeometry::push_across(double x[3], double v[3], const double *x_old, double off) const {
+bool WallGeometry::push_across(double x[3], double v[3], const double *x_old, double off, int *wall) const {
   double seg[3];
   sub3(x, x_old, seg);
   const double len = std::sqrt(dot3(seg, seg));
@@ -358,6 +410,7 @@ bool WallGeometry::push_across(double x[3], double v[3], const double *x_old, do
     }
   }
   if (bi < 0) return false;
+  if (wall) *wall = tris_[bi].mesh;
   double w[3];
   wall_velocity(tris_[bi], bb, w);
   // back to the fluid side, 'off' from the plane
@@ -374,7 +427,7 @@ bool WallGeometry::push_across(double x[3], double v[3], const double *x_old, do
 // triangle in its face region, or the triangles sharing the nearest edge or vertex); the point
 // goes to the nearest point of the mesh plus 'off' towards the fluid. Returns false if x is not
 // behind such a mesh.
-bool WallGeometry::push_from_behind(double x[3], double v[3], double reach, double off) const {
+bool WallGeometry::push_from_behind(double x[3], double v[3], double reach, double off, int *wall) const {
   const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
   const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
   const double r2 = reach * reach;
@@ -427,6 +480,7 @@ bool WallGeometry::push_from_behind(double x[3], double v[3], double reach, doub
   if (!behind || first < 0) return false;
   const Tri &t = tris_[idx[first]];
   const Hit &bh = hits[first];
+  if (wall) *wall = t.mesh;
   double d[3], bn[3];
   sub3(x, bh.p, d);
   const double dl = std::sqrt(bh.dist2);

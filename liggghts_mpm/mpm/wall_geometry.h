@@ -65,6 +65,7 @@ struct WallConstraint {
   double rate;
   bool behind;
   bool imposed;
+  int wall;  // the mesh (wall index) the condition belongs to
 };
 
 // Relaxation rate (1/time) of the tangential slip of the fluid within 'depth' of a wall whose
@@ -144,14 +145,23 @@ class WallGeometry {
   // Nearest triangle face to x within 'reach' (the closest point inside a triangle, not on an edge
   // or vertex only): q = that point, n = unit normal towards x's side (the fluid side of a
   // one-sided mesh; false if x is behind it). For the wall traction of the fix. reach <= margin.
-  bool nearest_face(const double x[3], double reach, double q[3], double n[3]) const;
+  // wall (optional): the mesh of that triangle.
+  bool nearest_face(const double x[3], double reach, double q[3], double n[3], int *wall = nullptr) const;
+
+  // The wall (mesh index) of the nearest triangle within 'reach' of x (-1: none), *dist its distance.
+  int nearest_wall(const double x[3], double reach, double *dist) const;
+
+  // The first triangle the ray from x along side e_d (side -1 or +1) meets within 'len': returns its
+  // wall (-1: none) and *t the distance to it.
+  int ray_wall(const double x[3], int d, int side, double len, double *t) const;
 
   // Material points. Undoes a crossing: (a) if x_old is given and the segment x_old -> x crosses a
   // triangle, x goes back to x_old's side of it; (b) for one-sided meshes, a point behind a
   // triangle (closest point inside the face, depth < reach) is put back on the fluid side. The
   // corrected point sits 1e-3 * reach off the plane, and its normal velocity relative to the wall
   // is zeroed. Returns true if x was changed.
-  bool push_back(double x[3], double v[3], double reach, const double *x_old = nullptr) const;
+  // wall (optional): the mesh of the last correction (unchanged if none).
+  bool push_back(double x[3], double v[3], double reach, const double *x_old = nullptr, int *wall = nullptr) const;
 
   // Side votes of the n points x[i] for every one-sided wall (side SIDE_AUTO, SIDE_NORMAL or
   // SIDE_OPPOSITE; not SIDE_BOTH): each point votes with the
@@ -208,8 +218,8 @@ class WallGeometry {
   int constraints(const KeptHits &kept, double reach, double reach_fluid, double rf2, double rb2,
                   WallConstraint *out) const;
   // push_back's steps (wall_constraints.cpp): one crossing undone, one point out from behind
-  bool push_across(double x[3], double v[3], const double *x_old, double off) const;
-  bool push_from_behind(double x[3], double v[3], double reach, double off) const;
+  bool push_across(double x[3], double v[3], const double *x_old, double off, int *wall) const;
+  bool push_from_behind(double x[3], double v[3], double reach, double off, int *wall) const;
   void bins_build(const double box[6]);
   // Candidate triangles for a query ball (x, r); returns null if x lies outside the bins (then
   // every triangle is a candidate).

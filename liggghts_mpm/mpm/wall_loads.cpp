@@ -1,22 +1,23 @@
 // What the fluid does to its mesh walls, and what pressure probes read (docs/fix_mpm_fluid.md,
-// "Wall loads and probes"; docs/theory/mesh_walls.md, "Force and torque on a mesh"): the pressure field
-// of the sub-step sampled on the triangles and at the probes, summed over the sub-steps of a fluid
-// step (walls) or of a probe window.
+// "Wall loads and probes"; docs/theory/mesh_walls.md, "Force and torque on a mesh").
 //
-// The pressure field. pressure projection: the nodal pressure the points interpolate (the
-// solve's, or the acceleration pressure with pressure_output acceleration), extended linearly
-// behind the mesh walls, read with the points' shape functions, less the solve's pressure at the
-// free surface (surface_pressure). pressure eos: the points' own pressures (those the internal
-// force of this sub-step used), fitted linearly around the sample, p(y) = a + b . (y - x), by
-// least squares with the weights m_p sum_i S_i(x) S_i(x_p) (the moments of the points gathered
+// Walls: the momentum each wall gives the fluid, recorded where it is given (Boundaries::
+// record_loads): the change of a node's momentum by each of the wall's velocity conditions, the
+// (8-23) traction of pressure eos, the points the wall puts back, and with the projection the
+// nodes behind the wall taking the velocity of the fluid in front and the pressure correction's
+// momentum, written as nodal terms (wall_pressure_loads) that go to the wall that ends the node's
+// grid line. The fluid's force on a wall is minus that momentum per time, its mean over a fluid step.
+//
+// Probes: the pressure field of the sub-step. pressure projection: the nodal pressure the points
+// interpolate (the solve's, or the acceleration pressure with pressure_output acceleration),
+// extended linearly behind the mesh walls, read with the points' shape functions, less the solve's
+// pressure at the free surface (surface_pressure). pressure eos: the points' own pressures (those
+// the internal force of this sub-step used), fitted linearly around the sample, p(y) = a + b . (y - x),
+// by least squares with the weights m_p sum_i S_i(x) S_i(x_p) (the moments of the points gathered
 // at the nodes, node_mass_pressure), p(x) = a: at a wall the fit is one-sided and extrapolates
-// to the wall (a mass-weighted mean would read the pressure about half a cell inside, measured
-// -15 % of the weight on the floor of a closed box 3 cells deep). Both read only where fluid is:
-// sum_i S_i(x) M_i above the empty-node mass.
-//
-// Each sample belongs to the rank that owns its nearest grid node (clamped into the grid along
-// non-periodic dimensions, never wrapped along periodic ones, so that a triangle's periodic image
-// counts once): summed over the ranks, every part of every triangle counts once.
+// to the wall. Both read only where fluid is: sum_i S_i(x) M_i above the empty-node mass. A point
+// probe belongs to the rank that owns its nearest grid node (clamped into the grid along
+// non-periodic dimensions).
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -185,86 +186,6 @@ bool FluidSolver::owns_sample(const double *x) const {
   return true;
 }
 
-/* Force and torque of the fluid on each mesh wall in this sub-step, added to wall_sum_ with
-   weight h. Each triangle is cut into n^2 equal triangles (n edges per side, none longer than
-   half a cell), each sampled at its centroid. One-sided wall: the pressure presses along the
-   normal away from the fluid, F = -p n_fluid dA. Two-sided wall (side both): the pressures one
-   cell in front of and behind the triangle, F = (p_behind - p_front) n dA. Shear walls also carry
-   the stress of their wall layer, mu (v_t - f w_t) / delta dA (the points' velocity at the sample
-   relative to f times the wall's). Torque: (x - reference point) x F. */
-void FluidSolver::wall_loads(double h) {
-  const WallGeometry &wg = *bc.walls();
-  const int nw = wg.walls();
-  const double dx = opt.grid.dx;
-  std::vector<double> loc(6 * static_cast<std::size_t>(nw), 0.0);
-  for (const WallGeometry::Tri &t : wg.triangles()) {
-    const WallSpec &ws = wg.wall(t.mesh);
-    if (!ws.loads) continue;
-    double e1[3], e2[3], e3[3];
-    for (int d = 0; d < 3; ++d) {
-      e1[d] = t.p[1][d] - t.p[0][d];
-      e2[d] = t.p[2][d] - t.p[0][d];
-      e3[d] = t.p[2][d] - t.p[1][d];
-    }
-    const double cr[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-    const double area = 0.5 * std::sqrt(geom::dot3(cr, cr));
-    const double lmax = std::sqrt(std::max({geom::dot3(e1, e1), geom::dot3(e2, e2), geom::dot3(e3, e3)}));
-    const int n = std::max(1, static_cast<int>(std::ceil(lmax / (0.5 * dx))));
-    const double dA = area / (static_cast<double>(n) * n);
-    const bool shear = ws.kind == WALL_SHEAR && opt.viscosity > 0.0;
-    const double delta = shear ? wg.layer_thickness(t.mesh) : 0.0;
-    double *out = &loc[6 * static_cast<std::size_t>(t.mesh)];
-    auto sample = [&](double a, double b) {
-      double x[3];
-      for (int d = 0; d < 3; ++d) x[d] = t.p[0][d] + a * e1[d] + b * e2[d];
-      if (!owns_sample(x)) return;
-      double F[3] = {0.0, 0.0, 0.0};
-      bool any = false;
-      if (ws.side == SIDE_BOTH) {
-        double xf[3], xb[3], pf = 0.0, pb = 0.0;
-        for (int d = 0; d < 3; ++d) {
-          xf[d] = x[d] + dx * t.n[d];
-          xb[d] = x[d] - dx * t.n[d];
-        }
-        const bool hf = pressure_at(xf, pf, nullptr), hb = pressure_at(xb, pb, nullptr);
-        any = hf || hb;
-        for (int d = 0; d < 3; ++d) F[d] = ((hb ? pb : 0.0) - (hf ? pf : 0.0)) * t.n[d] * dA;
-      } else {
-        double p = 0.0, v[3];
-        if (!pressure_at(x, p, shear ? v : nullptr)) return;
-        any = true;
-        const double s = ws.side == SIDE_OPPOSITE ? -1.0 : 1.0;  // n_fluid = s n
-        for (int d = 0; d < 3; ++d) F[d] = -p * s * t.n[d] * dA;
-        if (shear && std::isfinite(delta) && delta > 0.0) {
-          const double b0 = 1.0 - a - b;
-          double r[3];
-          for (int d = 0; d < 3; ++d)
-            r[d] = v[d] - ws.sticky * (b0 * t.w[0][d] + a * t.w[1][d] + b * t.w[2][d]);
-          const double rn = geom::dot3(r, t.n);
-          for (int d = 0; d < 3; ++d) F[d] += opt.viscosity * (r[d] - rn * t.n[d]) / delta * dA;
-        }
-      }
-      if (!any) return;
-      double r[3];
-      for (int d = 0; d < 3; ++d) r[d] = x[d] - ws.ref[d];
-      out[0] += F[0];
-      out[1] += F[1];
-      out[2] += F[2];
-      out[3] += r[1] * F[2] - r[2] * F[1];
-      out[4] += r[2] * F[0] - r[0] * F[2];
-      out[5] += r[0] * F[1] - r[1] * F[0];
-    };
-    const double inv = 1.0 / (3.0 * n);
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j + i < n; ++j) {
-        sample((3 * i + 1) * inv, (3 * j + 1) * inv);                        // upward
-        if (i + j <= n - 2) sample((3 * i + 2) * inv, (3 * j + 2) * inv);    // downward
-      }
-  }
-  if (wall_sum_.size() != loc.size()) wall_sum_.assign(loc.size(), 0.0);
-  for (std::size_t c = 0; c < loc.size(); ++c) wall_sum_[c] += h * loc[c];
-}
-
 /* The probes' sums of this sub-step with weight h: a point probe, the pressure at its point (on
    the rank that owns the point, where fluid is); a box probe, the nodal pressure of every owned
    node inside the box that holds fluid (each node counts once). probe_sum_[2 j] += h sum p,
@@ -358,15 +279,52 @@ void FluidSolver::surface_pressure() {
   p_surface_ = glob[1] > 0.0 ? glob[0] / glob[1] : 0.0;
 }
 
+/* pressure projection: the pressure correction's momentum of this sub-step as nodal terms
+   (Projection::load_coefficients), b_n = (p_n - p_surface_) c_n + r_n (the shift by a constant
+   changes no sum: the c_n sum to 0), each node's to the mesh wall nearest to it within 3 cells
+   (Boundaries::load_wall); nodes nearer a grid face or farther from every wall give theirs to
+   none. */
+void FluidSolver::wall_pressure_loads() {
+  const std::vector<double> &c = proj_->load_coefficients(), &r = proj_->load_rest();
+  if (c.empty()) return;
+  const double ps = opt.pressure_acceleration ? 0.0 : p_surface_;
+  const GridSpec &gs = opt.grid;
+  grid_.for_owned_all([&](int i, int j, int k, std::size_t n) {
+    const double p = proj_->load_pressure(n) - ps;
+    double b[3];
+    for (int d = 0; d < 3; ++d) b[d] = p * c[3 * n + d] + r[3 * n + d];
+    if (b[0] == 0.0 && b[1] == 0.0 && b[2] == 0.0) return;
+    const double x[3] = {gs.origin[0] + i * gs.dx, gs.origin[1] + j * gs.dx, gs.origin[2] + k * gs.dx};
+    // a node behind a mesh: its lines are those of its mirror image in front of the wall
+    double y[3] = {x[0], x[1], x[2]};
+    if (proj_->load_behind(i, j, k, n)) {
+      double nrm[3], dist = 0.0;
+      if (bc.node_normal(i, j, k, nrm) && bc.walls()->nearest_wall(x, 3.0 * gs.dx, &dist) >= 0)
+        for (int e = 0; e < 3; ++e) y[e] = x[e] + 2.0 * dist * nrm[e];
+    }
+    for (int d = 0; d < 3; ++d) {
+      if (b[d] == 0.0) continue;
+      const int w = bc.line_wall(i, j, k, y, d, b[d]);
+      if (w < 0) continue;
+      double J[3] = {0.0, 0.0, 0.0};
+      J[d] = b[d];
+      bc.add_impulse(w, x, J);
+    }
+  });
+}
+
 void FluidSolver::sample_pressure(double h) {
   if (probe_sum_.size() != 2 * opt.probes.size()) {
     probe_sum_.assign(2 * opt.probes.size(), 0.0);
     probe_mean_.assign(opt.probes.size(), 0.0);
     probe_time_ = 0.0;
   }
-  node_mass_pressure();
-  surface_pressure();
-  if (walls_with_loads()) wall_loads(h);
+  const bool pressure_loads = bc.recording() && proj_;
+  if (pressure_loads || !opt.probes.empty()) {
+    node_mass_pressure();
+    surface_pressure();
+  }
+  if (pressure_loads) wall_pressure_loads();
   if (!opt.probes.empty()) probe_sums(h);
   wall_time_ += h;
   probe_time_ += h;
@@ -388,6 +346,13 @@ void FluidSolver::begin_samples() {
 void FluidSolver::end_samples() {
   const int nw = bc.walls() ? bc.walls()->walls() : 0;
   if (static_cast<int>(wall_sum_.size()) != 6 * nw) wall_sum_.assign(6 * static_cast<std::size_t>(nw), 0.0);
+  // the walls' momentum given to the fluid over this step (Boundaries::record_loads): the fluid's
+  // force on them is its opposite
+  if (bc.recording()) {
+    std::vector<double> J(wall_sum_.size(), 0.0);
+    bc.take_loads(J);
+    for (std::size_t c = 0; c < wall_sum_.size(); ++c) wall_sum_[c] -= J[c];
+  }
   const bool window_done = !opt.probes.empty() && probe_time_ >= opt.probe_window * (1.0 - 1e-9);
   std::vector<double> loc(wall_sum_);
   if (window_done) loc.insert(loc.end(), probe_sum_.begin(), probe_sum_.end());

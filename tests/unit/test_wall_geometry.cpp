@@ -1,6 +1,7 @@
 // Unit tests of mpm::WallGeometry (liggghts_mpm/mpm/wall_geometry.h) without LIGGGHTS: closest
 // points against a dense sampling of the triangle, the five wall kinds on a plate against the
-// formulas of docs/theory/mesh_walls.md, undoing a crossing, and the bins against a scan of every triangle.
+// formulas of docs/theory/mesh_walls.md, undoing a crossing, the bins against a scan of every triangle,
+// and the mesh the wall loads give a condition, a crossing, a nearest triangle or a ray to.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -470,4 +471,43 @@ TEST(WallGeometry, ShearAutoTakesTheStokesLayerOfTheRotation) {
   WallGeometry fixed({wall(mpm::WALL_SHEAR, 1.0, mpm::SIDE_NORMAL, 2.5e-4)});
   fixed.set_triangles(band(0, 16, true), box, 0.01);
   EXPECT_EQ(fixed.layer_thickness(0), 2.5e-4);
+}
+
+// The wall loads' queries: which mesh a condition, a crossing undone, a nearest triangle and a ray
+// belong to. Two plates, z = 0.5 (mesh 0) and z = 0.8 (mesh 1), both with normals +z.
+TEST(WallGeometry, LoadQueriesNameTheMesh) {
+  const double w0[3] = {0, 0, 0};
+  WallGeometry g({wall(mpm::WALL_FREESLIP, 0.0, mpm::SIDE_BOTH), wall(mpm::WALL_FREESLIP, 0.0, mpm::SIDE_BOTH)});
+  std::vector<Tri> t = plate(0.5, w0, 0), u = plate(0.8, w0, 1);
+  t.insert(t.end(), u.begin(), u.end());
+  g.set_triangles(t, kBox, 0.1);
+  // conditions at a node between them, 0.05 from each: one per mesh, named
+  const double x[3] = {0.3, 0.4, 0.65};
+  WallConstraint c[WallGeometry::kMaxConstraints];
+  const int nc = g.collect(x, 0.2, 0.2, c);
+  ASSERT_EQ(nc, 2);
+  EXPECT_NE(c[0].wall, c[1].wall);
+  for (int k = 0; k < nc; ++k) EXPECT_EQ(c[k].wall, c[k].n[2] > 0.0 ? 0 : 1);  // above plate 0, below plate 1
+  // nearest triangle and its distance
+  double dist = 0.0;
+  const double y[3] = {0.3, 0.4, 0.74};
+  EXPECT_EQ(g.nearest_wall(y, 0.5, &dist), 1);
+  EXPECT_NEAR(dist, 0.06, 1e-12);
+  EXPECT_EQ(g.nearest_wall(y, 0.01, &dist), -1);
+  // rays along z: up from 0.6 meets mesh 1 at 0.2, down mesh 0 at 0.1; along x none
+  double t0 = 0.0;
+  const double z[3] = {0.3, 0.4, 0.6};
+  EXPECT_EQ(g.ray_wall(z, 2, 1, 1.0, &t0), 1);
+  EXPECT_NEAR(t0, 0.2, 1e-12);
+  EXPECT_EQ(g.ray_wall(z, 2, -1, 1.0, &t0), 0);
+  EXPECT_NEAR(t0, 0.1, 1e-12);
+  EXPECT_EQ(g.ray_wall(z, 2, -1, 0.05, &t0), -1);  // beyond the ray's length
+  EXPECT_EQ(g.ray_wall(z, 0, 1, 1.0, &t0), -1);
+  // a point that crossed plate 1 upwards is put back, and the crossing is mesh 1's
+  double p[3] = {0.3, 0.4, 0.82}, v[3] = {0.0, 0.0, 1.0};
+  const double pold[3] = {0.3, 0.4, 0.78};
+  int which = -1;
+  EXPECT_TRUE(g.push_back(p, v, 0.1, pold, &which));
+  EXPECT_EQ(which, 1);
+  EXPECT_LT(p[2], 0.8);
 }
