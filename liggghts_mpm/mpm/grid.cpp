@@ -134,20 +134,27 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
           }
     }
   }
+  self_ = false;
+  for (const auto &t : halo_side_) self_ = self_ || t.peer == me_;
+  for (const auto &t : owner_side_) self_ = self_ || t.peer == me_;
 }
 
 void LocalGrid::reverse_sum(double *data, int stride) {
+  if (nprocs_ == 1 && !self_) return;  // nothing to exchange (one rank, no periodic images)
   const Field f{data, stride};
   exchange(&f, 1, true);
 }
 void LocalGrid::forward(double *data, int stride) {
+  if (nprocs_ == 1 && !self_) return;
   const Field f{data, stride};
   exchange(&f, 1, false);
 }
 void LocalGrid::reverse_sum(std::initializer_list<Field> fields) {
+  if (nprocs_ == 1 && !self_) return;
   exchange(fields.begin(), static_cast<int>(fields.size()), true);
 }
 void LocalGrid::forward(std::initializer_list<Field> fields) {
+  if (nprocs_ == 1 && !self_) return;
   exchange(fields.begin(), static_cast<int>(fields.size()), false);
 }
 

@@ -213,6 +213,7 @@ class LocalGrid {
   std::size_t nnodes_ = 0;
   std::vector<Transfer> halo_side_;   // my halo nodes -> owner (reverse sends, forward receives)
   std::vector<Transfer> owner_side_;  // my owned nodes <- peer halos (reverse receives, forward sends)
+  bool self_ = false;                 // some transfer is with this rank (periodic images)
   // exchange()'s buffers and scratch, kept from call to call (grown, never shrunk)
   std::vector<double> sendbuf_, recvbuf_, selfbuf_;
   std::vector<int> xcount_, xoff_, xpos_;
