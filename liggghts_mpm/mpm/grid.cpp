@@ -63,6 +63,12 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
   MPI_Comm_size(comm, &nprocs_);
 
   owned_ = owned_box(spec, sublo, subhi);
+  place_patch(sublo, halo);
+  find_transfers();
+}
+
+void LocalGrid::place_patch(const double sublo[3], const int halo[2]) {
+  const GridSpec &spec = spec_;
   // The patch: owned nodes (or, for a rank without any, the nodes nearest its
   // subdomain) widened by the halo, clipped to the grid in non-periodic dims.
   for (int d = 0; d < 3; ++d) {
@@ -80,7 +86,10 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
     n_[d] = std::max(0, patch_.hi[d] - patch_.lo[d] + 1);
   }
   nnodes_ = std::size_t(n_[0]) * n_[1] * n_[2];
+}
 
+void LocalGrid::find_transfers() {
+  const GridSpec &spec = spec_;
   // Everybody's owned and patch boxes, to find who exchanges what with whom.
   std::vector<int> boxes(12 * nprocs_);
   int mine[12];
@@ -90,7 +99,7 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
     mine[6 + d] = patch_.lo[d];
     mine[9 + d] = patch_.hi[d];
   }
-  MPI_Allgather(mine, 12, MPI_INT, boxes.data(), 12, MPI_INT, comm);
+  MPI_Allgather(mine, 12, MPI_INT, boxes.data(), 12, MPI_INT, comm_);
   auto box_of = [&](int r, int off) {
     IndexBox b;
     for (int d = 0; d < 3; ++d) {

@@ -200,6 +200,9 @@ class LocalGrid {
     IndexBox mine;       // node indices in my patch (halo side) or my owned box (owner side)
     int shift[3];        // peer index = my index - shift (halo side)
   };
+  // setup()'s parts: the patch around the owned box; who exchanges which boxes with whom
+  void place_patch(const double sublo[3], const int halo[2]);
+  void find_transfers();
   void exchange(const Field *fields, int nfields, bool reverse);
   template <class BoxOf, class Pack, class Unpack>
   void exchange_peers(const std::vector<Transfer> &send, const std::vector<Transfer> &recv, int stride,
