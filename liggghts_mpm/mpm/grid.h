@@ -203,6 +203,7 @@ class LocalGrid {
   // setup()'s parts: the patch around the owned box; who exchanges which boxes with whom
   void place_patch(const double sublo[3], const int halo[2]);
   void find_transfers();
+  bool nothing_to_move(const Field *fields, int nfields);
   void exchange(const Field *fields, int nfields, bool reverse);
   template <class BoxOf, class Pack, class Unpack>
   void exchange_peers(const std::vector<Transfer> &send, const std::vector<Transfer> &recv, int stride,
