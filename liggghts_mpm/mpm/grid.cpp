@@ -37,6 +37,12 @@ void image_range(const GridSpec &g, const IndexBox &a, const IndexBox &b, int km
   }
 }
 
+// Some transfer of the list is with rank me.
+template <class List>
+bool any_with(const List &list, int me) {
+  return std::any_of(list.begin(), list.end(), [me](const auto &t) { return t.peer == me; });
+}
+
 }  // namespace
 
 IndexBox owned_box(const GridSpec &g, const double sublo[3], const double subhi[3]) {
@@ -100,8 +106,7 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
     return b;
   };
 
-  halo_side_.clear();
-  owner_side_.clear();
+  halo_side_.clear(), owner_side_.clear();
   for (int q = 0; q < nprocs_; ++q) {
     // My halo nodes that are images of nodes q owns.
     const IndexBox oq = box_of(q, 0);
@@ -134,9 +139,7 @@ void LocalGrid::setup(const GridSpec &spec, MPI_Comm comm, const double sublo[3]
           }
     }
   }
-  self_ = false;
-  for (const auto &t : halo_side_) self_ = self_ || t.peer == me_;
-  for (const auto &t : owner_side_) self_ = self_ || t.peer == me_;
+  self_ = any_with(halo_side_, me_) || any_with(owner_side_, me_);  // transfers with myself
 }
 
 void LocalGrid::reverse_sum(double *data, int stride) {
