@@ -37,6 +37,12 @@ void image_range(const GridSpec &g, const IndexBox &a, const IndexBox &b, int km
   }
 }
 
+// Some transfer of the list is with rank me.
+template <class List>
+bool any_with(const List &list, int me) {
+  return std::any_of(list.begin(), list.end(), [me](const auto &t) { return t.peer == me; });
+}
+
 }  // namespace
 
 IndexBox owned_box(const GridSpec &g, const double sublo[3], const double subhi[3]) {
@@ -109,8 +115,7 @@ void LocalGrid::find_transfers() {
     return b;
   };
 
-  halo_side_.clear();
-  owner_side_.clear();
+  halo_side_.clear(), owner_side_.clear();
   for (int q = 0; q < nprocs_; ++q) {
     // My halo nodes that are images of nodes q owns.
     const IndexBox oq = box_of(q, 0);
@@ -143,9 +148,7 @@ void LocalGrid::find_transfers() {
           }
     }
   }
-  self_ = false;
-  for (const auto &t : halo_side_) self_ = self_ || t.peer == me_;
-  for (const auto &t : owner_side_) self_ = self_ || t.peer == me_;
+  self_ = any_with(halo_side_, me_) || any_with(owner_side_, me_);  // transfers with myself
 }
 
 bool LocalGrid::nothing_to_move(const Field *fields, int nfields) {
