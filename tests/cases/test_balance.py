@@ -7,7 +7,8 @@ Standard library only.
 CASE: np2 (3-D dam break of inputs/bench on 2 ranks with the balance fix against 1 rank),
 every_fluid (the same re-balanced every 50 steps inside one run, eos and projection),
 every_dem (re-balancing inside a run, no fluid), volume_dem (keyword volume), measured (cuts by the
-measured work), grid2d (4 ranks on a 2 x 2 grid, dim x y against dim x and 1 rank), bad_input,
+measured work), grid2d (4 ranks on a 2 x 2 grid, dim x y against dim x and 1 rank), grid2d_measured (the same
+re-balanced in a run by measured work; thresh on the rank grid), bad_input,
 bad_input_dims (keyword dim with several dims), all. Exit status 0 when every check passes.
 """
 import argparse
@@ -97,6 +98,41 @@ def case_grid2d(r):
         diff = abs(f1[k][0] - f4[k][0])
         check(diff < 1e-10, f"{k}: np4 (dim x y) = np1 to 1e-10 (|diff| = {diff:.1e})")
     check(f1["front_x"][0] > 1.0 + 1e-3, "the column has started to spread")
+
+
+def case_grid2d_measured(r):
+    """The grid2d scene (4 ranks, 2 x 2) re-balanced every 25 steps of a 100-step run along x and y by
+    the work fix mpm/fluid measured on each rank: = 1 rank to 1e-10 m (eos, as the 2-rank measured
+    case); every balance after the first is by measured work and does not raise the measured
+    imbalance. thresh compares the imbalance of the rank grid: at 1.2, dim x y balances at step 0
+    (4 -> (16/15)^2) and then skips (1.138 <= 1.2); dim x alone balances at every setup, because its
+    ranks' imbalance stays 2.13 although its x slabs are even."""
+    inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
+    v = dict(cells=5, ppc=3, warm=10, nsteps=100, segments=1, cellw=0, alongx=2)
+    d1, _ = r.run("balance_grid2d_measured/np1", inp, v)
+    d4, p4 = r.run("balance_grid2d_measured/np4", inp, dict(v, balance=1, baldim="x y", rebal=25, measured="yes"), np=4)
+    lines = grid_lines(p4.stdout)
+    measured = re.findall(r"fix balance/mpm: step \d+, cuts in .* \((measured )?imbalance", p4.stdout)
+    print("  " + "\n  ".join(str(ln) for ln in lines))
+    # setups at steps 0 and 10, then steps 25, 50, 75, 100 of the second run
+    check(len(lines) == 6 and all(sorted(ln[1]) == ["x", "y"] for ln in lines),
+          f"balanced along x and y at both setups and every 25 steps ({len(lines)} of 6)")
+    check(len(measured) == 6 and measured[0] == "" and all(m for m in measured[1:]),
+          "the first balance by points (nothing measured yet), the others by measured work")
+    check(all(ln[2] >= 1.0 and 1.0 <= ln[3] <= ln[2] + 1e-9 for ln in lines[1:]),
+          "measured imbalance >= 1 before, and not above it after each re-cut")
+    f1 = read_csv(os.path.join(d1, "bench3d.csv"))
+    f4 = read_csv(os.path.join(d4, "bench3d.csv"))
+    for k in ("front_x", "front_y", "mass"):
+        diff = abs(f1[k][0] - f4[k][0])
+        check(diff < 1e-10, f"{k}: np4 (dim x y, measured, re-balanced in the run) = np1 to 1e-10 (|diff| = {diff:.1e})")
+    vt = dict(v, nsteps=20, segments=2, balance=1, balthresh=1.2)
+    for dims, nexp, after in (("x y", 1, (16.0 / 15.0) ** 2), ("x", 3, 32.0 / 15.0)):
+        _, p = r.run(f"balance_grid2d_measured/thresh_{dims.replace(' ', '')}", inp, dict(vt, baldim=dims), np=4)
+        tl = grid_lines(p.stdout)
+        print(f"  thresh 1.2, dim {dims}: {tl}")
+        check(len(tl) == nexp and bool(tl) and abs(tl[0][3] - after) < 5e-4,
+              f"thresh 1.2, dim {dims}: {len(tl)} of 3 setups balanced (expected {nexp}), the first to {after:.4f}")
 
 
 def case_np2(r):
@@ -325,7 +361,8 @@ def case_volume_dem(r):
 
 
 CASES = {"np2": case_np2, "every_fluid": case_every_fluid, "measured": case_measured, "bad_input": case_bad_input, "every_dem": case_every_dem,
-         "volume_dem": case_volume_dem, "grid2d": case_grid2d, "bad_input_dims": case_bad_input_dims}
+         "volume_dem": case_volume_dem, "grid2d": case_grid2d, "grid2d_measured": case_grid2d_measured,
+         "bad_input_dims": case_bad_input_dims}
 
 
 def main():
