@@ -103,8 +103,11 @@ def case_grid2d(r):
 def case_grid2d_measured(r):
     """The grid2d scene (4 ranks, 2 x 2) re-balanced every 25 steps of a 100-step run along x and y by
     the work fix mpm/fluid measured on each rank: = 1 rank to 1e-10 m (eos, as the 2-rank measured
-    case); every balance after the first is by measured work and does not raise the measured
-    imbalance. thresh compares the imbalance of the rank grid: at 1.2, dim x y balances at step 0
+    case); every balance after the first is by measured work, and the largest measured imbalance
+    after a re-cut is below the largest before one. (A single re-cut may raise it: cuts shared along
+    a dimension and placed by marginals even out the ranks only as far as the weight is a product
+    of its x and y parts, and a plane of points holds 1/15 of them; seen once in 100 re-cuts,
+    1.076 -> 1.106.) thresh compares the imbalance of the rank grid: at 1.2, dim x y balances at step 0
     (4 -> (16/15)^2) and then skips (1.138 <= 1.2); dim x alone balances at every setup, because its
     ranks' imbalance stays 2.13 although its x slabs are even."""
     inp = os.path.join(r.inputs, "bench", "in.dambreak3d")
@@ -119,8 +122,10 @@ def case_grid2d_measured(r):
           f"balanced along x and y at both setups and every 25 steps ({len(lines)} of 6)")
     check(len(measured) == 6 and measured[0] == "" and all(m for m in measured[1:]),
           "the first balance by points (nothing measured yet), the others by measured work")
-    check(all(ln[2] >= 1.0 and 1.0 <= ln[3] <= ln[2] + 1e-9 for ln in lines[1:]),
-          "measured imbalance >= 1 before, and not above it after each re-cut")
+    before, after = [ln[2] for ln in lines[1:]], [ln[3] for ln in lines[1:]]
+    check(bool(lines[1:]) and all(b >= 1.0 and a >= 1.0 for b, a in zip(before, after)) and max(after) < max(before),
+          f"measured imbalance >= 1; the largest after a re-cut {max(after, default=0)} below the largest before "
+          f"{max(before, default=0)}")
     f1 = read_csv(os.path.join(d1, "bench3d.csv"))
     f4 = read_csv(os.path.join(d4, "bench3d.csv"))
     for k in ("front_x", "front_y", "mass"):
