@@ -27,8 +27,11 @@ using namespace LAMMPS_NS;
 using mpm::parse_double;
 using mpm::parse_int;
 
+// LIGGGHTS' fractional cut positions of processor-grid dimension d
+static double *split_of(Comm *comm, int d) { return d == 0 ? comm->xsplit : d == 1 ? comm->ysplit : comm->zsplit; }
+
 /* ----------------------------------------------------------------------
-   fix ID group-ID balance/mpm dim x|y|z [every N] [weight group-ID w]... [volume w] [thresh t]
+   fix ID group-ID balance/mpm dim x|y|z [x|y|z [x|y|z]] [every N] [weight group-ID w]... [volume w] [thresh t]
        [measured yes|no]
 ------------------------------------------------------------------------- */
 
@@ -44,9 +47,7 @@ FixBalanceMpm::FixBalanceMpm(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg,
                              "' given more than once; the last value is used").c_str());
     seen.push_back(kw);
     if (strcmp(kw, "dim") == 0) {
-      dim_ = mpm::axis_of(v);
-      if (dim_ < 0) bad_arg(kw, "x, y or z", v);
-      iarg += 2;
+      iarg = parse_dims(narg, arg, iarg + 1);
     } else if (strcmp(kw, "every") == 0) {
       if (!v || !parse_int(v, every_, 0)) bad_arg(kw, "a number of steps >= 0", v);
       iarg += 2;
@@ -75,23 +76,50 @@ FixBalanceMpm::FixBalanceMpm(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg,
                          "' (expected dim, every, weight, volume, thresh or measured)").c_str());
     }
   }
-  if (dim_ < 0) error->all(FLERR, "Fix balance/mpm: keyword 'dim' (x, y or z) is required");
+  if (dims_.empty()) error->all(FLERR, "Fix balance/mpm: keyword 'dim' (x, y or z) is required");
   if (domain->triclinic) error->all(FLERR, "Fix balance/mpm: needs an orthogonal box");
-  if (dim_ == 2 && domain->dimension == 2) error->all(FLERR, "Fix balance/mpm: keyword 'dim' is z in a 2d run");
+  for (int d : dims_)
+    if (d == 2 && domain->dimension == 2) error->all(FLERR, "Fix balance/mpm: keyword 'dim' is z in a 2d run");
 
   box_change_domain = 1;
   if (every_ > 0) force_reneighbor = 1;
   next_reneighbor = -1;
 
-  const int P = comm->procgrid[dim_];
-  cut_.resize(P + 1);
-  const double *split = dim_ == 0 ? comm->xsplit : dim_ == 1 ? comm->ysplit : comm->zsplit;
-  for (int k = 0; k <= P; ++k) cut_[k] = domain->boxlo[dim_] + domain->prd[dim_] * split[k];
-
+  size_vector = 3;
+  for (int d : dims_) {
+    const int P = comm->procgrid[d];
+    const double *split = split_of(comm, d);
+    std::vector<double> cut(P + 1);
+    for (int k = 0; k <= P; ++k) cut[k] = domain->boxlo[d] + domain->prd[d] * split[k];
+    cut_.push_back(cut);
+    size_vector += P + 1;
+  }
   vector_flag = 1;
-  size_vector = 3 + P + 1;
   global_freq = 1;
   extvector = 0;
+}
+
+/* ----------------------------------------------------------------------
+   Keyword dim: its first value is required; every further one-letter word
+   is another dimension (all other keywords are longer words). Each of x, y,
+   z at most once.
+------------------------------------------------------------------------- */
+
+int FixBalanceMpm::parse_dims(int narg, char **arg, int iarg) {
+  dims_.clear();
+  std::string given;
+  while (iarg < narg && (dims_.empty() || strlen(arg[iarg]) == 1)) {
+    const char *v = arg[iarg];
+    const int d = mpm::axis_of(v);
+    if (d < 0) bad_arg("dim", "x, y or z", v);
+    given += (given.empty() ? "" : " ") + std::string(v);
+    if (std::find(dims_.begin(), dims_.end(), d) != dims_.end())
+      bad_arg("dim", "one to three distinct dimensions x, y or z (each at most once)", given.c_str());
+    dims_.push_back(d);
+    ++iarg;
+  }
+  if (dims_.empty()) bad_arg("dim", "x, y or z", nullptr);
+  return iarg;
 }
 
 void FixBalanceMpm::bad_arg(const char *keyword, const char *expected, const char *given) {
@@ -159,40 +187,80 @@ void FixBalanceMpm::measure() {
   have_busy_ = true;
 }
 
-// max / mean of the weight in the slabs between the cuts, the atoms where they are now
-double FixBalanceMpm::slab_imbalance(const std::vector<double> &cut) const {
-  const int P = static_cast<int>(cut.size()) - 1;
-  std::vector<double> mine(P, 0.0), all(P, 0.0);
+/* ----------------------------------------------------------------------
+   max / mean of the weight in the subdomains of the rank grid whose cuts
+   along the listed dims are 'cuts' (the other dims' cuts as they are), the
+   atoms where they are now.
+------------------------------------------------------------------------- */
+
+double FixBalanceMpm::grid_imbalance(const std::vector<std::vector<double>> &cuts) const {
+  std::vector<double> c3[3];
+  for (int d = 0; d < 3; ++d) {
+    const int P = comm->procgrid[d];
+    const double *split = split_of(comm, d);
+    c3[d].resize(P + 1);
+    for (int k = 0; k < P; ++k) c3[d][k] = domain->boxlo[d] + domain->prd[d] * split[k];
+    c3[d][P] = domain->boxhi[d];
+  }
+  for (std::size_t m = 0; m < dims_.size(); ++m) c3[dims_[m]] = cuts[m];
+  const int P0 = comm->procgrid[0], P1 = comm->procgrid[1], n = P0 * P1 * comm->procgrid[2];
+  std::vector<double> mine(n, 0.0), all(n, 0.0);
   double **x = atom->x;
   for (int i = 0; i < atom->nlocal; ++i) {
-    int k = static_cast<int>(std::upper_bound(cut.begin() + 1, cut.end() - 1, x[i][dim_]) - (cut.begin() + 1));
-    mine[k] += weight(i);
+    int k[3];
+    for (int d = 0; d < 3; ++d)
+      k[d] = static_cast<int>(std::upper_bound(c3[d].begin() + 1, c3[d].end() - 1, x[i][d]) - (c3[d].begin() + 1));
+    mine[(k[2] * P1 + k[1]) * P0 + k[0]] += weight(i);
   }
   if (comm->me == 0)
-    for (int k = 0; k < P; ++k) mine[k] += volume_below(cut[k + 1]) - volume_below(cut[k]);
-  MPI_Allreduce(mine.data(), all.data(), P, MPI_DOUBLE, MPI_SUM, world);
+    for (int c = 0; c < n; ++c) {
+      const int k[3] = {c % P0, (c / P0) % P1, c / (P0 * P1)};
+      const double lo[3] = {c3[0][k[0]], c3[1][k[1]], c3[2][k[2]]};
+      const double hi[3] = {c3[0][k[0] + 1], c3[1][k[1] + 1], c3[2][k[2] + 1]};
+      mine[c] += box_volume_weight(lo, hi);
+    }
+  MPI_Allreduce(mine.data(), all.data(), n, MPI_DOUBLE, MPI_SUM, world);
   double mx = 0.0, sum = 0.0;
   for (double v : all) mx = std::max(mx, v), sum += v;
-  return sum > 0.0 ? mx / (sum / P) : 1.0;
+  return sum > 0.0 ? mx / (sum / n) : 1.0;
 }
 
-// Weight of the box volume below coordinate c along dim_ (keyword volume).
-double FixBalanceMpm::volume_below(double c) const {
+// Weight of the box volume below coordinate c along dim, over the whole cross-section (keyword volume).
+double FixBalanceMpm::volume_below(int dim, double c) const {
   if (wvol_ <= 0.0) return 0.0;
   double area = 1.0;
   for (int d = 0; d < domain->dimension; ++d)
-    if (d != dim_) area *= domain->prd[d];
-  const double lo = domain->boxlo[dim_], hi = domain->boxhi[dim_];
+    if (d != dim) area *= domain->prd[d];
+  const double lo = domain->boxlo[dim], hi = domain->boxhi[dim];
   return wvol_ * area * (std::min(std::max(c, lo), hi) - lo);
 }
 
+// Weight of the volume of the box lo..hi (inside the simulation box; keyword volume), computed as
+// volume_below's difference along the first listed dim.
+double FixBalanceMpm::box_volume_weight(const double *lo, const double *hi) const {
+  if (wvol_ <= 0.0) return 0.0;
+  const int d0 = dims_[0];
+  double area = 1.0;
+  for (int d = 0; d < domain->dimension; ++d)
+    if (d != d0) area *= hi[d] - lo[d];
+  const double blo = domain->boxlo[d0], bhi = domain->boxhi[d0];
+  auto below = [&](double c) { return wvol_ * area * (std::min(std::max(c, blo), bhi) - blo); };
+  return below(hi[d0]) - below(lo[d0]);
+}
+
 double FixBalanceMpm::imbalance() const {
-  double mine = volume_below(domain->subhi[dim_]) - volume_below(domain->sublo[dim_]);
+  double mine = box_volume_weight(domain->sublo, domain->subhi);
   for (int i = 0; i < atom->nlocal; ++i) mine += weight(i);
   double mx = 0.0, sum = 0.0;
   MPI_Allreduce(&mine, &mx, 1, MPI_DOUBLE, MPI_MAX, world);
   MPI_Allreduce(&mine, &sum, 1, MPI_DOUBLE, MPI_SUM, world);
   return sum > 0.0 ? mx / (sum / comm->nprocs) : 1.0;
+}
+
+int FixBalanceMpm::max_slabs() const {
+  int P = 1;
+  for (int d : dims_) P = std::max(P, comm->procgrid[d]);
+  return P;
 }
 
 /* ----------------------------------------------------------------------
@@ -227,7 +295,8 @@ static void place_cuts(std::vector<double> &cut, const std::vector<double> &b, c
 }
 
 /* ----------------------------------------------------------------------
-   Cut k (1..P-1) goes where the weight below it is k/P of the total. The
+   Cut k (1..P-1) along dim goes where the weight below it is k/P of the
+   total (the marginal weight: summed over the other dims). The
    weight below a coordinate is a step function (atoms sit on planes, e.g. the
    lattice of material points), so the target is bracketed by bisection on
    the coordinate (one vector MPI_Allreduce per step, all cuts at once), then
@@ -235,15 +304,19 @@ static void place_cuts(std::vector<double> &cut, const std::vector<double> &b, c
    neighbour on the side that comes closer to the target.
 ------------------------------------------------------------------------- */
 
-void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
-  const int P = comm->procgrid[dim_], nc = P - 1;
-  const double lo = domain->boxlo[dim_], hi = domain->boxhi[dim_], len = hi - lo;
+void FixBalanceMpm::find_cuts(int dim, std::vector<double> &cut) {
+  const int P = comm->procgrid[dim], nc = P - 1;
+  const double lo = domain->boxlo[dim], hi = domain->boxhi[dim], len = hi - lo;
   const double inf = std::numeric_limits<double>::infinity();
+  if (P < 2) {  // one slab: nothing to place
+    cut = {lo, hi};
+    return;
+  }
 
   std::vector<std::pair<double, double>> cw;
   for (int i = 0; i < atom->nlocal; ++i) {
     const double w = weight(i);
-    if (w > 0.0) cw.emplace_back(atom->x[i][dim_], w);
+    if (w > 0.0) cw.emplace_back(atom->x[i][dim], w);
   }
   std::sort(cw.begin(), cw.end());
   std::vector<double> xs(cw.size()), pre(cw.size() + 1, 0.0);
@@ -263,10 +336,10 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
 
   double total = 0.0;
   MPI_Allreduce(&pre.back(), &total, 1, MPI_DOUBLE, MPI_SUM, world);
-  total += volume_below(hi);
+  total += volume_below(dim, hi);
   // the volume's weight is added once, by rank 0, to the collective sums
   const double vol_share = comm->me == 0 ? 1.0 : 0.0;
-  auto below_all = [&](double c) { return below(c) + vol_share * volume_below(c); };  // this rank's share
+  auto below_all = [&](double c) { return below(c) + vol_share * volume_below(dim, c); };  // this rank's share
   cut.assign(P + 1, 0.0);
   cut[0] = lo;
   cut[P] = hi;
@@ -310,12 +383,12 @@ void FixBalanceMpm::find_cuts(std::vector<double> &cut) {
 /* ----------------------------------------------------------------------
    The cuts are found from the total weight times up to P (find_cuts), so
    that product must stay finite: atoms and volume may each bring half of
-   DBL_MAX / P. Checked at every balance, as the number of atoms of a run is
+   DBL_MAX / P (P the largest processor count of the listed dims). Checked at every balance, as the number of atoms of a run is
    known only at its setup (and may change between balances).
 ------------------------------------------------------------------------- */
 
 void FixBalanceMpm::check_weights() {
-  const int P = comm->procgrid[dim_];
+  const int P = max_slabs();
   const double limit = std::numeric_limits<double>::max() / (2.0 * P);
   const double natoms = static_cast<double>(atom->natoms);
   for (double w : wvalues_)
@@ -340,26 +413,35 @@ void FixBalanceMpm::check_weights() {
 
 void FixBalanceMpm::balance() {
   check_weights();  // on one rank too: the input is as wrong there
-  const int P = comm->procgrid[dim_];
-  if (P < 2) return;
+  if (max_slabs() < 2) return;
   if (measured_) measure();
   imb_before_ = imbalance();
   if (thresh_ > 1.0 && imb_before_ <= thresh_) {
     imb_after_ = imb_before_;
     return;
   }
-  std::vector<double> cut;
-  find_cuts(cut);
+  // each listed dim by its marginal weight: independent of the other dims' cuts
+  std::vector<std::vector<double>> cuts(dims_.size());
+  for (std::size_t m = 0; m < dims_.size(); ++m) find_cuts(dims_[m], cuts[m]);
   // measured: the atoms that change rank would take the new rank's scale; the imbalance of the new
   // cuts is that of the measured weights where the atoms are now
-  if (scaled_) imb_after_ = slab_imbalance(cut);
+  if (scaled_) imb_after_ = grid_imbalance(cuts);
+  apply_cuts(cuts);
+  if (!scaled_) imb_after_ = imbalance();
+  ++nbalance_;
+  print_line();
+}
 
-  double *split = dim_ == 0 ? comm->xsplit : dim_ == 1 ? comm->ysplit : comm->zsplit;
-  const double lo = domain->boxlo[dim_], len = domain->prd[dim_];
-  split[0] = 0.0;
-  split[P] = 1.0;
-  for (int k = 1; k < P; ++k) split[k] = (cut[k] - lo) / len;
-  for (int k = 0; k <= P; ++k) cut_[k] = lo + len * split[k];
+void FixBalanceMpm::apply_cuts(const std::vector<std::vector<double>> &cuts) {
+  for (std::size_t m = 0; m < dims_.size(); ++m) {
+    const int d = dims_[m], P = comm->procgrid[d];
+    double *split = split_of(comm, d);
+    const double lo = domain->boxlo[d], len = domain->prd[d];
+    split[0] = 0.0;
+    split[P] = 1.0;
+    for (int k = 1; k < P; ++k) split[k] = (cuts[m][k] - lo) / len;
+    for (int k = 0; k <= P; ++k) cut_[m][k] = lo + len * split[k];
+  }
   comm->uniform = 0;
   domain->set_local_box();
 
@@ -373,19 +455,21 @@ void FixBalanceMpm::balance() {
   // fix mpm/fluid builds its grid patch from the subdomain: inside a run it builds it again at
   // its next step (at the setup of a run it builds it after this anyway)
   for (FixMpmFluid *f : fluid_fixes()) f->subdomain_changed();
+}
 
-  if (!scaled_) imb_after_ = imbalance();
-  ++nbalance_;
-  if (comm->me == 0) {
-    std::ostringstream os;
-    os.precision(6);
-    os << "fix balance/mpm: step " << update->ntimestep << ", cuts in " << char('x' + dim_) << ":";
-    for (double x : cut_) os << " " << x;
-    os.precision(4);
-    os << (scaled_ ? " (measured imbalance " : " (imbalance ") << imb_before_ << " -> " << imb_after_ << ")\n";
-    if (screen) fputs(os.str().c_str(), screen);
-    if (logfile) fputs(os.str().c_str(), logfile);
+void FixBalanceMpm::print_line() const {
+  if (comm->me != 0) return;
+  std::ostringstream os;
+  os.precision(6);
+  os << "fix balance/mpm: step " << update->ntimestep << ", cuts in ";
+  for (std::size_t m = 0; m < dims_.size(); ++m) {
+    os << (m ? ", in " : "") << char('x' + dims_[m]) << ":";
+    for (double x : cut_[m]) os << " " << x;
   }
+  os.precision(4);
+  os << (scaled_ ? " (measured imbalance " : " (imbalance ") << imb_before_ << " -> " << imb_after_ << ")\n";
+  if (screen) fputs(os.str().c_str(), screen);
+  if (logfile) fputs(os.str().c_str(), logfile);
 }
 
 void FixBalanceMpm::setup_pre_exchange() {
@@ -403,5 +487,10 @@ double FixBalanceMpm::compute_vector(int n) {
   if (n == 0) return imb_after_;
   if (n == 1) return imb_before_;
   if (n == 2) return nbalance_;
-  return cut_[n - 3];
+  int k = n - 3;  // the cuts of the listed dims, one list after another
+  for (const std::vector<double> &c : cut_) {
+    if (k < static_cast<int>(c.size())) return c[k];
+    k -= static_cast<int>(c.size());
+  }
+  return 0.0;
 }
