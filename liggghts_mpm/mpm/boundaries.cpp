@@ -241,33 +241,6 @@ void Boundaries::add_impulse(int k, const double *x, const double *J) {
   o[5] += r[0] * J[1] - r[1] * J[0];
 }
 
-int Boundaries::load_wall(int i, int j, int k) {
-  if (!walls_) return -1;
-  const std::size_t n = grid_->index(i, j, k);
-  if (lw_stamp_.size() != grid_->size()) {
-    lw_stamp_.assign(grid_->size(), -1);
-    lw_.assign(grid_->size(), -1);
-  }
-  if (lw_stamp_[n] != epoch_) {
-    const GridSpec &gs = opt_->grid;
-    const int idx[3] = {i, j, k};
-    const double xn[3] = {gs.origin[0] + i * gs.dx, gs.origin[1] + j * gs.dx, gs.origin[2] + k * gs.dx};
-    double dist = 0.0;
-    int w = walls_->nearest_wall(xn, 3.0 * gs.dx, &dist);
-    if (w < 0) {
-      // farther in: the nearest wall at any distance (all triangles; once per wall position)
-      double diag = 0.0;
-      for (int d = 0; d < 3; ++d) diag += (gs.ncell[d] + 1.0) * (gs.ncell[d] + 1.0);
-      w = walls_->nearest_wall(xn, std::sqrt(diag) * gs.dx, &dist);
-    }
-    for (int d = 0; d < 3 && w >= 0; ++d)
-      if (!gs.periodic[d] && std::min(idx[d], gs.ncell[d] - idx[d]) * gs.dx < dist) w = -1;
-    lw_[n] = w;
-    lw_stamp_[n] = epoch_;
-  }
-  return lw_[n];
-}
-
 int Boundaries::line_wall(int i, int j, int k, const double x[3], int d, double sign) {
   if (!walls_) return -1;
   const std::size_t n = grid_->index(i, j, k);

@@ -76,9 +76,6 @@ class Boundaries {
     for (int d = 0; d < 3; ++d) n[d] = cache_[first_[c]].n[d];
     return true;
   }
-  // the mesh wall whose load the pressure terms of node (i, j, k) belong to: the nearest one,
-  // unless a grid face (non-periodic) is nearer; -1: none (cached per wall position)
-  int load_wall(int i, int j, int k);
   // The mesh wall that takes an impulse along d of sign 'sign' at x (node (i, j, k); cached per
   // wall position): the boundary the grid line through x along d meets first on either side, a
   // triangle or a grid face (non-periodic); on a tie the one on the side the impulse points away
@@ -107,8 +104,6 @@ class Boundaries {
   double rec_h_ = 0.0;
   double rec_s_ = 1.0;
   std::vector<double> rec_;
-  std::vector<long> lw_stamp_;
-  std::vector<int> lw_;
   std::vector<long> ln_stamp_;
   std::vector<int> ln_;      // per node and d: wall below, wall above (-1 grid face / none)
   std::vector<double> lt_;   // their distances

@@ -281,9 +281,9 @@ void FluidSolver::surface_pressure() {
 
 /* pressure projection: the pressure correction's momentum of this sub-step as nodal terms
    (Projection::load_coefficients), b_n = (p_n - p_surface_) c_n + r_n (the shift by a constant
-   changes no sum: the c_n sum to 0), each node's to the mesh wall nearest to it within 3 cells
-   (Boundaries::load_wall); nodes nearer a grid face or farther from every wall give theirs to
-   none. */
+   changes no sum: the c_n sum to 0), each direction d of each node's to the boundary that its grid
+   line along d meets first (Boundaries::line_wall; a node behind a mesh casts from its mirror
+   image in front): a mesh wall takes it, a grid face takes none. */
 void FluidSolver::wall_pressure_loads() {
   const std::vector<double> &c = proj_->load_coefficients(), &r = proj_->load_rest();
   if (c.empty()) return;
