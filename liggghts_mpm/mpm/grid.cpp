@@ -163,16 +163,8 @@ bool LocalGrid::nothing_to_move(const Field *fields, int nfields) {
   return true;
 }
 
-void LocalGrid::reverse_sum(double *data, int stride) {
-  const Field f{data, stride};
-  if (nothing_to_move(&f, 1)) return;
-  exchange(&f, 1, true);
-}
-void LocalGrid::forward(double *data, int stride) {
-  const Field f{data, stride};
-  if (nothing_to_move(&f, 1)) return;
-  exchange(&f, 1, false);
-}
+void LocalGrid::reverse_sum(double *data, int stride) { reverse_sum({Field{data, stride}}); }
+void LocalGrid::forward(double *data, int stride) { forward({Field{data, stride}}); }
 void LocalGrid::reverse_sum(std::initializer_list<Field> fields) {
   if (nothing_to_move(fields.begin(), static_cast<int>(fields.size()))) return;
   exchange(fields.begin(), static_cast<int>(fields.size()), true);
