@@ -211,28 +211,18 @@ void pressure_gradient(const LocalGrid &grid, const NodeLabels &labels, const do
                [&](int i, int j, int k, std::size_t n) { return !empty_away_from_fluid(grid, labels, i, j, k, n); },
                [&](std::size_t n, const Face &f, int d, int side) {
     if (side < 0) num = den = 0.0;
-    if (!f.wall) {
-      const std::uint8_t a = labels.kind[n], b = labels.kind[f.m];
-      const double s = 1.0 / surface_scale(labels, n, f.m);  // s_f (1 off the surface)
-      const double G = side * (p[f.m] - p[n]) * inv_dx;       // face gradient along +d, p = 0 at EMPTY
-      if (a == kFluid) {
-        // the adjoint of flux_divergence: weight theta_f w_n, w_n = 1/2 between two FLUID nodes
-        // and 1 towards an EMPTY one (whose face carries u_n); the denominator sum theta_f w_n s_f
-        // is the node's share of the faces' fluid lengths (hydrostatic exact)
-        const double th = theta ? 0.5 * (theta[n] + theta[f.m]) : 1.0;
-        const double w = th * (b == kFluid ? 0.5 : 1.0 - surface_weight(labels, n, f.m));
-        num += w * G;
-        den += w * s;
-      } else if (b == kFluid && !labels.wet.empty() && labels.wet[n]) {
-        // an EMPTY node holding fluid: the adjoint too, with its weight in the face's flux
-        const double w = (theta ? 0.5 * (theta[n] + theta[f.m]) : 1.0) * surface_weight(labels, n, f.m);
-        num += w * G;
-        den += w * s;
-      } else if (b == kFluid) {
-        // an EMPTY node: the gradient of its faces to FLUID nodes, continued from the fluid side
-        // (a face between two EMPTY nodes carries no pressure information)
+    double w = 0.0, s = 1.0;
+    bool plain = false;
+    if (!f.wall && gradient_face(labels, theta, n, f.m, &w, &s, &plain)) {
+      // the denominator sum theta_f w_n s_f is the node's share of the faces' fluid lengths
+      // (hydrostatic exact); a dry EMPTY node continues the gradient of its faces to FLUID nodes
+      const double G = side * (p[f.m] - p[n]) * inv_dx;  // face gradient along +d, p = 0 at EMPTY
+      if (plain) {
         num += G / s;
         den += 1.0;
+      } else {
+        num += w * G;
+        den += w * s;
       }
     }
     if (side > 0) grad[3 * n + d] = den > 0.0 ? num / den : 0.0;
@@ -250,21 +240,11 @@ bool gradient_weights(const LocalGrid &grid, const NodeLabels &labels, const dou
     if (!open_face(grid, labels, i, j, k, d, side, &nb)) continue;
     const int q = side > 0;
     m[q] = nb;
-    const std::uint8_t a = labels.kind[n], b = labels.kind[nb];
-    const double s = 1.0 / surface_scale(labels, n, nb);
-    if (a == kFluid) {
-      const double th = theta ? 0.5 * (theta[n] + theta[nb]) : 1.0;
-      const double w = th * (b == kFluid ? 0.5 : 1.0 - surface_weight(labels, n, nb));
-      c[q] = w;
-      den += w * s;
-    } else if (b == kFluid && !labels.wet.empty() && labels.wet[n]) {
-      const double w = (theta ? 0.5 * (theta[n] + theta[nb]) : 1.0) * surface_weight(labels, n, nb);
-      c[q] = w;
-      den += w * s;
-    } else if (b == kFluid) {
-      c[q] = 1.0 / s;
-      den += 1.0;
-    }
+    double w = 0.0, s = 1.0;
+    bool plain = false;
+    if (!gradient_face(labels, theta, n, nb, &w, &s, &plain)) continue;
+    c[q] = plain ? 1.0 / s : w;
+    den += plain ? 1.0 : w * s;
   }
   if (!(den > 0.0)) {
     c[0] = c[1] = 0.0;

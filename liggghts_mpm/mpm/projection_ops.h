@@ -144,6 +144,32 @@ inline bool open_face(const LocalGrid &grid, const NodeLabels &labels, int i, in
   return !((labels.closed[lower] >> d) & 1u) && labels.kind[n] != kSolid && labels.kind[nb] != kSolid;
 }
 
+// pressure_gradient's weight of the open face of node n towards m (theta: the fluid fractions, or
+// null): false if the face carries no pressure information (n not FLUID and not wet, m not
+// FLUID). *s: the face's s_f = 1 / surface_scale. *plain false: the face adds w G to the
+// gradient's numerator and w s_f to its denominator (G the face gradient; the adjoint of
+// flux_divergence: w = theta_f w_n, w_n = 1/2 between two FLUID nodes, 1 - surface_weight towards
+// an EMPTY one, surface_weight for a wet EMPTY node towards a FLUID one); *plain true (a dry EMPTY
+// node towards a FLUID one: the gradient continued from the fluid side): G / s_f and 1.
+inline bool gradient_face(const NodeLabels &labels, const double *theta, std::size_t n, std::size_t m, double *w,
+                          double *s, bool *plain) {
+  const std::uint8_t a = labels.kind[n], b = labels.kind[m];
+  *s = 1.0 / surface_scale(labels, n, m);
+  *plain = false;
+  if (a == kFluid) {
+    const double th = theta ? 0.5 * (theta[n] + theta[m]) : 1.0;
+    *w = th * (b == kFluid ? 0.5 : 1.0 - surface_weight(labels, n, m));
+    return true;
+  }
+  if (b != kFluid) return false;
+  if (!labels.wet.empty() && labels.wet[n]) {
+    *w = (theta ? 0.5 * (theta[n] + theta[m]) : 1.0) * surface_weight(labels, n, m);
+    return true;
+  }
+  *plain = true;
+  return true;
+}
+
 // The integrated divergence of theta u at the owned non-SOLID nodes:
 // D_n = sum over the faces of n of (area x outward flux) / dx, per dx^3 (the
 // divergence per volume is D_n / volume(n)). The flux through an open face is
