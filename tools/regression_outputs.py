@@ -67,10 +67,21 @@ def run(args):
 
 def thermo_lines(path):
     """Log lines without wall-clock content; the fix's wall-time outputs f_ID[14], f_ID[15] never
-    appear in the inputs' thermo, the 'fix mpm/fluid: wall time' line is dropped."""
+    appear in the inputs' thermo, the 'fix mpm/fluid: wall time' line is dropped, and thermo rows
+    under a header with LIGGGHTS' CPU column lose that column."""
     keep = []
+    cpu = None  # the CPU column of the thermo rows under a header that has one (LIGGGHTS' default style)
     with open(path, errors="replace") as f:
         for line in f:
+            words = line.split()
+            if "CPU" in words and "Step" in words:
+                cpu = (words.index("CPU"), len(words))
+            elif cpu and len(words) == cpu[1] and all(re.fullmatch(r"[-+.0-9eE]+", w) for w in words):
+                del words[cpu[0]]
+                keep.append(" ".join(words))
+                continue
+            elif line.startswith("Loop time"):  # the end of the run's thermo rows
+                cpu = None
             # the fix's end-of-run lines: wall times, waits and peak memory (and builds without them)
             if TIMING.search(line) or line.startswith(("fix mpm/fluid: wall time", "fix mpm/fluid: halo exchanges",
                                                        "fix mpm/fluid: work per rank")):
