@@ -243,6 +243,12 @@ run 0
 """
 
 
+def expect_refusals(r, case, tmpl, bad):
+    """Each (arguments, message) of bad, put into tmpl's {args}, stops with an error containing the message."""
+    for i, (args, expect) in enumerate(bad):
+        r.expect_error(f"{case}/{i}", tmpl.format(args=args), (expect,), f"'{args}' -> \"{expect}\"")
+
+
 def case_bad_input(r):
     """Bad arguments stop with an error naming the command and the keyword."""
     tmpl = BAD_TMPL
@@ -264,8 +270,7 @@ def case_bad_input(r):
         ("dim x measured maybe", "Fix balance/mpm: keyword 'measured' expects yes or no, got 'maybe'"),
         ("dim x measured", "Fix balance/mpm: keyword 'measured' expects yes or no, got nothing"),
     ]
-    for i, (args, expect) in enumerate(bad):
-        r.expect_error(f"balance_bad_input/{i}", tmpl.format(args=args), (expect,), f"'{args}' -> \"{expect}\"")
+    expect_refusals(r, "balance_bad_input", tmpl, bad)
     p, msg = r.run_script("balance_bad_input/ok", tmpl.format(args="dim x every 0 weight all 1.0 thresh 1.1"))
     check(p.returncode == 0, f"valid arguments run ({msg.strip()[:120]})")
 
@@ -284,8 +289,7 @@ def case_bad_input_dims(r):
         ("dim x y colour red", "Fix balance/mpm: unknown keyword 'colour'"),
         ("dim x yz", "Fix balance/mpm: unknown keyword 'yz'"),
     ]
-    for i, (args, expect) in enumerate(bad):
-        r.expect_error(f"balance_bad_input_dims/{i}", tmpl.format(args=args), (expect,), f"'{args}' -> \"{expect}\"")
+    expect_refusals(r, "balance_bad_input_dims", tmpl, bad)
     two_d = """dimension 2
 atom_style sphere
 boundary f f p
