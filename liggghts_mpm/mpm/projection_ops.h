@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "mpm/grid.h"
+#include "mpm/shape_functions.h"
 
 namespace mpm {
 
@@ -87,6 +88,23 @@ struct ProjectionGeometry {
     return a;
   }
 };
+
+// The signed distance (units of dx, positive inside) from a node to a plane free surface whose
+// fluid gives the node the fill f, the fluid being points of the fill's lattice, np points per cell
+// along the surface's normal: the inverse of the lattice's fill
+//   G(s) = (1 / np) sum_{j >= 0} N(s - (j + 1/2) / np)
+// of a node s cells below the surface, its top layer of points half a spacing below it (N the
+// shape function; docs/theory/projection.md, "Free surface: energy and stiffness"). G is the fill
+// the node's mass gives wherever the plane lies relative to the nodes and moves with the points:
+// the level is the distance itself. The continuous F(s) = int_{-inf}^{s} N (the limit np -> inf)
+// read the points' samples as a continuum: with 2 points per cell the EMPTY node above a surface on
+// a node plane has the fill N(5/4) / 2 = 1/64 against F(-1) = 1/48, its level read -1.046 and the
+// ghost surface moved 0.956 times as far as the water (the standing wave 3 % slow at 20 cells).
+// G is 0 up to s = -r + 1 / (2 np) (r the support's half width) and 1 from r - 1 / (2 np): a fill
+// of 0 or 1 reads those ends (the level continuous in the fill).
+// lattice_fill: G(s) (slope: dG/ds, if not null); surface_distance: the level of the fill f, G^-1(f).
+double lattice_fill(double s, ShapeKind shape, int np, double *slope = nullptr);
+double surface_distance(double f, ShapeKind shape, int np);
 
 // Smallest fraction of a cell between a FLUID node and the surface (clamp of the ghost-fluid
 // coefficient 1 / s_f: at most 20x the face's own).

@@ -27,34 +27,50 @@ constexpr double kSurfaceFill = 0.25;
 // filled up to a node plane gives its nodes a level of exactly 0 up to round-off; with 0 as the
 // bound they flipped between EMPTY and FLUID from step to step (F1 at rest: 2.6e-4 m/s after 1 s).
 
-// The signed distance (units of dx, positive inside) from a node to a plane free surface whose
-// fluid gives the node the fill f: the inverse of the fill F(s) = int_{-inf}^{s} N(x) dx of the
-// shape function N across the surface (uniform fluid up to the plane at s cells above the node;
-// docs/theory/projection.md, "Free surface: energy and stiffness"). With fill - 1/2 as the level instead,
-// the ghost surface moved 1 / N(0) = 4/3 (quadratic B-spline) times as far as the water near a
-// node and the surface was too stiff: the standing wave ran fast.
-double surface_distance(double f, ShapeKind shape) {
-  if (shape == ShapeKind::Linear) {  // hat: F = (1 + s)^2 / 2 (s < 0), 1 - (1 - s)^2 / 2
-    if (f <= 0.0) return -1.0;
-    if (f >= 1.0) return 1.0;
-    return f < 0.5 ? std::sqrt(2.0 * f) - 1.0 : 1.0 - std::sqrt(2.0 * (1.0 - f));
+}  // namespace
+
+// (projection_ops.h)
+double lattice_fill(double s, ShapeKind shape, int np, double *slope) {
+  const double r = shape == ShapeKind::Linear ? 1.0 : 1.5, h = 1.0 / np;
+  double g = 0.0, dg = 0.0;
+  for (int j = 0;; ++j) {
+    const double x = s - (j + 0.5) * h, a = std::fabs(x);  // the point's offset from the node
+    if (x <= -r) break;
+    if (a >= r) continue;
+    const double sg = x < 0.0 ? -1.0 : 1.0;
+    if (shape == ShapeKind::Linear) {
+      g += 1.0 - a;
+      dg -= sg;
+    } else if (a < 0.5) {
+      g += 0.75 - a * a;
+      dg -= 2.0 * x;
+    } else {
+      g += 0.5 * (1.5 - a) * (1.5 - a);
+      dg -= sg * (1.5 - a);
+    }
   }
-  // quadratic B-spline: F = (s + 3/2)^3 / 6 on [-3/2, -1/2], 1 - (3/2 - s)^3 / 6 on [1/2, 3/2],
-  // 1/2 + 3 s / 4 - s^3 / 3 between
-  if (f <= 0.0) return -1.5;
-  if (f >= 1.0) return 1.5;
-  if (f <= 1.0 / 6.0) return std::cbrt(6.0 * f) - 1.5;
-  if (f >= 5.0 / 6.0) return 1.5 - std::cbrt(6.0 * (1.0 - f));
-  double x = (f - 0.5) / 0.75;  // Newton on the middle branch (F' = 3/4 - s^2 >= 1/2 there)
-  for (int it = 0; it < 30; ++it) {
-    const double r = 0.5 + 0.75 * x - x * x * x / 3.0 - f;
-    x -= r / (0.75 - x * x);
-    if (std::fabs(r) < 1e-15) break;
+  if (slope) *slope = dg * h;
+  return g * h;
+}
+
+double surface_distance(double f, ShapeKind shape, int np) {
+  const double lo = (shape == ShapeKind::Linear ? -1.0 : -1.5) + 0.5 / np, hi = -lo;
+  if (f <= 0.0) return lo;
+  if (f >= 1.0) return hi;
+  // safeguarded Newton on the increasing G between the bracket's ends
+  double a = lo, b = hi, x = 0.5 * (lo + hi);
+  for (int it = 0; it < 100; ++it) {
+    double dg;
+    const double res = lattice_fill(x, shape, np, &dg) - f;
+    if (std::fabs(res) < 1e-14) break;
+    (res < 0.0 ? a : b) = x;
+    double nx = dg > 0.0 ? x - res / dg : 0.5 * (a + b);
+    if (!(nx > a && nx < b)) nx = 0.5 * (a + b);
+    if (b - a < 1e-14) break;
+    x = nx;
   }
   return x;
 }
-}  // namespace
-
 
 /* FLUID where the node holds fluid (mass above the threshold and kSurfaceFill of a full cell),
    EMPTY elsewhere (the free surface: p = 0), SOLID padding behind the box walls (NodeLabels::reset). The closed gate is a
@@ -67,6 +83,9 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
   mesh_ = walls != nullptr;
   if (mesh_) mesh_wall_labels(*walls);
   const double dx = opt_.grid.dx, full = opt_.rho0 * dx * dx * dx;
+  // the points per cell along the surface's normal: the fill's largest count (a slab one cell
+  // thick, filled with one point across, has no surface across it)
+  const int np = std::max({opt_.fill_ppc[0], opt_.fill_ppc[1], opt_.fill_ppc[2]});
   if (opt_.surface_ghost) {
     // with a work box: outside it the level is never read (it enters only the faces of FLUID
     // nodes) and fold_mass_ is 0 (retire)
@@ -82,9 +101,9 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     const double cut = mesh_ ? frac_[n] : 1.0;
     const double fill = (opt_.surface_ghost ? folded_mass(i, j, k) : m) / (th * full * geo_.volume(i, j, k) * cut);
     if (opt_.surface_ghost) {
-      // level set: the fill of a node whose dual cell the surface halves is 1/2 (a symmetric
-      // kernel), so fill - 1/2 changes sign at the surface; FLUID where it is positive
-      lab_.level[n] = surface_distance(fill, opt_.shape);
+      // level set: the signed distance to the surface read from the fill (surface_distance);
+      // FLUID where it exceeds kLevelTie
+      lab_.level[n] = surface_distance(fill, opt_.shape, np);
       if (m <= mmin || m <= 0.0 || !level_is_fluid(lab_.level[n])) lab_.kind[n] = kEmpty;
     } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
       lab_.kind[n] = kEmpty;

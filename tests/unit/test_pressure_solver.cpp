@@ -863,3 +863,43 @@ TEST(PressureSolver, DISABLED_Timing) {
 }
 
 }  // namespace
+
+// The level (projection_ops.h, surface_distance): the nodes below and above a plane surface with
+// the fluid's points on the fill's lattice (np per cell, the top layer half a spacing below the
+// surface) read the signed distance to the plane, whether the plane lies on a node plane, mid-cell
+// or in between, with 1, 2 or 3 points per cell, for both shape functions. The fill is summed
+// here from the points themselves (the node mass over a full cell's), independently of
+// lattice_fill. The continuous fill's inverse, the level before, read -1.046 at the EMPTY node
+// above a node-plane surface with 2 points per cell.
+TEST(PressureSolver, SurfaceLevelOfAPointLatticeIsTheDistance) {
+  auto bspline = [](double x) {
+    x = std::fabs(x);
+    return x < 0.5 ? 0.75 - x * x : (x < 1.5 ? 0.5 * (1.5 - x) * (1.5 - x) : 0.0);
+  };
+  auto hat = [](double x) { return std::max(0.0, 1.0 - std::fabs(x)); };
+  int checked = 0;  // nodes with 0 < fill < 1
+  for (const mpm::ShapeKind shape : {mpm::ShapeKind::QuadraticBSpline, mpm::ShapeKind::Linear}) {
+    for (int np = 1; np <= 3; ++np) {
+      for (const double zs : {0.0, 0.5, 0.3, 0.77, 0.05}) {  // the plane, in cells above node 0
+        for (int node = -3; node <= 3; ++node) {
+          double fill = 0.0;  // points at zs - (j + 1/2) / np, each 1 / np of a cell
+          for (int j = 0; j < 20 * np; ++j) {
+            const double x = zs - (j + 0.5) / np - node;
+            fill += (shape == mpm::ShapeKind::Linear ? hat(x) : bspline(x)) / np;
+          }
+          if (fill <= 1e-12 || fill >= 1.0 - 1e-12) continue;  // beyond the points' reach
+          EXPECT_NEAR(mpm::surface_distance(fill, shape, np), zs - node, 1e-10)
+              << mpm::shape_name(shape) << ", " << np << " points per cell, plane at " << zs << ", node " << node;
+          ++checked;
+        }
+      }
+    }
+  }
+  printf("  %d nodes between the empty and the full ones\n", checked);
+  EXPECT_GE(checked, 50);
+  // the continuous fill's inverse at that node: F(-1) = 1/48 against the lattice's 1/64
+  EXPECT_NEAR(mpm::lattice_fill(-1.0, mpm::ShapeKind::QuadraticBSpline, 2), 1.0 / 64.0, 1e-15);
+  // a fill of 0 reads the end of the lattice's reach (the level continuous in the fill)
+  EXPECT_NEAR(mpm::surface_distance(0.0, mpm::ShapeKind::QuadraticBSpline, 2), -1.25, 1e-15);
+  EXPECT_NEAR(mpm::surface_distance(1e-12, mpm::ShapeKind::QuadraticBSpline, 2), -1.25, 1e-5);
+}
