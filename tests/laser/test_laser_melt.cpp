@@ -4,7 +4,9 @@
 // the status names the physics check that failed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -404,4 +406,62 @@ TEST(LaserStatus, TimeStepErrorNotDecreasingIsNamed) {
   const double dv = std::fabs(rh.volume_removed - r.volume_removed) / r.volume_removed;
   std::printf("[ STEP ] volume at dt/2 differs by %.3g\n", dv);
   EXPECT_GT(dv, c.tol);
+}
+
+namespace {
+// Median surface temperature, one step after their onset, of the nodes that melt
+// between t0 and the end of the run (every step is a frame).
+double median_first_step_T(const Result& r, double t0) {
+  std::vector<double> T;
+  for (size_t i = 1; i < r.xi.size(); ++i) {
+    const double tm = r.tau_m_s[i];
+    if (tm < t0 || tm > r.t_end) continue;
+    for (const Frame& f : r.frames) {
+      if (f.t <= tm) continue;
+      if (f.g[i] > 0.0) T.push_back(f.T[i]);
+      break;
+    }
+  }
+  if (T.empty()) return 0.0;
+  std::sort(T.begin(), T.end());
+  return T[T.size() / 2];
+}
+}  // namespace
+
+// The layer's heat content (--melt-content transient, docs 2.7). With the quasi-steady
+// layer the heat the flow brings into a column that has just melted is conducted out at
+// once, half against the beam: the column's surface temperature one step after its
+// onset rises as d(xi) shrinks (the power lands on one cell; docs section 3: 2016 /
+// 2608 / 3988 K over 200 us). With the transient term the inflowing heat fills the
+// new layer instead, and the first-step temperature no longer grows with refinement.
+// The bookkeeping closes with the content as its own term, no heat is created
+// (flow_advected >= 0) and every column stays under its energy bound.
+TEST(LaserMelt, LayerContentTakesTheInflowingHeat) {
+  double Ts[2][3];
+  const double grids[3] = {0.025, 0.0125, 0.00625};
+  for (int k = 0; k < 2; ++k) {
+    for (int j = 0; j < 3; ++j) {
+      Config c = short_case(142.0, MeltFlow::Conservative);
+      c.tp = 60e-6;
+      c.dxi = grids[j];
+      c.frames = 241;
+      c.melt_content = k == 0 ? MeltContent::Steady : MeltContent::Transient;
+      const Result r = run_simulation(c);
+      Ts[k][j] = median_first_step_T(r, 20e-6);
+      const Energy& e = r.energy;
+      const double imb = (e.sum() - e.laser_exact) / e.laser_exact;
+      std::printf("[ CONTENT ] %s d(xi) %g: first-step T_s %.0f K, content %.4g J, flow_advected %.4g J, imbalance %.2g, "
+                  "column %.3f, %s\n",
+                  k ? "transient" : "steady", c.dxi, Ts[k][j], e.melt_content, e.flow_advected, imb,
+                  r.check.worst_node_ratio, r.status.c_str());
+      EXPECT_LT(std::fabs(imb), 1e-4);
+      EXPECT_GE(e.flow_advected, 0.0);
+      EXPECT_LT(r.check.worst_node_ratio, 1.0);
+      if (k == 0) EXPECT_EQ(e.melt_content, 0.0);
+      else EXPECT_GT(e.melt_content, 0.0);
+    }
+  }
+  EXPECT_GT(Ts[0][2], 1.3 * Ts[0][0]) << "quasi-steady: the spike grows with refinement";
+  EXPECT_LT(Ts[1][2], 1.1 * Ts[1][0]) << "transient: it does not";
+  for (int j = 0; j < 3; ++j) EXPECT_LT(Ts[1][j], Ts[0][j]) << grids[j];
 }
