@@ -310,7 +310,7 @@ void add_model_params(std::vector<Param>& t) {
       "heat content of the melt layer with the face heat fluxes: transient = the layer's energy balance keeps "
       "the transient term of (3-3b) (inflowing heat first raises the layer's content), steady = the text's "
       "quasi-steady layer (heat brought in is conducted out in the same step); auto = transient with --melt-heat "
-      "flux, steady with ode (transient needs --melt-heat flux)",
+      "flux and --melt-update implicit, steady otherwise (transient needs --melt-heat flux)",
       [](Config& c, const std::string& v) {
         c.melt_content = v == "transient" ? MeltContent::Transient
                          : v == "steady"  ? MeltContent::Steady
