@@ -587,6 +587,9 @@ void validate(Config& c) {
   if (c.melt_content == MeltContent::Transient && !c.flux_heat())
     throw UsageError("--melt-content: transient needs --melt-heat flux (the layer's content is balanced against the "
                      "face heat fluxes; (4-27) is quasi-steady), got --melt-heat ode");
+  if (c.melt_content == MeltContent::Transient && c.model == FlowModel::Conduction)
+    throw UsageError("--melt-content: transient needs a melt flow model (the layer's content changes through b2 of "
+                     "(4-25), which --model conduction does not have), got --model conduction");
   if (c.dtau > 0.0) c.dt = c.dtau * c.R * c.R / (m.kl / (m.rho * m.cpl));
   if (c.dt > 0.0 && !(c.dt < c.tp))
     throw UsageError(std::string(c.dtau > 0 ? "--dtau" : "--dt") + ": the time step " + fmt(c.dt) +

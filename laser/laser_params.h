@@ -62,7 +62,8 @@ struct Config {
   // update (4-14) keeps the quasi-steady layer (docs/theory/laser_model.md 2.7: with it the
   // transient term does not converge in dt at the Table 5.1 case)
   bool transient_content() const {
-    return flux_heat() && (melt_content == MeltContent::Transient || (melt_content == MeltContent::Auto && implicit_melt));
+    return flux_heat() && model != FlowModel::Conduction &&
+           (melt_content == MeltContent::Transient || (melt_content == MeltContent::Auto && implicit_melt));
   }
   // Recoil pressure that drives the melt flow, as a fraction of p_sat(T_s): 1 =
   // the text (full saturation pressure), 0.54 = Anisimov (1968) / Knight (1979)
