@@ -75,6 +75,7 @@ class Drill {
   void move_fronts(Node& n, const Rates& r, double dtn);
   void melt_temperature();
   void flux_heat_march();
+  void limit_b2(Node& n, double g, double th, bool content_only);
   void record(double tau, bool frame);
   void emit(Frame&& f);
   void physical_check();
@@ -82,6 +83,7 @@ class Drill {
   bool step(long step, double ta, double tb, double& tau);
   void finish(double tau);
   void assess();
+  void note_content_hits();
   double node_ta(const Node& n, double ta) const { return std::max(ta, n.tau_m); }
 
   Config cfg_;

@@ -283,6 +283,24 @@ void Drill::melt_temperature() {
   }
 }
 
+// Safeguard of (4-25): |b2| g^2 <= theta_sat keeps the profile monotone; a hit is
+// counted as the flow's, or as the layer content's where only the content asked for
+// more (content_only; --melt-content transient), and the interface re-solved at the limit.
+void Drill::limit_b2(Node& n, double g, double th, bool content_only) {
+  if (!(std::fabs(n.b2) * g * g > th)) return;
+  const double ask = th > 0.0 ? std::fabs(n.b2) * g * g / th : std::numeric_limits<double>::infinity();
+  const std::string where = "first at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
+  if (content_only) {
+    if (res_.b2_content_clamps++ == 0) first_content_ = where;
+    if (!(ask <= res_.b2_content_demand_max)) res_.b2_content_demand_max = ask;
+  } else {
+    if (res_.b2_clamps++ == 0) first_b2_ = where;
+    if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
+  }
+  n.b2 = th > 0.0 ? std::copysign(th / (g * g), n.b2) : 0.0;
+  n.itf = solve_interface(G_, n.xi, g, n.b2, advected_);
+}
+
 // --melt-heat flux (docs/theory/laser_model.md 2.7): the heat the flow carries through
 // the cell faces, volume rate q = |c_k| g_up^2 at the flux-weighted mean
 // temperature 2 theta_sat/3 of the upwind layer, and the layer's gradients are
@@ -340,22 +358,8 @@ void Drill::flux_heat_march() {
     n.itf = solve_interface_flux(G_, n.xi, g, s * beta, s * gamma, advected_, kappa, H_old);
     const double th = std::max(n.itf.theta_sat, 0.0);
     n.b2 = (s * (beta * th - gamma) + (transient ? kappa * (layer_content(n.itf, g, 0.0) - H_old) : 0.0)) / g;
-    if (std::fabs(n.b2) * g * g > th) {
-      const double ask = th > 0.0 ? std::fabs(n.b2) * g * g / th : std::numeric_limits<double>::infinity();
-      // a hit the quasi-steady layer would not have had (its flow part beta theta_sat - gamma
-      // is within the limit) is the layer's content asking for more than (4-25) can hold
-      if (transient && std::fabs(beta * th - gamma) * g <= th) {
-        if (res_.b2_content_clamps++ == 0)
-          first_content_ = "first at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
-        if (!(ask <= res_.b2_content_demand_max)) res_.b2_content_demand_max = ask;
-      } else {
-        if (res_.b2_clamps == 0) first_b2_ = "first at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
-        if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
-        ++res_.b2_clamps;
-      }
-      n.b2 = th > 0.0 ? std::copysign(th / (g * g), n.b2) : 0.0;
-      n.itf = solve_interface(G_, n.xi, g, n.b2, advected_);
-    }
+    // a hit whose flow part alone is within the limit is the layer's content asking for more
+    limit_b2(n, g, th, transient && std::fabs(beta * th - gamma) * g <= th);
     // the column's heat balance: what it sends on is what came in, plus what its
     // gradients give the flow (2 a b2 g), minus what it keeps in its content; with
     // the solved b2 this is qout 2 theta_sat/3; where the limit of (4-25) held b2

@@ -312,14 +312,11 @@ void add_model_params(std::vector<Param>& t) {
       "quasi-steady layer (heat brought in is conducted out in the same step); auto = transient with --melt-heat "
       "flux and --melt-update implicit, steady otherwise (transient needs --melt-heat flux)",
       [](Config& c, const std::string& v) {
-        c.melt_content = v == "transient" ? MeltContent::Transient
-                         : v == "steady"  ? MeltContent::Steady
-                                          : MeltContent::Auto;
+        c.melt_content = v == "transient" ? MeltContent::Transient : v == "steady" ? MeltContent::Steady : MeltContent::Auto;
       },
       [](const Config& c) {
-        return std::string(c.melt_content == MeltContent::Transient ? "transient"
-                           : c.melt_content == MeltContent::Steady  ? "steady"
-                                                                    : "auto");
+        const MeltContent m = c.melt_content;
+        return std::string(m == MeltContent::Transient ? "transient" : m == MeltContent::Steady ? "steady" : "auto");
       }));
   t.push_back(real("shift", "model", "tau_m", 0, 10, true,
                    "backward shift of the Stefan solution for --solid shifted (3-36: 3 tau_0 = 3/(4 pi))",
