@@ -323,3 +323,30 @@ TEST(LaserLaws, LayerContentBalancesTheColumn) {
   }
   EXPECT_GT(checked, 100);
 }
+
+// What the curvature clamp hides at Pr 1420 (docs section 3, "The cusp on the axis"):
+// (3-37) as printed gives a node deeper than both neighbours (a > 0) C_c < 1, i.e. less
+// heat drawn into the solid, so it melts faster than its shallower neighbours (a < 0,
+// C_c > 1): a node-scale mode of the front grows. With d = d(xi), a mode of fixed
+// amplitude e has a d = 2 e / d(xi), so the factor departs further from 1 on finer grids,
+// while a smooth front's a d -> 0.
+TEST(LaserLaws, CurvatureFactorFavoursTheDeeperNode) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  const double e = 2e-3;              // mode amplitude (in R)
+  const double grad_n = -5.0, grad_l = 20.0;  // solid draws heat, the layer delivers it
+  double last_ad = 0.0;
+  for (double h : {0.05, 0.025, 0.0125, 0.00625}) {
+    const double s2xx_deep = -2.0 * e / (h * h), s2xx_shallow = 2.0 * e / (h * h);  // S2'' (S2' = 0)
+    const double Cd = curvature_factor(-s2xx_deep, h), Cs = curvature_factor(-s2xx_shallow, h);
+    EXPECT_LT(Cd, 1.0) << h;
+    EXPECT_GT(Cs, 1.0) << h;
+    const double rd = melting_rate(G, Cd, grad_n, 1.0, grad_l, true);
+    const double rs = melting_rate(G, Cs, grad_n, 1.0, grad_l, true);
+    EXPECT_GT(rd, rs) << "the deeper node melts faster at d(xi) " << h;
+    const double ad = -s2xx_deep * h;
+    EXPECT_GT(ad, last_ad);  // 2 e / d(xi): grows under refinement
+    last_ad = ad;
+  }
+  // a smooth front (S2 = c xi^2, fixed curvature): C_c -> 1 as d(xi) -> 0
+  EXPECT_LT(std::fabs(curvature_factor(0.5, 0.00625) - 1.0), std::fabs(curvature_factor(0.5, 0.05) - 1.0) / 50.0);
+}
