@@ -25,6 +25,9 @@ struct Node {
   double dS1 = 0, dS2 = 0, v = 0, f = 0;  // rates of the last step, f: u = f zeta
   double v_kin = 0;  // conservative flow: -(1/xi) d(xi Q)/dxi at the start of the step (used in (4-27))
   double last_dg = 0;  // dg/dtau of the last step
+  // --melt-content transient: the layer's heat content int_0^g theta dzeta at the end of
+  // the last step, and its change in the last march (booked with the step that uses its b2 g)
+  double H = 0, dH = 0;
   int flips = 0;       // consecutive sign changes of dg/dtau with lambda dtau > 2
 };
 
@@ -72,6 +75,7 @@ class Drill {
   void move_fronts(Node& n, const Rates& r, double dtn);
   void melt_temperature();
   void flux_heat_march();
+  void limit_b2(Node& n, double g, double th, bool content_only);
   void record(double tau, bool frame);
   void emit(Frame&& f);
   void physical_check();
@@ -79,6 +83,7 @@ class Drill {
   bool step(long step, double ta, double tb, double& tau);
   void finish(double tau);
   void assess();
+  void note_content_hits();
   double node_ta(const Node& n, double ta) const { return std::max(ta, n.tau_m); }
 
   Config cfg_;
@@ -91,10 +96,10 @@ class Drill {
   double A_ = 0, u_peak_ = 0;
   double lambda_max_ = 0;
   double dtau_ = 0;
-  double tb_ = 0;  // end of the current step (tau), for messages
+  double ta_ = 0, tb_ = 0;  // the current step (tau); tb_ also for messages
   std::string flow_failure_, flow_cause_;
   std::string first_clamp_;
-  std::string first_b2_, first_bl_;
+  std::string first_b2_, first_bl_, first_content_;
   long flow_substeps_ = 0;
   std::vector<double> face_c_;  // conservative flow: face volume-rate coefficients c_k (rate c_k g_up^2)
   int first_c_ = 0;             // first node of the integral profiles

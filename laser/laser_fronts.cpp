@@ -165,7 +165,11 @@ void Drill::book_energy(const Node& n, const Geometry& geo, double grad_n, const
   // liquid on its way to the surface; the rest is carried sideways by the flow
   const double sensible = advected_ ? n.itf.w * n.itf.theta_sat : 0.0;
   E.melt_sensible += sensible * qscale_l * n.area * dts;
-  E.flow_advected += (n.itf.grad_top - n.itf.grad_bottom - sensible) * qscale_l * n.area * dts;
+  // --melt-content transient: of the flow's 2 b2 g (determined by the last march and held
+  // over this step), the part that changed the layer's own heat content stays in the column
+  const double content = n.dH * m.rho * m.cpl * G_.dT * cfg_.R * n.area;
+  E.melt_content += content;
+  E.flow_advected += (n.itf.grad_top - n.itf.grad_bottom - sensible) * qscale_l * n.area * dts - content;
 }
 
 // (3-40), (3-25), (4-14), (4-15)

@@ -223,22 +223,57 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
   return s;
 }
 
+double content_factor(double Pe, double* dc) {
+  if (Pe < 1e-3) {  // series of 1/Pe - 1/(e^Pe - 1)
+    if (dc) *dc = -1.0 / 12.0 + Pe * Pe / 240.0;
+    return 0.5 - Pe / 12.0 + Pe * Pe * Pe / 720.0;
+  }
+  const double em1 = std::expm1(Pe);  // e^Pe - 1
+  if (dc) *dc = -1.0 / (Pe * Pe) + (std::isfinite(em1) ? 1.0 / (em1 * -std::expm1(-Pe)) : 0.0);
+  return 1.0 / Pe - (std::isfinite(em1) ? 1.0 / em1 : 0.0);
+}
+
+double layer_content(const InterfaceState& s, double g, double b2) {
+  return s.theta_sat * g * content_factor(s.peclet) - b2 * g * g * g / 6.0;
+}
+
 InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
-                                    bool advected) {
-  if (!(g > 0.0) || !(beta >= 0.0)) return solve_interface(G, xi, g, 0.0, advected);
+                                    bool advected, double kappa, double H_old) {
+  if (!(g > 0.0) || !(beta >= 0.0) || !(kappa >= 0.0)) return solve_interface(G, xi, g, 0.0, advected);
   const double E = gaussian_beam(xi);
-  const double avail = E + G.kprime * gamma;
+  // content0(phi) = theta_sat g c(Pe(phi)) >= 0, so the flow's part is >= beta theta_sat - gamma - kappa H_old
+  const double avail = E + G.kprime * (gamma + kappa * H_old);
+  auto content0 = [&](double p, double* dcont) {
+    const double th = (p - G.theta_m) / (1.0 - G.theta_m);
+    double c = 0.5, dc = 0.0, Pe = 0.0, dw = 0.0;
+    if (advected) {
+      const double w = flux_recession_rate(G, p, &dw);
+      Pe = std::max(w, 0.0) * g;
+      if (!(w > 0.0)) dw = 0.0;
+      c = content_factor(Pe, &dc);
+    }
+    if (dcont) *dcont = g * (c / (1.0 - G.theta_m) + th * dc * g * dw);
+    return th * g * c;
+  };
+  auto flow_part = [&](double p, double* dpart) {  // b2 g
+    const double th = (p - G.theta_m) / (1.0 - G.theta_m);
+    double dcont = 0.0;
+    const double cont = kappa > 0.0 ? content0(p, dpart ? &dcont : nullptr) : 0.0;
+    if (dpart) *dpart = beta / (1.0 - G.theta_m) + kappa * dcont;
+    return beta * th - gamma + (kappa > 0.0 ? kappa * (cont - H_old) : 0.0);
+  };
   double phi = G.theta_m;
   RootResult rr;
   rr.converged = true;
   if (vapour_term(G, G.theta_m, nullptr) - avail < 0.0) {
     auto residual = [&](double p, double* df) {
-      const double th = (p - G.theta_m) / (1.0 - G.theta_m);
       const double r = advected ? advected_residual(G, p, xi, g, 0.0, df) : interface_residual(G, p, xi, g, 0.0, df);
-      if (df) *df += G.kprime * beta / (1.0 - G.theta_m);
-      return r + G.kprime * (beta * th - gamma);
+      double dpart = 0.0;
+      const double part = flow_part(p, df ? &dpart : nullptr);
+      if (df) *df += G.kprime * dpart;
+      return r + G.kprime * part;
     };
-    // vapour term >= 0 and F >= 1: theta_sat <= avail / (k' (1/g + beta))
+    // vapour term >= 0, F >= 1, content0 >= 0: theta_sat <= avail / (k' (1/g + beta))
     const double hi = G.theta_m + avail * (1.0 - G.theta_m) / (G.kprime * (1.0 / g + beta));
     if (residual(hi, nullptr) > 0.0) {
       auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
@@ -248,12 +283,11 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
       phi = hi;
     }
   }
-  const double th = (phi - G.theta_m) / (1.0 - G.theta_m);
-  InterfaceState s = interface_at(G, phi, g, (beta * th - gamma) / g, advected);
+  const double b2 = flow_part(phi, nullptr) / g;
+  InterfaceState s = interface_at(G, phi, g, b2, advected);
   s.iterations = rr.iterations;
   s.converged = rr.converged;
-  const double res = advected ? advected_residual(G, phi, xi, g, (beta * th - gamma) / g, nullptr)
-                              : interface_residual(G, phi, xi, g, (beta * th - gamma) / g);
+  const double res = advected ? advected_residual(G, phi, xi, g, b2, nullptr) : interface_residual(G, phi, xi, g, b2);
   s.residual = res / E;
   return s;
 }

@@ -140,8 +140,22 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
 // b2 g = beta theta_sat - gamma (beta >= 0): the layer gives the heat its outflow
 // carries at its own temperature and takes gamma from upstream (--melt-heat flux,
 // docs/theory/laser_model.md 2.7). Every term still rises with phi: one bracketed root.
+//
+// With the layer's heat content (--melt-content transient, docs 2.7) the flow's part
+// becomes b2 g = beta theta_sat - gamma + kappa (content0(phi) - H_old), where
+// content0 = theta_sat g c(Pe) is the content of the layer's profile without b2,
+// H_old the content at the start of the step and kappa = s/(2 dtau) >= 0 (the
+// caller scales beta and gamma by s = 1/(1 + g^2/(12 dtau))); kappa = 0 is the
+// quasi-steady layer.
 InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
-                                    bool advected = false);
+                                    bool advected = false, double kappa = 0.0, double H_old = 0.0);
+// Content factor of the layer's profile without b2: int_0^g theta dzeta = theta_sat g c(Pe),
+// c(Pe) = 1/Pe - 1/(e^Pe - 1) for the advected (exponential) profile, 1/2 for the
+// linear one (Pe = 0); dc receives c'(Pe).
+double content_factor(double Pe, double* dc = nullptr);
+// Heat content int_0^g theta dzeta of a layer with the profile of s and the
+// quadratic term b2 zeta (zeta - g) of (4-25): theta_sat g c(Pe) - b2 g^3/6.
+double layer_content(const InterfaceState& s, double g, double b2);
 // Nondimensional vaporization recession rate dS1/dtau by (3-25).
 double recession_rate(const Groups& G, double xi, const InterfaceState& s);
 // The same rate from the dimensional laws (3-16), (3-17): rho ds1/dt = j_v M.

@@ -283,27 +283,53 @@ void Drill::melt_temperature() {
   }
 }
 
+// Safeguard of (4-25): |b2| g^2 <= theta_sat keeps the profile monotone; a hit is
+// counted as the flow's, or as the layer content's where only the content asked for
+// more (content_only; --melt-content transient), and the interface re-solved at the limit.
+void Drill::limit_b2(Node& n, double g, double th, bool content_only) {
+  if (!(std::fabs(n.b2) * g * g > th)) return;
+  const double ask = th > 0.0 ? std::fabs(n.b2) * g * g / th : std::numeric_limits<double>::infinity();
+  const std::string where = "first at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
+  if (content_only) {
+    if (res_.b2_content_clamps++ == 0) first_content_ = where;
+    if (!(ask <= res_.b2_content_demand_max)) res_.b2_content_demand_max = ask;
+  } else {
+    if (res_.b2_clamps++ == 0) first_b2_ = where;
+    if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
+  }
+  n.b2 = th > 0.0 ? std::copysign(th / (g * g), n.b2) : 0.0;
+  n.itf = solve_interface(G_, n.xi, g, n.b2, advected_);
+}
+
 // --melt-heat flux (docs/theory/laser_model.md 2.7): the heat the flow carries through
 // the cell faces, volume rate q = |c_k| g_up^2 at the flux-weighted mean
-// temperature 2 theta_sat/3 of the upwind layer, and the layer's gradients
-// 2 b2 g = D (heat per unit area and time leaving the column) are solved
-// together, marching with the flow: the heat entering a column comes from its
-// upwind neighbour (already solved), the heat leaving it depends on its own
+// temperature 2 theta_sat/3 of the upwind layer, and the layer's gradients are
+// solved together, marching with the flow: the heat entering a column comes from
+// its upwind neighbour (already solved), the heat leaving it depends on its own
 // theta_sat, which in turn falls as b2 g rises: one bracketed root in the
-// surface temperature (solve_interface_flux). Implicit and upwind, the
-// march has no grid-dependent step limit; lagging D from one step to the next
+// surface temperature (solve_interface_flux). Implicit and upwind, the march has
+// no grid-dependent step limit; lagging the divergence from one step to the next
 // made an odd-even oscillation beyond xi = 1.6 at Pr 142 (docs 2.7).
+// Quasi-steady layer (--melt-content steady): 2 b2 g = D, the divergence of the face
+// heat fluxes per unit area. With the transient term of (3-3b) (default): the layer's
+// content H = int_0^g theta dzeta obeys dH/dtau = 2 b2 g - D (docs 2.7), backward
+// Euler over the column's part of the step, H = content0(theta_sat) - b2 g^3/6.
 void Drill::flux_heat_march() {
   const int N = static_cast<int>(nodes_.size());
   const double R2 = cfg_.R * cfg_.R;
-  const bool outward = A_ >= 0.0;
+  const bool outward = A_ >= 0.0, transient = cfg_.transient_content();
   std::vector<double> theta_out(N, 0.0);  // flux-weighted temperature of the heat a node sends
   std::vector<char> done(N, 0);
   auto active = [&](int i) { return i >= first_c_ && i < N && nodes_[i].molten && nodes_[i].g > 0.0; };
   for (int k = 0; k < N; ++k) {
     const int i = outward ? k : N - 1 - k;
     Node& n = nodes_[i];
-    if (!active(i) || face_c_.empty()) { n.b2 = 0.0; continue; }
+    n.dH = 0.0;
+    if (!active(i) || face_c_.empty()) {
+      n.b2 = 0.0;
+      n.H = 0.0;
+      continue;
+    }
     const double a = n.area / R2, g = n.g;
     double qout = 0.0, hin = 0.0;
     for (int f : {i - 1, i}) {  // faces between i-1|i and i|i+1
@@ -316,27 +342,41 @@ void Drill::flux_heat_march() {
         hin += std::fabs(cf) * nodes_[up].g * nodes_[up].g * theta_out[up];
       }
     }
-    if (qout == 0.0 && hin == 0.0) {
+    const double dtn = tb_ - node_ta(n, ta_);
+    if ((qout == 0.0 && hin == 0.0 && !transient) || !(dtn > 0.0)) {
       n.b2 = 0.0;
+      n.H = transient ? layer_content(n.itf, g, 0.0) : 0.0;
       done[i] = 1;
       continue;
     }
-    // b2 g = (qout 2 theta_sat/3 - hin) / (2 a) = beta theta_sat - gamma
-    n.itf = solve_interface_flux(G_, n.xi, g, qout / (3.0 * a), hin / (2.0 * a), advected_);
-    n.b2 = (qout / (3.0 * a) * std::max(n.itf.theta_sat, 0.0) - hin / (2.0 * a)) / g;
+    // quasi-steady: b2 g = (qout 2 theta_sat/3 - hin) / (2 a) = beta theta_sat - gamma;
+    // transient: b2 g = s (beta theta_sat - gamma) + kappa (content0 - H_old),
+    // s = 1/(1 + g^2/(12 dtn)), kappa = s/(2 dtn)
+    const double s = transient ? 1.0 / (1.0 + g * g / (12.0 * dtn)) : 1.0;
+    const double kappa = transient ? s / (2.0 * dtn) : 0.0, H_old = transient ? n.H : 0.0;
+    const double beta = qout / (3.0 * a), gamma = hin / (2.0 * a);
+    n.itf = solve_interface_flux(G_, n.xi, g, s * beta, s * gamma, advected_, kappa, H_old);
     const double th = std::max(n.itf.theta_sat, 0.0);
-    if (std::fabs(n.b2) * g * g > th) {
-      const double ask = th > 0.0 ? std::fabs(n.b2) * g * g / th : std::numeric_limits<double>::infinity();
-      if (res_.b2_clamps == 0) first_b2_ = "first at xi = " + fmt(n.xi, 4) + ", t = " + fmt(tb_ * G_.t_scale, 4) + " s";
-      if (!(ask <= res_.b2_demand_max)) res_.b2_demand_max = ask;
-      ++res_.b2_clamps;
-      n.b2 = th > 0.0 ? std::copysign(th / (g * g), n.b2) : 0.0;
-      n.itf = solve_interface(G_, n.xi, g, n.b2, advected_);
-    }
-    // what the column sends on is what came in minus what it keeps, 2 a b2 g: with
-    // the solved b2 g this is qout 2 theta_sat/3; where the limit of (4-25) held b2
+    n.b2 = (s * (beta * th - gamma) + (transient ? kappa * (layer_content(n.itf, g, 0.0) - H_old) : 0.0)) / g;
+    // a hit whose flow part alone is within the limit is the layer's content asking for more
+    limit_b2(n, g, th, transient && std::fabs(beta * th - gamma) * g <= th);
+    // the column's heat balance: what it sends on is what came in, plus what its
+    // gradients give the flow (2 a b2 g), minus what it keeps in its content; with
+    // the solved b2 this is qout 2 theta_sat/3; where the limit of (4-25) held b2
     // back, the heat the layer could not take (or give) stays with the flow, so the
     // face fluxes still telescope (heat is moved, never lost or made)
+    if (transient) {
+      // the content is the state the balance gives, dH = dtn (2 b2 g - D), D = (qout 2 theta_sat/3
+      // - hin)/a; with the solved b2 it is the profile's content; where the limit held b2 back,
+      // the layer keeps the heat it was sent (or lacks what it could not take) and its content
+      // differs from its profile's until later steps close the gap (nothing is moved elsewhere)
+      const double D = (qout * 2.0 / 3.0 * std::max(n.itf.theta_sat, 0.0) - hin) / a;
+      n.dH = dtn * (2.0 * n.b2 * g - D);
+      n.H = H_old + n.dH;
+      theta_out[i] = 2.0 / 3.0 * std::max(n.itf.theta_sat, 0.0);
+      done[i] = 1;
+      continue;
+    }
     theta_out[i] = qout > 0.0 ? std::max(hin + 2.0 * a * n.b2 * g, 0.0) / qout
                               : 2.0 / 3.0 * std::max(n.itf.theta_sat, 0.0);
     done[i] = 1;

@@ -123,6 +123,7 @@ bool Drill::state_admissible(double tb) {
 // Returns false when the run stops (status and message set); tau is moved to
 // tb once the fronts have moved.
 bool Drill::step(long step, double ta, double tb, double& tau) {
+  ta_ = ta;
   tb_ = tb;
   melt_onset(tb);
   solve_interfaces();

@@ -49,11 +49,12 @@ struct Energy {  // J, over the pulse
   double melt_sensible = 0;    // advected layer: rho c_pl (T_sat - T_m) of the vaporized liquid
   double vapour_latent = 0;    // rho h_lv * j_v M/rho, flux from (3-15), (3-17)
   double vapour_kinetic = 0;   // 1/2 j_v M V_v^2, (3-13), (3-17)
-  double flow_advected = 0;    // k_l (grad_top - grad_bottom): carried sideways by the flow
+  double flow_advected = 0;    // k_l (grad_top - grad_bottom) - the two terms around it: carried sideways by the flow
+  double melt_content = 0;     // heat content the melt layer gained (transient term of (3-3b), --melt-content)
   double clamp_defect = 0;     // (< 0) solid demand not delivered where ds2/dt < 0 was clamped to 0
   double sum() const {
     return solid_premelt + solid_conduction + solid_preheat + melt_latent + melt_sensible + vapour_latent +
-           vapour_kinetic + flow_advected + clamp_defect;
+           vapour_kinetic + flow_advected + melt_content + clamp_defect;
   }
 };
 
@@ -118,6 +119,10 @@ struct Result {
   long bl_steps = 0;           // boundary model: steps with melt off the axis
   double bl_first_ratio = 0;   // delta / g there, at the first such step
   double b2_demand_max = 0;    // largest |b2| g^2 / theta_sat that (4-27) asked for (1: limit of (4-25))
+  // --melt-content transient: limiter hits that the quasi-steady layer would not have had (the
+  // layer's content asked for more than (4-25) holds; the layer keeps the balance's content)
+  long b2_content_clamps = 0;
+  double b2_content_demand_max = 0;
   int steps = 0, nodes = 0;
   int melt_clamps = 0, melt_rate_clamps = 0, curvature_clamps = 0, b2_clamps = 0;
   double max_interface_residual = 0;

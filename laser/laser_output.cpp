@@ -401,6 +401,7 @@ ordered_json case_json(const Config& cfg) {
                {"melt_energy", to_string(cfg.melt_energy)},
                {"melt_flow", to_string(cfg.melt_flow)},
                {"melt_heat", cfg.flux_heat() ? "flux" : "ode"},
+               {"melt_content", cfg.transient_content() ? "transient" : "steady"},
                {"recoil_fraction_of_p_sat", num(cfg.recoil)},
                {"absorptivity", num(cfg.absorptivity)},
                {"melt_update", cfg.implicit_melt ? "implicit" : "explicit"},
@@ -428,6 +429,7 @@ void energy_json(ordered_json& j, const Result& r) {
                    {"vapour_latent", num(e.vapour_latent)},
                    {"vapour_kinetic", num(e.vapour_kinetic)},
                    {"flow_advected", num(e.flow_advected)},
+                   {"melt_heat_content", num(e.melt_content)},
                    {"clamp_defect", num(e.clamp_defect)},
                    {"sum_of_terms", num(sum)},
                    {"relative_imbalance", num(e.laser_exact > 0 ? (sum - e.laser_exact) / e.laser_exact : 0.0)}};
@@ -510,6 +512,7 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["melt_rate_clamps"] = r.melt_rate_clamps;
   j["curvature_clamps"] = r.curvature_clamps;
   j["b2_limiter_hits"] = r.b2_clamps;
+  j["b2_limiter_content_hits"] = r.b2_content_clamps;
   j["max_interface_residual"] = num(r.max_interface_residual);
   j["case"] = case_json(cfg);
   energy_json(j, r);

@@ -305,6 +305,19 @@ void add_model_params(std::vector<Param>& t) {
       [](const Config& c) {
         return std::string(c.melt_heat == MeltHeat::Flux ? "flux" : c.melt_heat == MeltHeat::Ode ? "ode" : "auto");
       }));
+  t.push_back(choice(
+      "melt-content", "model", {"auto", "transient", "steady"},
+      "heat content of the melt layer with the face heat fluxes: transient = the layer's energy balance keeps "
+      "the transient term of (3-3b) (inflowing heat first raises the layer's content), steady = the text's "
+      "quasi-steady layer (heat brought in is conducted out in the same step); auto = transient with --melt-heat "
+      "flux and --melt-update implicit, steady otherwise (transient needs --melt-heat flux)",
+      [](Config& c, const std::string& v) {
+        c.melt_content = v == "transient" ? MeltContent::Transient : v == "steady" ? MeltContent::Steady : MeltContent::Auto;
+      },
+      [](const Config& c) {
+        const MeltContent m = c.melt_content;
+        return std::string(m == MeltContent::Transient ? "transient" : m == MeltContent::Steady ? "steady" : "auto");
+      }));
   t.push_back(real("shift", "model", "tau_m", 0, 10, true,
                    "backward shift of the Stefan solution for --solid shifted (3-36: 3 tau_0 = 3/(4 pi))",
                    &Config::shift));
@@ -568,6 +581,12 @@ void validate(Config& c) {
   if (c.melt_heat == MeltHeat::Flux && c.melt_flow != MeltFlow::Conservative)
     throw UsageError("--melt-heat: flux needs --melt-flow conservative (the face fluxes are the conservative flow's), "
                      "got --melt-flow text");
+  if (c.melt_content == MeltContent::Transient && !c.flux_heat())
+    throw UsageError("--melt-content: transient needs --melt-heat flux (the layer's content is balanced against the "
+                     "face heat fluxes; (4-27) is quasi-steady), got --melt-heat ode");
+  if (c.melt_content == MeltContent::Transient && c.model == FlowModel::Conduction)
+    throw UsageError("--melt-content: transient needs a melt flow model (the layer's content changes through b2 of "
+                     "(4-25), which --model conduction does not have), got --model conduction");
   if (c.dtau > 0.0) c.dt = c.dtau * c.R * c.R / (m.kl / (m.rho * m.cpl));
   if (c.dt > 0.0 && !(c.dt < c.tp))
     throw UsageError(std::string(c.dtau > 0 ? "--dtau" : "--dt") + ": the time step " + fmt(c.dt) +

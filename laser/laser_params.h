@@ -28,6 +28,12 @@ enum class MeltEnergy { Advected, Text };
 // conserved), Text = v(xi, g) of (4-22)/(4-13) as printed.
 enum class MeltFlow { Conservative, Text };
 enum class MeltHeat { Auto, Ode, Flux };
+// Heat content of the melt layer with the face heat fluxes: Transient = the
+// transient term of (3-3b) kept in the layer's energy balance (the layer's
+// content int theta dzeta changes over a step), Steady = the text's quasi-steady
+// layer (what flows in is conducted out at once); Auto = transient with the face
+// heat fluxes and the implicit melt update (docs/theory/laser_model.md 2.7).
+enum class MeltContent { Auto, Transient, Steady };
 
 const char* to_string(FlowModel m);
 const char* to_string(SolidModel m);
@@ -50,6 +56,14 @@ struct Config {
   MeltHeat melt_heat = MeltHeat::Auto;
   bool flux_heat() const {
     return melt_heat == MeltHeat::Flux || (melt_heat == MeltHeat::Auto && melt_flow == MeltFlow::Conservative);
+  }
+  MeltContent melt_content = MeltContent::Auto;
+  // auto: transient with the face heat fluxes and the implicit melt update; the explicit
+  // update (4-14) keeps the quasi-steady layer (docs/theory/laser_model.md 2.7: with it the
+  // transient term does not converge in dt at the Table 5.1 case)
+  bool transient_content() const {
+    return flux_heat() && model != FlowModel::Conduction &&
+           (melt_content == MeltContent::Transient || (melt_content == MeltContent::Auto && implicit_melt));
   }
   // Recoil pressure that drives the melt flow, as a fraction of p_sat(T_s): 1 =
   // the text (full saturation pressure), 0.54 = Anisimov (1968) / Knight (1979)

@@ -59,6 +59,18 @@ void Drill::physical_check() {
   pc.holds = pc.melt_vap_over_beam < 1.0 && pc.worst_node_ratio < 1.0 && (!no_flow || pc.centre_velocity_ratio < 1.0);
 }
 
+// --melt-content transient: limiter hits only the layer's content asked for are a note,
+// not a cause (a layer formed within one step; they vanish under dt refinement)
+void Drill::note_content_hits() {
+  if (res_.b2_content_clamps > 0)
+    res_.notes.push_back("melt layer content: the transient balance asked for |b2| g^2 / theta_sat up to " +
+                         fmt(res_.b2_content_demand_max, 4) + " (limit of (4-25): 1) " +
+                         std::to_string(res_.b2_content_clamps) + " times (" + first_content_ +
+                         "), where the quasi-steady layer would not; the layer keeps the content its balance "
+                         "gives (a layer formed within one step; these hits vanish under dt refinement, "
+                         "docs/theory/laser_model.md 2.7, and the step-doubling estimate measures their effect)");
+}
+
 // Status from the physics checks: every check that fails is named (the most
 // serious first) in Result::causes and the message; the counts count.
 void Drill::assess() {
@@ -105,6 +117,7 @@ void Drill::assess() {
                         "sideways: " + std::string(cfg_.flux_heat() ? "the face heat fluxes ask" : "(4-27) asks") + " for |b2| g^2 / theta_sat up to " + fmt(res_.b2_demand_max, 4) +
                         " (monotone profile: at most 1); limited to 1 " + std::to_string(res_.b2_clamps) +
                         " times (" + fmt(res_.b2_clamps / node_steps, 3) + " of the node steps; " + first_b2_ + ")");
+  note_content_hits();
   // named as a cause where the boundary model was not applied in most steps; a
   // few steps (the first ones after onset, when the melt is one step thick) are a note
   if (cfg_.model == FlowModel::Boundary && res_.bl_thicker_steps > 0 && 2 * res_.bl_thicker_steps <= res_.bl_steps)

@@ -271,3 +271,82 @@ TEST(LaserLaws, InterfaceWithFlowHeatIsConsistent) {
   }
   EXPECT_GT(hot, 40);
 }
+
+// The layer's heat content (--melt-content transient, docs 2.7). content_factor
+// against a Simpson integral of the exponential profile (theta_sat = 1, g = 1);
+// solve_interface_flux with the content term: (a) its phi is the root of the
+// ordinary balance at the b2 it implies (checked by solve_interface), (b) the
+// column's energy balance of one backward-Euler step holds, dH/dtau = 2 b2 g - D
+// with H = layer_content at that b2 and D = 2 (beta theta_sat - gamma) the heat the
+// flow takes out.
+TEST(LaserLaws, LayerContentBalancesTheColumn) {
+  for (double Pe : {0.0, 1e-4, 0.3, 1.0, 3.0, 12.0, 800.0}) {
+    const int n = 20000;  // Simpson over z in [0, 1] of (e^(-Pe z) - e^(-Pe)) / (1 - e^(-Pe))
+    auto prof = [&](double z) {
+      return Pe == 0.0 ? 1.0 - z : (std::exp(-Pe * z) - std::exp(-Pe)) / -std::expm1(-Pe);
+    };
+    double sum = prof(0.0) + prof(1.0);
+    for (int k = 1; k < n; ++k) sum += (k % 2 ? 4.0 : 2.0) * prof(double(k) / n);
+    const double integral = sum / (3.0 * n);
+    EXPECT_NEAR(content_factor(Pe), integral, 1e-9 + 1e-6 * integral) << Pe;
+    double dc = 0.0;
+    const double h = 1e-5 * std::max(Pe, 1.0);
+    content_factor(Pe, &dc);
+    if (Pe > 2e-3) EXPECT_NEAR(dc, (content_factor(Pe + h) - content_factor(Pe - h)) / (2 * h), 1e-6) << Pe;
+  }
+  const Groups G = make_groups(kMat, kI0, kR);
+  int checked = 0;
+  for (bool adv : {false, true}) {
+    for (double xi : {0.0, 1.7}) {
+      for (double g : {1e-3, 2e-2, 8e-2}) {
+        for (auto [beta, gamma] : {std::pair{0.0, 0.0}, {50.0, 0.0}, {0.0, 30.0}, {200.0, 300.0}}) {
+          for (double dtau : {1e-5, 1e-3}) {
+            for (double H_old : {0.0, 0.05 * g, 2.0 * g}) {
+              const double s = 1.0 / (1.0 + g * g / (12.0 * dtau)), kappa = s / (2.0 * dtau);
+              const InterfaceState st = solve_interface_flux(G, xi, g, s * beta, s * gamma, adv, kappa, H_old);
+              const double th = st.theta_sat;
+              const double b2 =
+                  (s * (beta * th - gamma) + kappa * (layer_content(interface_at(G, st.phi, g, 0.0, adv), g, 0.0) - H_old)) / g;
+              const InterfaceState r = solve_interface(G, xi, g, b2, adv);
+              EXPECT_NEAR(st.phi, r.phi, 1e-10 * r.phi) << adv << " " << xi << " " << g << " " << beta << " " << H_old;
+              EXPECT_LT(std::fabs(st.residual), 1e-10);
+              if (!(th > 0.0)) continue;
+              const double H_new = layer_content(st, g, b2);
+              const double lhs = (H_new - H_old) / dtau, rhs = 2.0 * b2 * g - 2.0 * (beta * th - gamma);
+              EXPECT_NEAR(lhs, rhs, 1e-9 * (std::fabs(lhs) + std::fabs(2.0 * b2 * g) + 1.0)) << adv << " " << g;
+              ++checked;
+            }
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 100);
+}
+
+// What the curvature clamp hides at Pr 1420 (docs section 3, "The cusp on the axis"):
+// (3-37) as printed gives a node deeper than both neighbours (a > 0) C_c < 1, i.e. less
+// heat drawn into the solid, so it melts faster than its shallower neighbours (a < 0,
+// C_c > 1): a node-scale mode of the front grows. With d = d(xi), a mode of fixed
+// amplitude e has a d = 2 e / d(xi), so the factor departs further from 1 on finer grids,
+// while a smooth front's a d -> 0.
+TEST(LaserLaws, CurvatureFactorFavoursTheDeeperNode) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  const double e = 2e-3;              // mode amplitude (in R)
+  const double grad_n = -5.0, grad_l = 20.0;  // solid draws heat, the layer delivers it
+  double last_ad = 0.0;
+  for (double h : {0.05, 0.025, 0.0125, 0.00625}) {
+    const double s2xx_deep = -2.0 * e / (h * h), s2xx_shallow = 2.0 * e / (h * h);  // S2'' (S2' = 0)
+    const double Cd = curvature_factor(-s2xx_deep, h), Cs = curvature_factor(-s2xx_shallow, h);
+    EXPECT_LT(Cd, 1.0) << h;
+    EXPECT_GT(Cs, 1.0) << h;
+    const double rd = melting_rate(G, Cd, grad_n, 1.0, grad_l, true);
+    const double rs = melting_rate(G, Cs, grad_n, 1.0, grad_l, true);
+    EXPECT_GT(rd, rs) << "the deeper node melts faster at d(xi) " << h;
+    const double ad = -s2xx_deep * h;
+    EXPECT_GT(ad, last_ad);  // 2 e / d(xi): grows under refinement
+    last_ad = ad;
+  }
+  // a smooth front (S2 = c xi^2, fixed curvature): C_c -> 1 as d(xi) -> 0
+  EXPECT_LT(std::fabs(curvature_factor(0.5, 0.00625) - 1.0), std::fabs(curvature_factor(0.5, 0.05) - 1.0) / 50.0);
+}
