@@ -352,6 +352,13 @@ void FluidSolver::couple_kernel(double h) {
   // the end of this function)
   std::vector<double> Kgrain(static_cast<std::size_t>(nlocal), 0.0);
   grain_drag_sums<NS>(Kgrain, proj, weak);
+  if (opt.every_auto) {
+    // every auto: the mobile grains' shortest drag response time m / K (choose_every)
+    double tau = HUGE_VAL;
+    for (int k = 0; k < nlocal; ++k)
+      if (Kgrain[k] > 0.0 && (pts.mask[k] & pts.integrated_bits)) tau = std::min(tau, pts.rmass[k] / Kgrain[k]);
+    state.grain_tau = std::min(state.grain_tau, tau);
+  }
   // the grains wrote dr in gbox only (0 elsewhere until the reverse sum)
   if (opt.reaction_points && !proj) {
     // the grains' pressure reaction, folded at the faces like their volume (route_reaction)
