@@ -334,6 +334,8 @@ class FluidSolver {
     const char *which = "";
   } auto_;
   void choose_every();
+  double wall_speed2() const;
+  void auto_limits(const double *glob);
   long last_output_step_ = -1;
 };
 

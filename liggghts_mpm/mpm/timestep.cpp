@@ -63,20 +63,12 @@ double FluidSolver::stable_dt() {
       }
     }
   }
-  double w2max = 0.0;  // every auto: the mesh walls' largest node speed squared
-  if (every_auto && bc.walls())
-    for (const WallGeometry::Tri &t : bc.walls()->triangles())
-      for (int q = 0; q < 3; ++q) w2max = std::max(w2max, t.w[q][0] * t.w[q][0] + t.w[q][1] * t.w[q][1] + t.w[q][2] * t.w[q][2]);
   double loc[17] = {std::sqrt(v2max), rho_max, mrho_max, ratio_max, mth_max, mgrain_max, p_max, a2max,
-                    ext[0], ext[1], ext[2], ext[3], ext[4], ext[5], vg2max, w2max, -this->state.grain_tau};
+                    ext[0], ext[1], ext[2], ext[3], ext[4], ext[5], vg2max, every_auto ? wall_speed2() : 0.0,
+                    -this->state.grain_tau};
   double glob[17];
   MPI_Allreduce(loc, glob, every_auto ? 17 : eos_scale ? 14 : 6, MPI_DOUBLE, MPI_MAX, comm_);
-  if (every_auto) {
-    auto_.accel = std::sqrt(glob[7]);
-    auto_.grain_speed = std::sqrt(glob[14]);
-    auto_.wall_speed = std::sqrt(glob[15]);
-    auto_.grain_tau = -glob[16];  // of the last fluid step (HUGE_VAL before the first)
-  }
+  if (every_auto) auto_limits(glob);
   if (eos_scale) {
     // rho0 (|a|max H + |v|max^2), H the points' largest extent: hydrostatic plus dynamic pressure
     double extent = 0.0;
@@ -96,6 +88,24 @@ double FluidSolver::stable_dt() {
   const double dt_visc = viscous_dt_limit(dx, eos.rho0, opt.viscosity, opt.dimension);
   coupled_limits(glob);
   return std::min(dt_ac, dt_visc);
+}
+
+// every auto: the mesh walls' largest node speed squared (the triangles near this rank)
+double FluidSolver::wall_speed2() const {
+  double w2max = 0.0;
+  if (bc.walls())
+    for (const WallGeometry::Tri &t : bc.walls()->triangles())
+      for (int q = 0; q < 3; ++q) w2max = std::max(w2max, t.w[q][0] * t.w[q][0] + t.w[q][1] * t.w[q][1] + t.w[q][2] * t.w[q][2]);
+  return w2max;
+}
+
+// every auto: the reduced maxima of stable_dt (|a|^2 at 7, grains' |v|^2 at 14, walls' at 15, minus
+// the grains' shortest response time at 16)
+void FluidSolver::auto_limits(const double *glob) {
+  auto_.accel = std::sqrt(glob[7]);
+  auto_.grain_speed = std::sqrt(glob[14]);
+  auto_.wall_speed = std::sqrt(glob[15]);
+  auto_.grain_tau = -glob[16];  // of the last fluid step (HUGE_VAL before the first)
 }
 
 // Grains an integrator moves: the pore-pressure waves (fluid_laws.h). The coupled wave limits the
