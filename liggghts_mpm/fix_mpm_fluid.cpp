@@ -233,6 +233,16 @@ void FixMpmFluid::setup(int) {
     s.setup_coupling();
     print(s.check_timestep(true));
   });
+  if (s.opt.every_auto) {
+    // the N the state asks for now, for the log (the next fluid step chooses again; one already
+    // scheduled by an earlier run or a restart file stays where it is)
+    const int n_now = s.opt.fluid_every;
+    s.opt.fluid_every = s.state.last_every;
+    std::ostringstream os;
+    os << "fix mpm/fluid: every auto: the fluid advances by N x timestep, N at most " << mpm::FluidSolver::kMaxEvery
+       << " and within the smallest limit of the state (now N = " << n_now << ", " << s.every_auto_limit() << ")\n";
+    print(os.str());
+  }
   // LIGGGHTS recomputed the grains' forces for this run; the fluid force of the last fluid step
   // (kept in the state rows, also across restart files) acts on them on this step as it did when
   // the step was first taken, so that run N; run M (or a restart between them, on a fluid step or
@@ -284,6 +294,7 @@ void FixMpmFluid::mark_run_start() {
   run_time_start[6] = static_cast<double>(s.n_outputs);
   run_time_start[7] = s.grid().wait_seconds();
   run_stats_start = mpm::run_stats_start(s.grid());
+  every_run[0] = every_run[1] = every_run[2] = 0.0;
 }
 
 /* Where the fix's time went in the run just finished (slowest rank), next
@@ -305,6 +316,8 @@ void FixMpmFluid::post_run() {
        << " solves, " << (nsolve > 0.0 ? nit / nsolve : 0.0) << " PCG iterations per solve)";
   }
   if (s.opt.coupled) os << ", coupling " << g[1] << " s (" << (g[0] > 0.0 ? g[1] / g[0] : 0.0) << " of the fluid time)";
+  if (s.opt.every_auto && every_run[2] > 0.0)
+    os << "; every auto: " << every_run[2] << " fluid steps, N from " << every_run[0] << " to " << every_run[1];
   const double nout = static_cast<double>(s.n_outputs) - run_time_start[6];  // the same on every rank
   if (nout > 0.0) os << ", output " << g[3] << " s (" << nout << " files, " << g[3] / nout << " s per file)";
   if (comm->nprocs > 1) {
@@ -349,8 +362,9 @@ void FixMpmFluid::pre_final_integrate() {
   }
   // the fluid advances on every N-th step by N dt (keyword every); the grains receive the force of
   // the last fluid step on each DEM step, this one included
-  if (s.opt.fluid_every == 1 || update->ntimestep % s.opt.fluid_every == 0) {
+  if (fluid_step_due(s)) {
     guarded([&] { print(s.check_timestep(false)); });
+    if (s.opt.every_auto) note_every(s);
     refresh_walls();
     if (s.opt.coupled && s.opt.fluid_every > 1) {
       // the fluid sees the grains (N-1)/2 steps ahead, where they are halfway through the N steps
@@ -375,6 +389,37 @@ void FixMpmFluid::pre_final_integrate() {
     vector_step = -1;
   }
   add_grain_force();
+}
+
+/* Whether the fluid steps on this step: every N-th step (every N), or (every auto) when the N
+   steps of the last fluid step are over; the N of the fluid step about to be taken is chosen in
+   check_timestep (note_every ends it with the run). The schedule is in restart files, so that a
+   run resumed from one written during a run (restart N) continues bit for bit. */
+bool FixMpmFluid::fluid_step_due(const mpm::FluidSolver &s) const {
+  if (!s.opt.every_auto) return s.opt.fluid_every == 1 || update->ntimestep % s.opt.fluid_every == 0;
+  // a step more than N ahead: the step count was reset (reset_timestep); the fluid steps now
+  const long next = s.state.next_fluid_step, now = static_cast<long>(update->ntimestep);
+  return next < 0 || now >= next || next > now + s.state.last_every;
+}
+
+// every auto: N ends the fluid step at the last step of the run (what a run, a fix_modify or a
+// restart file between runs changes acts from the next run's first step) and at the gate's release
+// time; the next fluid step's host step, and the range of N over the run (post_run)
+void FixMpmFluid::note_every(mpm::FluidSolver &s) {
+  const long now = static_cast<long>(update->ntimestep);
+  long cap = static_cast<long>(update->laststep) - now + 1;
+  const mpm::Gate &gate = s.opt.gate;
+  if (gate.active && gate.release_time >= 0.0) {
+    const double k = std::floor((gate.release_time - sim_time()) / update->dt + 0.5);
+    if (k >= 1.0 && k < cap) cap = static_cast<long>(k);
+  }
+  if (cap >= 1 && s.opt.fluid_every > cap) s.opt.fluid_every = static_cast<int>(cap);
+  const int n = s.opt.fluid_every;
+  s.state.next_fluid_step = static_cast<long>(update->ntimestep) + n;
+  s.state.last_every = n;
+  every_run[0] = every_run[2] == 0.0 ? n : std::min(every_run[0], double(n));
+  every_run[1] = std::max(every_run[1], double(n));
+  every_run[2] += 1.0;
 }
 
 /* every N > 1: the fluid step at step n gives its force F to the N DEM steps n .. n+N-1. With F
@@ -498,14 +543,17 @@ void FixMpmFluid::unpack_restart(int nlocal, int nth) {
 int FixMpmFluid::size_restart(int) { return NCOL + 1; }
 int FixMpmFluid::maxsize_restart() { return NCOL + 1; }
 
-/* The fix's global restart data. Format 2: R_VERSION = -2 (negative: format 1, written before
+/* The fix's global restart data. Format 3: R_VERSION = -3 (negative: format 1, written before
    the pressure projection's state was kept, began with R_FILLED, 0 or 1), the fields of format 1,
-   then the state of the last pressure solve (ProjectionState::pack: a 0 when there is none).
-   Format-1 files are read as before: a `pressure projection` run resumed from one starts its
-   first solve from p = 0 without the d(theta)/dt source (a warning says so). */
+   the state of every auto (R_NEXT..R_TAU; format 2 ends before them), then the state of the
+   last pressure solve (ProjectionState::pack: a 0 when there is none). Format-1 files are read as
+   before: a `pressure projection` run resumed from one starts its first solve from p = 0 without
+   the d(theta)/dt source (a warning says so); format-2 files start every auto with a fluid step. */
 namespace {
-enum { R_FILLED, R_PMASS, R_SP0, R_SP1, R_SP2, R_CLAMPED, R_GATE, R_NSUB, R_THETA, R_TIME, R_TYPE, R_COUNT };
-constexpr double kRestartFormat = 2.0;
+enum { R_FILLED, R_PMASS, R_SP0, R_SP1, R_SP2, R_CLAMPED, R_GATE, R_NSUB, R_THETA, R_TIME, R_TYPE,
+       R_NEXT, R_LASTN, R_VCDUE, R_TAU, R_COUNT };
+constexpr double kRestartFormat = 3.0;
+constexpr int kFormat2Count = R_NEXT;
 }
 
 void FixMpmFluid::write_restart(FILE *fp) {
@@ -522,6 +570,10 @@ void FixMpmFluid::write_restart(FILE *fp) {
   v[R_THETA] = st.theta_initialized ? 1.0 : 0.0;
   v[R_TIME] = sim_time();
   v[R_TYPE] = point_type;
+  v[R_NEXT] = static_cast<double>(st.next_fluid_step);
+  v[R_LASTN] = st.last_every;
+  v[R_VCDUE] = st.vc_due;
+  v[R_TAU] = st.grain_tau;  // HUGE_VAL (finite) when no grain moved
   mpm::ProjectionState ps;
   guarded([&] { ps = solver->projection_state(); });  // collective
   ps.pack(list);
@@ -538,9 +590,10 @@ void FixMpmFluid::write_restart(FILE *fp) {
 void FixMpmFluid::restart(char *buf) {
   const double *list = reinterpret_cast<const double *>(buf);
   const bool format1 = list[0] >= 0.0;  // R_FILLED first
-  if (!format1 && list[0] != -kRestartFormat) {
+  const bool format2 = list[0] == -2.0;
+  if (!format1 && !format2 && list[0] != -kRestartFormat) {
     std::ostringstream os;
-    os << "Fix mpm/fluid: the restart file's fix data has format " << -list[0] << "; this build reads formats 1 and "
+    os << "Fix mpm/fluid: the restart file's fix data has format " << -list[0] << "; this build reads formats 1 to "
        << kRestartFormat << " (write the restart file again with the build that will read it)";
     error->all(FLERR, os.str().c_str());
   }
@@ -560,6 +613,11 @@ void FixMpmFluid::restart(char *buf) {
   restart_time = v[R_TIME];
   restart_time_pending = true;
   point_type = static_cast<int>(v[R_TYPE]);
+  const bool schedule = !format1 && !format2;
+  st.next_fluid_step = schedule ? static_cast<long>(v[R_NEXT]) : -1;
+  st.last_every = schedule ? static_cast<int>(v[R_LASTN]) : 1;
+  st.vc_due = schedule ? v[R_VCDUE] : 0.0;
+  st.grain_tau = schedule ? v[R_TAU] : HUGE_VAL;
   // the last pressure solve (warm start, the grains' gradient, theta for d(theta)/dt)
   st.projection = mpm::ProjectionState();
   if (format1) {
@@ -570,7 +628,7 @@ void FixMpmFluid::restart(char *buf) {
     return;
   }
   mpm::ProjectionState ps;
-  guarded([&] { ps.unpack(v + R_COUNT); });
+  guarded([&] { ps.unpack(v + (format2 ? kFormat2Count : R_COUNT)); });
   if (!ps.valid || !solver->opt.projection) return;
   const mpm::GridSpec &gs = solver->opt.grid;
   bool fits = true;

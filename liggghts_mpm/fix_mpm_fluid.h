@@ -70,6 +70,9 @@ class FixMpmFluid : public Fix {
   // the solver's fluid, coupling and pressure-solver wall time, solves and PCG iterations at the setup of the run
   double run_time_start[8] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};  // [7]: halo waits (this rank)
   mpm::RunStatsStart run_stats_start;  // the halo exchanges' counters at the setup of the run (mpm/run_stats.h)
+  double every_run[3] = {0.0, 0.0, 0.0};  // every auto: least and largest N, fluid steps in this run
+  bool fluid_step_due(const mpm::FluidSolver &s) const;
+  void note_every(mpm::FluidSolver &s);
   void mark_run_start();
   double **pdata = nullptr;  // per-point state rows (mpm::Column)
   int pdata_rows = 0;

@@ -12,6 +12,7 @@ C6 damped while held) f3var (F3 with the other transfer) f4fine (F4 at 80 cells)
 c3 (C3 tank, quick size, 0.26 s) c4 (C4 jar, full size, C4_TURNS turns, default 1) starter (quick and default size), or all. Each run prints one line: row, model, settings, figures, wall time (s).
 """
 import argparse
+import inspect
 import json
 import math
 import os
@@ -264,14 +265,17 @@ def row_transfer(r, models):
     row_c6(r, models, extra="transfer apic", phis=(0.3,))
 
 
-def row_c3(r, models):
+def row_c3(r, models, extra=""):
     """C3 tank, quick size (Grid20, 1 point per cell, 2000 beads) to 0.26 s after the start of the lift
     (past the water's impact on the far wall), fronts.csv every 2 ms: the time the water reaches
     0.19 m, the fronts at 0.05-0.2 s, the largest point pressure against rho g h + rho U_gate^2, the
     highest bead against the highest water point, the fluid mass."""
     bound = 1000.0 * 9.81 * 0.1 + 1000.0 * 0.68 ** 2
     for m in models:
-        d, p, w = timed(r, f"c3/{m}", "tank/in.tank", {"quick": 1, "tend": 0.26, "tfront": 0.002, "pressure": m})
+        v = {"quick": 1, "tend": 0.26, "tfront": 0.002, "pressure": m}
+        if extra:
+            v["extra"] = extra  # after the input's own keywords: a repeated one (e.g. every) takes this value
+        d, p, w = timed(r, f"c3/{m}{extra.replace(' ', '_')}", "tank/in.tank", v)
         f = read_csv(os.path.join(d, "fronts.csv"))
         t = f["t"]
 
@@ -288,7 +292,7 @@ def row_c3(r, models):
                      "bed_rise_to_0.2s_mm": 1e3 * (max(z for z, tt in zip(f["z_beads"], t) if tt <= 0.2 + 1e-9)
                                                    - f["z_beads"][0]),
                      "mass_exact": max(f["mass"]) == min(f["mass"])})
-        emit("C3", m, "quick (Grid20 x 1, 2000 beads), 0.26 s", figs, w)
+        emit("C3", m, "quick (Grid20 x 1, 2000 beads), 0.26 s" + (f", {extra}" if extra else ""), figs, w)
 
 
 def row_c4(r, models, turns=float(os.environ.get("C4_TURNS", "1"))):
@@ -355,12 +359,16 @@ def main():
     ap.add_argument("--work", default="/tmp/model_table")
     ap.add_argument("--models", nargs="+", default=["projection", "eos"])
     ap.add_argument("--json", default=None, help="append one JSON line per run to this file")
+    ap.add_argument("--extra", default="", help="more fix mpm/fluid keywords for the rows that take them "
+                    "(c1, c5, ...: their function has an 'extra' argument), e.g. 'every auto'")
     a = ap.parse_args()
     a.exe, a.work = os.path.abspath(a.exe), os.path.abspath(a.work)
     r = runner(a)
     names = sorted(ROWS) if a.rows == ["all"] else a.rows
     for n in names:
-        ROWS[n](r, a.models)
+        if a.extra and "extra" not in inspect.signature(ROWS[n]).parameters:
+            sys.exit(f"model_table.py: row {n} takes no --extra keywords")
+        ROWS[n](r, a.models, **({"extra": a.extra} if a.extra else {}))
     if a.json:
         with open(a.json, "a") as f:
             for rec in OUT:

@@ -265,9 +265,13 @@ void parse_height(Options &o, Args &a, const ParseEnv &) {
 }
 
 void parse_every(Options &o, Args &a, const ParseEnv &) {
-  const char *what = "an integer N >= 1 (the fluid advances every N-th time step)";
+  const char *what = "an integer N >= 1 (the fluid advances every N-th time step) or 'auto'";
   a.need(1, "every", what);
-  if (!parse_int(a.at(1), o.fluid_every) || o.fluid_every < 1) bad_arg("every", what, a.at(1));
+  o.every_auto = strcmp(a.at(1), "auto") == 0;
+  if (o.every_auto)
+    o.fluid_every = 1;
+  else if (!parse_int(a.at(1), o.fluid_every) || o.fluid_every < 1)
+    bad_arg("every", what, a.at(1));
   a.iarg += 2;
 }
 
@@ -391,7 +395,7 @@ const std::vector<Keyword> kTable = {
      REAL(cfl), 0.0, 1.0, true, false, nullptr, nullptr, true},
     {"subcycle", "yes/no", "-", "", "no", "'yes' or 'no'",
      nullptr, 0, 0, false, false, &Options::subcycle, nullptr, true},
-    {"every", "integer", "steps", ">= 1", "1", "an integer N >= 1 (the fluid advances every N-th time step)",
+    {"every", "integer or auto", "steps", ">= 1", "1", "an integer N >= 1 (the fluid advances every N-th time step) or 'auto'",
      nullptr, 0, 0, false, false, nullptr, parse_every, false},
     {"mass_threshold", "real", "-", "[0,1)", "1e-5", "a fraction of the point mass in [0,1)",
      REAL(mass_threshold), 0.0, 1.0, false, true, nullptr, nullptr, false},

@@ -75,6 +75,9 @@ struct Options {
   bool subcycle = false;
   int max_subcycle = 1000;
   int fluid_every = 1;              // the fluid advances every N-th time step, by N dt (keyword every)
+  // every auto: N chosen at each fluid step from the stable step of the state then
+  // (FluidSolver::choose_every); fluid_every holds the N of the current fluid step
+  bool every_auto = false;
   double mass_threshold = 1e-5;
   bool sparse = true;                // fluid grid phases only on the blocks the points reach (pressure eos)
   // pressure model (keyword pressure): projection (default), the incompressible fluid of a pressure

@@ -163,8 +163,18 @@ void FluidSolver::step() {
   if (opt.projection && opt.volume_correction > 0.0) {
     const double hf = opt.fluid_every * clock.dt;
     const long every = Projection::volume_correction_every(opt.volume_correction, hf);
-    if ((clock.step / opt.fluid_every) % every == 0) vc_time = every * hf;
+    if (!opt.every_auto) {
+      if ((clock.step / opt.fluid_every) % every == 0) vc_time = every * hf;
+    } else {
+      // N varies: the correction's period every * hf is counted down in time
+      if (state.vc_due <= 0.5 * hf) {
+        vc_time = every * hf;
+        state.vc_due = vc_time;
+      }
+      state.vc_due -= hf;
+    }
   }
+  if (opt.every_auto) state.grain_tau = HUGE_VAL;  // this step's, for the next choice of N (couple_kernel)
   const bool samples = samples_on();
   if (walls_with_loads()) bc.record_loads(h);
   if (samples) begin_samples();

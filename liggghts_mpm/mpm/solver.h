@@ -50,6 +50,12 @@ struct SolverState {
   double n_clamped = 0;           // points put back inside a wall (cumulative)
   int nsub = 1;                   // fluid sub-steps per step (last check)
   bool theta_initialized = false; // fluid mass reduced by the grains' volume once
+  // every auto: the host step of the next fluid step (-1: the next step), the N of the last one,
+  // and the time left until the next volume correction
+  long next_fluid_step = -1;
+  int last_every = 1;
+  double vc_due = 0.0;
+  double grain_tau = HUGE_VAL;  // this rank's shortest drag response time m/K in the last fluid step
   ProjectionState projection;     // from a restart file, until the grid is set up (whole grid)
 };
 
@@ -87,8 +93,13 @@ class FluidSolver {
   void setup_coupling();
 
   // Time-step check of the current state (collective, throws mpm::Error): the number of fluid
-  // sub-steps of the next step (state.nsub); returns a log line when it changed at setup.
+  // sub-steps of the next step (state.nsub), and with every auto the N of the next fluid step
+  // (opt.fluid_every); returns a log line when it changed at setup.
   std::string check_timestep(bool at_setup);
+  // every auto: the largest N accepted (a fluid at rest without gravity has no limit of its own),
+  // and the limit that set N at the last check, in words with its value
+  static constexpr int kMaxEvery = 1000;
+  std::string every_auto_limit() const;
 
   // One fluid step of fluid_every * dt in state.nsub sub-steps; with couple, the fluid force on
   // the grains (mean over the sub-steps) goes to their state rows (C_FGRAIN) and grain_force(): the
@@ -312,6 +323,19 @@ class FluidSolver {
   void end_samples();
   std::vector<double> pvol_;          // volume_correction: sum S V of the points per node
   double vmax_ = 0.0;                 // |v|max of the points at the last time-step check
+  // every auto (timestep.cpp): the limits of the last check besides the fluid's own, and the one
+  // that set N
+  struct EveryAuto {
+    double grain_speed = 0.0;   // |v|max of the coupled grains
+    double accel = 0.0;         // |f/m|max of the points' external forces (gravity)
+    double wall_speed = 0.0;    // |w|max of the mesh walls' triangles near this rank
+    double grain_tau = HUGE_VAL;  // shortest drag response time m/K of a moving grain, all ranks
+    double limit = HUGE_VAL;    // the step N dt must not exceed
+    const char *which = "";
+  } auto_;
+  void choose_every();
+  double wall_speed2() const;
+  void auto_limits(const double *glob);
   long last_output_step_ = -1;
 };
 

@@ -23,9 +23,10 @@ double FluidSolver::stable_dt() {
   // the scene's pressure scale, the largest |f/m| squared of the points' external force (gravity)
   // and the points' extent
   double p_max = -HUGE_VAL, a2max = 0.0, ext[6] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  double vg2max = 0.0;  // every auto: the coupled grains' largest |v|^2
   const int n = pts.nlocal, *mask = pts.mask, point_bit = pts.point_bit;
   double *const *vel = pts.v, *const *state = pts.state;
-  const bool coupled = opt.coupled, eos_scale = !opt.projection && !range_warned_;
+  const bool coupled = opt.coupled, eos_scale = !opt.projection && !range_warned_, every_auto = opt.every_auto;
   for (int i = 0; i < n; ++i) {
     if (mask[i] & point_bit) {
       const double *v = vel[i], *s = state[i];
@@ -33,6 +34,10 @@ double FluidSolver::stable_dt() {
       const double rho = s[C_RHO];
       rho_max = std::max(rho_max, rho);
       mrho_max = std::max(mrho_max, -rho);
+      if (every_auto && !eos_scale) {
+        const double *f = pts.f[i], m = pts.rmass[i];
+        a2max = std::max(a2max, (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) / (m * m));
+      }
       if (eos_scale) {
         p_max = std::max(p_max, s[C_P]);
         const double *f = pts.f[i], *x = pts.x[i], m = pts.rmass[i];
@@ -52,12 +57,18 @@ double FluidSolver::stable_dt() {
     } else if (is_grain(i) && (mask[i] & pts.integrated_bits) && pts.radius[i] > 0.0) {
       const double r = pts.radius[i];
       mgrain_max = std::max(mgrain_max, -pts.rmass[i] / (4.0 / 3.0 * M_PI * r * r * r));
+      if (every_auto) {
+        const double *v = vel[i];
+        vg2max = std::max(vg2max, v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      }
     }
   }
-  double loc[14] = {std::sqrt(v2max), rho_max, mrho_max, ratio_max, mth_max, mgrain_max, p_max, a2max,
-                    ext[0], ext[1], ext[2], ext[3], ext[4], ext[5]};
-  double glob[14];
-  MPI_Allreduce(loc, glob, eos_scale ? 14 : 6, MPI_DOUBLE, MPI_MAX, comm_);
+  double loc[17] = {std::sqrt(v2max), rho_max, mrho_max, ratio_max, mth_max, mgrain_max, p_max, a2max,
+                    ext[0], ext[1], ext[2], ext[3], ext[4], ext[5], vg2max, every_auto ? wall_speed2() : 0.0,
+                    -this->state.grain_tau};
+  double glob[17];
+  MPI_Allreduce(loc, glob, every_auto ? 17 : eos_scale ? 14 : 6, MPI_DOUBLE, MPI_MAX, comm_);
+  if (every_auto) auto_limits(glob);
   if (eos_scale) {
     // rho0 (|a|max H + |v|max^2), H the points' largest extent: hydrostatic plus dynamic pressure
     double extent = 0.0;
@@ -77,6 +88,24 @@ double FluidSolver::stable_dt() {
   const double dt_visc = viscous_dt_limit(dx, eos.rho0, opt.viscosity, opt.dimension);
   coupled_limits(glob);
   return std::min(dt_ac, dt_visc);
+}
+
+// every auto: the mesh walls' largest node speed squared (the triangles near this rank)
+double FluidSolver::wall_speed2() const {
+  double w2max = 0.0;
+  if (bc.walls())
+    for (const WallGeometry::Tri &t : bc.walls()->triangles())
+      for (int q = 0; q < 3; ++q) w2max = std::max(w2max, t.w[q][0] * t.w[q][0] + t.w[q][1] * t.w[q][1] + t.w[q][2] * t.w[q][2]);
+  return w2max;
+}
+
+// every auto: the reduced maxima of stable_dt (|a|^2 at 7, grains' |v|^2 at 14, walls' at 15, minus
+// the grains' shortest response time at 16)
+void FluidSolver::auto_limits(const double *glob) {
+  auto_.accel = std::sqrt(glob[7]);
+  auto_.grain_speed = std::sqrt(glob[14]);
+  auto_.wall_speed = std::sqrt(glob[15]);
+  auto_.grain_tau = -glob[16];  // of the last fluid step (HUGE_VAL before the first)
 }
 
 // Grains an integrator moves: the pore-pressure waves (fluid_laws.h). The coupled wave limits the
@@ -126,9 +155,55 @@ std::string FluidSolver::range_warning() {
   return os.str();
 }
 
+/* every auto: N for the fluid step about to be taken, the largest with N dt within every limit of
+   the state now. Without sub-cycling: the fluid's own (advective, acoustic, viscous: stable_dt),
+   the coupled wave's, and the free-surface limit cfl sqrt(dx / |a|max) of the points' external
+   acceleration (a surface wave one cell long has omega^2 = g pi / dx; a point starting from rest
+   falls cfl^2 dx / 2 in one step). With 'subcycle yes' the fluid's sub-steps keep those, and the
+   grains' pore-pressure wave limits the step instead. Always: the grains' and the mesh walls'
+   advective limits cfl dx / |v|max (the fluid sees grains and walls only at its steps, so neither
+   may cross more than cfl cells in one), and cfl times the shortest drag response time m / K of a
+   moving grain at the last fluid step (the drag exchange is implicit and stable at any step, but a
+   grain's approach to its slip is resolved only on steps below m / K: C1's settling curve 7 % off
+   at 6 m / K). At least 1 (check_timestep then names a limit that one step exceeds), at most
+   kMaxEvery. */
+void FluidSolver::choose_every() {
+  constexpr double kTauShare = 0.1;  // of the shortest drag response time
+  const double cfl = opt.cfl, dx = opt.grid.dx;
+  auto_.limit = HUGE_VAL;
+  auto_.which = "none applies";
+  auto take = [&](double lim, const char *which) {
+    if (lim < auto_.limit) {
+      auto_.limit = lim;
+      auto_.which = which;
+    }
+  };
+  if (opt.subcycle) {
+    take(dt_grain_, "the grains' pore-pressure wave (the fluid sub-cycled)");
+  } else {
+    take(dt_stable_, "the fluid's stable step");
+    take(dt_couple_, "the coupled pore-pressure wave");
+    if (auto_.accel > 0.0) take(cfl * std::sqrt(dx / auto_.accel), "the free-surface limit cfl sqrt(dx/|a|max)");
+  }
+  if (auto_.grain_speed > 0.0) take(cfl * dx / auto_.grain_speed, "the grains' advective limit cfl dx/|v_grain|max");
+  take(kTauShare * auto_.grain_tau, "the grains' drag response 0.1 min(m/K)");
+  if (auto_.wall_speed > 0.0) take(cfl * dx / auto_.wall_speed, "the mesh walls' advective limit cfl dx/|w|max");
+  const double nmax = std::floor(auto_.limit / clock.dt);  // inf or NaN: none of the limits applies
+  opt.fluid_every = nmax >= kMaxEvery || std::isnan(nmax) ? kMaxEvery : nmax < 1.0 ? 1 : static_cast<int>(nmax);
+}
+
+std::string FluidSolver::every_auto_limit() const {
+  std::ostringstream os;
+  os.precision(6);
+  os << "limit: " << auto_.which;
+  if (std::isfinite(auto_.limit)) os << " = " << auto_.limit;
+  return os.str();
+}
+
 std::string FluidSolver::check_timestep(bool at_setup) {
   if (at_setup) range_warned_ = false;
   dt_stable_ = stable_dt();
+  if (opt.every_auto && !std::isnan(dt_stable_)) choose_every();
   const int every = opt.fluid_every;
   const double dt = every * clock.dt, cfl = opt.cfl, dx = opt.grid.dx;
   // (projection at rest without viscosity: no limit at all, dt_stable_ = inf)

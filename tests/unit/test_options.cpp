@@ -97,6 +97,22 @@ TEST(Options, ErrorsNameKeywordExpectationAndValue) {
   EXPECT_EQ(error_of(kBase + "viscosity 1e-3 couple grains theta_smooth 0"), "");
 }
 
+// every N or every auto: auto starts at N = 1 (the fluid's first step chooses N); anything else is
+// refused with the range and 'auto' named
+TEST(Options, EveryIntegerOrAuto) {
+  const mpm::Options a = parse(kBase + "every auto");
+  EXPECT_TRUE(a.every_auto);
+  EXPECT_EQ(a.fluid_every, 1);
+  const mpm::Options n = parse(kBase + "every 7");
+  EXPECT_FALSE(n.every_auto);
+  EXPECT_EQ(n.fluid_every, 7);
+  const std::string expect = "Fix mpm/fluid: keyword 'every' expects an integer N >= 1 (the fluid advances every N-th "
+                             "time step) or 'auto', got '";
+  EXPECT_EQ(error_of(kBase + "every 0"), expect + "0'");
+  EXPECT_EQ(error_of(kBase + "every Auto"), expect + "Auto'");
+  EXPECT_EQ(error_of(kBase + "every 2.5"), expect + "2.5'");
+}
+
 // fill ... inside mesh-ID [outside mesh-ID ...]: values, and refusals that name the keyword, what it
 // expects and the value (the meshes themselves are checked when the points are created)
 TEST(Options, FillInsideOutsideMeshes) {
