@@ -163,6 +163,23 @@ void check_derived(const Options &o) {
 
 }  // namespace
 
+// superficial_velocity: a periodic axis (the flux it holds passes the box's faces along it), no gate
+// across it (also after fix_modify)
+void check_drive(const Options &o) {
+  const FlowDrive &dr = o.drive;
+  if (!dr.active) return;
+  if (!o.grid.periodic[dr.axis]) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: keyword 'superficial_velocity' expects a periodic axis (the flux it holds leaves the box "
+       << "through one face and enters through the other), got '" << "xyz"[dr.axis]
+       << "', along which the box is not periodic (boundary p in that dimension)";
+    throw Error(os.str());
+  }
+  if (o.gate.active && o.gate.dim == dr.axis)
+    throw Error(std::string("Fix mpm/fluid: keyword 'gate' across axis ") + "xyz"[dr.axis] +
+                " stops the flux that keyword 'superficial_velocity' holds along it; remove one of them");
+}
+
 void check_inert(const Options &o, const std::vector<std::string> &seen, const char *command) {
   for (const Inert &r : kInert)
     if (std::find(seen.begin(), seen.end(), r.keyword) != seen.end() && r.inert(o))
@@ -229,6 +246,7 @@ void finish_options(Options &o, const std::vector<std::string> &seen, const bool
   const Gate &g = o.gate;
   if (g.active && !o.grid.periodic[g.dim] && (g.pos <= o.grid.origin[g.dim] || g.pos >= o.grid.upper(g.dim)))
     throw Error("Fix mpm/fluid: keyword 'gate' expects a position inside the grid");
+  check_drive(o);
   for (const Probe &p : o.probes)
     for (int d = 0; d < 3; ++d)
       if (!(p.lo[d] >= o.grid.origin[d] && p.hi[d] <= o.grid.upper(d))) {
