@@ -418,8 +418,9 @@ void FixMpmFluid::add_grain_force() {
       for (int d = 0; d < 3; ++d) f[k][d] += pdata[k][mpm::C_FGRAIN + d];
 }
 
-/* superficial_velocity v_name: the equal-style variable, looked up at every run's init (a script
-   may define or redefine it between runs) and evaluated before each fluid step. */
+/* superficial_velocity v_name: the equal-style variable, looked up at every run's init (an error
+   before the run) and before each fluid step (fix_modify may have named another between runs
+   that skip the setup), then evaluated. */
 void FixMpmFluid::find_drive_variable() {
   const mpm::FlowDrive &dr = solver->opt.drive;
   drive_var = -1;
@@ -433,12 +434,14 @@ void FixMpmFluid::find_drive_variable() {
 }
 
 void FixMpmFluid::drive_target() {
-  if (drive_var < 0) return;
+  const mpm::FlowDrive &dr = solver->opt.drive;
+  if (!dr.active || dr.variable.empty()) return;
+  find_drive_variable();
   const double u = input->variable->compute_equal(drive_var);
   if (!std::isfinite(u)) {
     std::ostringstream os;
     os << "Fix mpm/fluid: keyword 'superficial_velocity' expects a finite superficial velocity (velocity), got " << u
-       << " from variable v_" << solver->opt.drive.variable << " at step " << update->ntimestep;
+       << " from variable v_" << dr.variable << " at step " << update->ntimestep;
     error->all(FLERR, os.str().c_str());
   }
   solver->opt.drive.target = u;

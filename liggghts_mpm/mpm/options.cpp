@@ -349,25 +349,6 @@ void parse_probe(Options &o, Args &a, const ParseEnv &) {
   o.probes.push_back(p);
 }
 
-// superficial_velocity axis U|v_name (also fix_modify; a.iarg at the keyword)
-void parse_drive(Options &o, Args &a) {
-  const char *what = "an axis x, y or z and a superficial velocity (velocity), a number or v_name of an equal-style variable";
-  a.need(2, "superficial_velocity", what);
-  FlowDrive dr;
-  dr.active = true;
-  dr.axis = axis_of(a.at(1));
-  if (dr.axis < 0) bad_arg("superficial_velocity", "an axis x, y or z", a.at(1));
-  const char *v = a.at(2);
-  if (strncmp(v, "v_", 2) == 0) {
-    if (v[2] == '\0') bad_arg("superficial_velocity", "a variable name after 'v_'", v);
-    dr.variable = v + 2;
-  } else if (!parse_double(v, dr.target)) {
-    bad_arg("superficial_velocity", "a finite superficial velocity (velocity) or v_name of an equal-style variable", v);
-  }
-  o.drive = dr;
-  a.iarg += 3;
-}
-
 void parse_superficial_velocity(Options &o, Args &a, const ParseEnv &) { parse_drive(o, a); }
 
 void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
@@ -548,23 +529,7 @@ int modify_value(Options &o, const Keyword &k, int narg, char **arg) {
     o.gate.active = false;
     return 2;
   }
-  if (strcmp(arg[0], "superficial_velocity") == 0) {
-    // the fix's global vector has the gradient's entry only if the fix command gave the keyword,
-    // and the gradient it holds drives that axis
-    if (!o.drive.active)
-      throw Error("Fix mpm/fluid: fix_modify superficial_velocity needs the keyword in the fix command (the driving "
-                  "gradient's entry of the global vector is made there)");
-    const int axis = o.drive.axis;
-    Args a{narg, arg, 0};
-    parse_drive(o, a);
-    if (o.drive.axis != axis) {
-      const std::string got = arg[1];
-      o.drive.axis = axis;
-      bad_arg("fix_modify superficial_velocity", (std::string("the axis of the fix command, ") + "xyz"[axis]).c_str(),
-              got.c_str());
-    }
-    return a.iarg;
-  }
+  if (strcmp(arg[0], "superficial_velocity") == 0) return modify_drive(o, narg, arg);
   if (strcmp(arg[0], "boundary") == 0) {
     if (narg < 3)
       bad_arg("fix_modify boundary", "a face and 'noslip', 'freeslip', 'partial f' or 'shear delta'", nullptr);

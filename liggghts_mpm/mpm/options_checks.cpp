@@ -11,6 +11,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "mpm/args.h"
 #include "mpm/error.h"
 
 namespace mpm {
@@ -162,6 +163,45 @@ void check_derived(const Options &o) {
 }
 
 }  // namespace
+
+// superficial_velocity axis U|v_name (also fix_modify; a.iarg at the keyword)
+void parse_drive(Options &o, Args &a) {
+  const char *what = "an axis x, y or z and a superficial velocity (velocity), a number or v_name of an equal-style variable";
+  a.need(2, "superficial_velocity", what);
+  FlowDrive dr;
+  dr.active = true;
+  dr.axis = axis_of(a.at(1));
+  if (dr.axis < 0) bad_arg("superficial_velocity", "an axis x, y or z", a.at(1));
+  const char *v = a.at(2);
+  if (strncmp(v, "v_", 2) == 0) {
+    if (v[2] == '\0') bad_arg("superficial_velocity", "a variable name after 'v_'", v);
+    dr.variable = v + 2;
+  } else if (!parse_double(v, dr.target)) {
+    bad_arg("superficial_velocity", "a finite superficial velocity (velocity) or v_name of an equal-style variable", v);
+  }
+  o.drive = dr;
+  a.iarg += 3;
+}
+
+// fix_modify superficial_velocity axis U|v_name (arg[0] the keyword): returns the words used
+int modify_drive(Options &o, int narg, char **arg) {
+  // the fix's global vector has the gradient's entry only if the fix command gave the keyword,
+  // and the gradient it holds drives that axis
+  if (!o.drive.active)
+    throw Error("Fix mpm/fluid: fix_modify superficial_velocity needs the keyword in the fix command (the driving "
+                "gradient's entry of the global vector is made there)");
+  const FlowDrive before = o.drive;
+  const int axis = o.drive.axis;
+  Args a{narg, arg, 0};
+  parse_drive(o, a);
+  if (o.drive.axis != axis) {
+    const std::string got = arg[1];
+    o.drive = before;
+    bad_arg("fix_modify superficial_velocity", (std::string("the axis of the fix command, ") + "xyz"[axis]).c_str(),
+            got.c_str());
+  }
+  return a.iarg;
+}
 
 // superficial_velocity: a periodic axis (the flux it holds passes the box's faces along it), no gate
 // across it (also after fix_modify)
