@@ -123,7 +123,7 @@ def stages(cols):
         dp = mean("dP")
         sd = math.sqrt(sum((cols["dP"][i] - dp) ** 2 for i in half) / len(half))
         out.append({"U": mean("Ut"), "Um": mean("U"), "dP": dp, "dP_sd": sd, "zmean": mean("zmean"),
-                    "n": len(half)})
+                    "n": len(half), "nfloor": mean("nfloor") if "nfloor" in cols else float("nan")})
     return out
 
 
@@ -149,8 +149,8 @@ def analyse(folder, figure=None, out=sys.stdout):
       f"u_t = {ut:.4f} m/s (Re_t {re_t:.0f}), Richardson-Zaki n = {n:.3f}")
     p("")
     p("| U (m/s) | U held (m/s) | dP (Pa) | sd dP (Pa) | dP / (W/A) | Ergun at eps0 (Pa) | H / H0 | eps | "
-      "eps R-Z | eps / eps R-Z - 1 | eps of the law |")
-    p("|---|---|---|---|---|---|---|---|---|---|---|")
+      "eps R-Z | eps / eps R-Z - 1 | eps of the law | beads on the distributor |")
+    p("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for s in st:
         H = 2.0 * s["zmean"]
         eps = 1.0 - N * V / (A * H)
@@ -159,7 +159,7 @@ def analyse(folder, figure=None, out=sys.stdout):
         if H / H0 - 1.0 < 0.01 and s["dP"] < 0.97 * W:
             fixed.append(s)
             p(f"| {s['U']:.4f} | {s['Um']:.6f} | {s['dP']:.2f} | {s['dP_sd']:.2f} | {s['dP'] / W:.4f} | {erg:.2f} | "
-              f"{H / H0:.4f} | {eps:.4f} | - | - | - |")
+              f"{H / H0:.4f} | {eps:.4f} | - | - | - | {s['nfloor']:.1f} |")
         else:
             rz = (s["U"] / ut) ** (1.0 / n)
             law = law_voidage(s["U"], d, rhop, rho, mu, g)
@@ -167,7 +167,7 @@ def analyse(folder, figure=None, out=sys.stdout):
             if H / H0 - 1.0 > 0.02:
                 fluid.append(s)
             p(f"| {s['U']:.4f} | {s['Um']:.6f} | {s['dP']:.2f} | {s['dP_sd']:.2f} | {s['dP'] / W:.4f} | {erg:.2f} | "
-              f"{H / H0:.4f} | {eps:.4f} | {rz:.4f} | {eps / rz - 1.0:+.3f} | {law:.4f} |")
+              f"{H / H0:.4f} | {eps:.4f} | {rz:.4f} | {eps / rz - 1.0:+.3f} | {law:.4f} | {s['nfloor']:.1f} |")
     p("")
     result = {"inputs": res, "W": W, "umf_wy": umf_wy, "umf_ergun": umf_erg, "ut": ut, "n": n, "stages": st, "eps0": eps0, "H0": H0}
     # the onset: dP = a U + b U^2 through the fixed-bed stages (least squares), met with the plateau
@@ -246,7 +246,7 @@ def run(exe, work, variables, np=1, mpirun=None):
     p = subprocess.run(cmd, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace")
     with open(os.path.join(work, "log.txt"), "w") as f:
         f.write(p.stdout)
-    if p.returncode != 0:
+    if p.returncode != 0 or "ERROR" in p.stdout:
         raise RuntimeError("liggghts_mpm exited with %d:\n%s" % (p.returncode, "\n".join(p.stdout.splitlines()[-15:])))
 
 

@@ -23,7 +23,7 @@ sys.path.insert(0, os.path.join(HERE, "..", "..", "tools"))
 from cases import check, driver_main, read_csv  # noqa: E402
 import fluidized_bed as fb  # noqa: E402
 
-QUICK = {"Ulist": "0.02 0.05", "thold": 0.5, "nz": 10, "H0": 0.02, "tsettle": 0.15}
+QUICK = {"Ulist": "0.02 0.05", "thold": 0.6, "cellf": 2.0, "nxy": 3, "nz": 10, "H0": 0.03, "tsettle": 0.2}
 
 
 def case_quick(r):
