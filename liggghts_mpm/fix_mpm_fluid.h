@@ -104,6 +104,11 @@ class FixMpmFluid : public Fix {
   double restart_time = 0.0;          // the fix's time in the restart file, applied at init()
   bool restart_time_pending = false;
   int point_type = 0;  // atom type of the material points (fill type, or from the restart file)
+  // superficial_velocity v_name: the variable's index (looked up at init and before each fluid
+  // step), its value the target of the step
+  int drive_var = -1;
+  void find_drive_variable();
+  void drive_target();
 };
 
 }  // namespace LAMMPS_NS

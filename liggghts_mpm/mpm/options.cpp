@@ -353,6 +353,8 @@ void parse_probe(Options &o, Args &a, const ParseEnv &) {
   o.probes.push_back(p);
 }
 
+void parse_superficial_velocity(Options &o, Args &a, const ParseEnv &) { parse_drive(o, a); }
+
 void parse_mesh_wall(Options &, Args &a, const ParseEnv &env) {
   if (!env.mesh_wall) bad_arg("mesh_wall", "a LIGGGHTS host", nullptr);
   a.iarg = env.mesh_wall(a.narg, a.arg, a.iarg);
@@ -442,6 +444,9 @@ const std::vector<Keyword> kTable = {
      "'point x y z' or 'box xlo xhi ylo yhi zlo zhi' (length)", nullptr, 0, 0, false, false, nullptr, parse_probe, false},
     {"probe_window", "real", "time", ">= 0", "0 (each fluid step)", "a time window (time) >= 0 of the probes' average",
      REAL(probe_window), 0.0, kInf, false, true, nullptr, nullptr, false},
+    {"superficial_velocity", "axis U | axis v_name", "velocity", "axis periodic; U finite", "none",
+     "an axis x, y or z and a superficial velocity (velocity), a number or v_name of an equal-style variable",
+     nullptr, 0, 0, false, false, nullptr, parse_superficial_velocity, true},
     {"mesh_wall", "fix-ID kind [value] [side s] [loads yes|no] [reference_point x y z]", "-", "", "none",
      "a fix ID and noslip | freeslip | partial f | sticky f | shear delta f",
      nullptr, 0, 0, false, false, nullptr, parse_mesh_wall, false},
@@ -528,6 +533,7 @@ int modify_value(Options &o, const Keyword &k, int narg, char **arg) {
     o.gate.active = false;
     return 2;
   }
+  if (strcmp(arg[0], "superficial_velocity") == 0) return modify_drive(o, narg, arg);
   if (strcmp(arg[0], "boundary") == 0) {
     if (narg < 3)
       bad_arg("fix_modify boundary", "a face and 'noslip', 'freeslip', 'partial f' or 'shear delta'", nullptr);

@@ -39,6 +39,14 @@ struct Probe {
   bool box = false;
   double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.0, 0.0, 0.0};
 };
+// keyword superficial_velocity: the fluid's mean volume flux along a periodic axis held at a target
+// by a uniform driving pressure gradient (mpm/flow_drive.cpp)
+struct FlowDrive {
+  bool active = false;
+  int axis = 2;
+  double target = 0.0;   // superficial velocity (velocity); from the variable each fluid step if one is named
+  std::string variable;  // an equal-style variable of the host (given as v_name), or ""
+};
 enum class Transfer { Apic, Pic, Flip };
 // The coupling's forms (docs/theory): standard, the project's (the grains' pressure force is the
 // gradient the fluid itself feels, its reaction goes through the points that displaced it, the
@@ -118,6 +126,7 @@ struct Options {
   // pressure probes (keyword probe, one each) and the window of their time average (0: every fluid step)
   std::vector<Probe> probes;
   double probe_window = 0.0;
+  FlowDrive drive;
   // output
   int out_every = 0;
   std::string out_prefix;

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "mpm/args.h"
 #include "mpm/error.h"
 
 namespace mpm {
@@ -163,6 +164,62 @@ void check_derived(const Options &o) {
 
 }  // namespace
 
+// superficial_velocity axis U|v_name (also fix_modify; a.iarg at the keyword)
+void parse_drive(Options &o, Args &a) {
+  const char *what = "an axis x, y or z and a superficial velocity (velocity), a number or v_name of an equal-style variable";
+  a.need(2, "superficial_velocity", what);
+  FlowDrive dr;
+  dr.active = true;
+  dr.axis = axis_of(a.at(1));
+  if (dr.axis < 0) bad_arg("superficial_velocity", "an axis x, y or z", a.at(1));
+  const char *v = a.at(2);
+  if (strncmp(v, "v_", 2) == 0) {
+    if (v[2] == '\0') bad_arg("superficial_velocity", "a variable name after 'v_'", v);
+    dr.variable = v + 2;
+  } else if (!parse_double(v, dr.target)) {
+    bad_arg("superficial_velocity", "a finite superficial velocity (velocity) or v_name of an equal-style variable", v);
+  }
+  o.drive = dr;
+  a.iarg += 3;
+}
+
+// fix_modify superficial_velocity axis U|v_name (arg[0] the keyword): returns the words used
+int modify_drive(Options &o, int narg, char **arg) {
+  // the fix's global vector has the gradient's entry only if the fix command gave the keyword,
+  // and the gradient it holds drives that axis
+  if (!o.drive.active)
+    throw Error("Fix mpm/fluid: fix_modify superficial_velocity needs the keyword in the fix command (the driving "
+                "gradient's entry of the global vector is made there)");
+  const FlowDrive before = o.drive;
+  const int axis = o.drive.axis;
+  Args a{narg, arg, 0};
+  parse_drive(o, a);
+  if (o.drive.axis != axis) {
+    const std::string got = arg[1];
+    o.drive = before;
+    bad_arg("fix_modify superficial_velocity", (std::string("the axis of the fix command, ") + "xyz"[axis]).c_str(),
+            got.c_str());
+  }
+  return a.iarg;
+}
+
+// superficial_velocity: a periodic axis (the flux it holds passes the box's faces along it), no gate
+// across it (also after fix_modify)
+void check_drive(const Options &o) {
+  const FlowDrive &dr = o.drive;
+  if (!dr.active) return;
+  if (!o.grid.periodic[dr.axis]) {
+    std::ostringstream os;
+    os << "Fix mpm/fluid: keyword 'superficial_velocity' expects a periodic axis (the flux it holds leaves the box "
+       << "through one face and enters through the other), got '" << "xyz"[dr.axis]
+       << "', along which the box is not periodic (boundary p in that dimension)";
+    throw Error(os.str());
+  }
+  if (o.gate.active && o.gate.dim == dr.axis)
+    throw Error(std::string("Fix mpm/fluid: keyword 'gate' across axis ") + "xyz"[dr.axis] +
+                " stops the flux that keyword 'superficial_velocity' holds along it; remove one of them");
+}
+
 void check_inert(const Options &o, const std::vector<std::string> &seen, const char *command) {
   for (const Inert &r : kInert)
     if (std::find(seen.begin(), seen.end(), r.keyword) != seen.end() && r.inert(o))
@@ -229,6 +286,7 @@ void finish_options(Options &o, const std::vector<std::string> &seen, const bool
   const Gate &g = o.gate;
   if (g.active && !o.grid.periodic[g.dim] && (g.pos <= o.grid.origin[g.dim] || g.pos >= o.grid.upper(g.dim)))
     throw Error("Fix mpm/fluid: keyword 'gate' expects a position inside the grid");
+  check_drive(o);
   for (const Probe &p : o.probes)
     for (int d = 0; d < 3; ++d)
       if (!(p.lo[d] >= o.grid.origin[d] && p.hi[d] <= o.grid.upper(d))) {

@@ -70,6 +70,7 @@ void FluidSolver::global_vector(double *out, int walls) {
     out[kGlobalSize + c] = c < static_cast<int>(wall_mean_.size()) ? wall_mean_[c] : 0.0;
   for (std::size_t j = 0; j < opt.probes.size(); ++j)
     out[kGlobalSize + 6 * walls + j] = j < probe_mean_.size() ? probe_mean_[j] : 0.0;
+  if (opt.drive.active) out[kGlobalSize + 6 * walls + opt.probes.size()] = state.drive_gradient;
 }
 
 // since the fix was created: the Projection of each grid patch (a new one at every re-cut) adds

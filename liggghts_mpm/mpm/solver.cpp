@@ -178,8 +178,10 @@ void FluidSolver::step() {
   const bool samples = samples_on();
   if (walls_with_loads()) bc.record_loads(h);
   if (samples) begin_samples();
+  if (opt.drive.active) drive_force();
   for (int s = 0; s < state.nsub; ++s) substep(h, s == 0 ? vc_time : 0.0);
   if (samples) end_samples();
+  if (opt.drive.active) drive_correct(opt.fluid_every * clock.dt);
   if (!opt.coupled) return;
   // fluid force on the grains (mean over the sub-steps): kept in the state rows, from which the host
   // adds it to the grains' forces on each of the N DEM steps this fluid step covers (with every N;

@@ -56,6 +56,7 @@ struct SolverState {
   int last_every = 1;
   double vc_due = 0.0;
   double grain_tau = HUGE_VAL;  // this rank's shortest drag response time m/K in the last fluid step
+  double drive_gradient = 0.0;    // superficial_velocity: the driving pressure gradient of the last fluid step
   ProjectionState projection;     // from a restart file, until the grid is set up (whole grid)
 };
 
@@ -115,8 +116,11 @@ class FluidSolver {
   // then, from index kGlobalSize (f_ID[20] on): per mesh wall k (in the order of the fix command)
   // the fluid's force on it (3) and its torque about the wall's reference point (3): minus the
   // momentum the wall gave the fluid over the last fluid step per time (wall_loads.cpp); then per probe the pressure averaged
-  // over the last completed probe window. walls: the number of mesh walls of the host.
-  static int global_size(int walls, int probes) { return kGlobalSize + 6 * walls + probes; }
+  // over the last completed probe window; then, with superficial_velocity (drive), the driving
+  // pressure gradient of the last fluid step. walls: the number of mesh walls of the host.
+  static int global_size(int walls, int probes, bool drive = false) {
+    return kGlobalSize + 6 * walls + probes + (drive ? 1 : 0);
+  }
   void global_vector(double *out, int walls);
   // wall_loads.cpp: the pressure field the probes read in this sub-step, added to the probes' sums
   // with weight h, and (projection) the pressure correction's momentum to the mesh walls' loads
@@ -160,6 +164,11 @@ class FluidSolver {
   void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
   void update_stress(double h, bool theta_only = false);  // (7-21)-(7-24)
   void advance_positions(double h); // (8-41), points put back
+  // superficial_velocity (flow_drive.cpp): before the sub-steps, the driving gradient of the last
+  // fluid step as a body force on the points; after them, the fluid's mean flux set to the target
+  // by a uniform velocity increment, the gradient updated to the one that acted, the grains' share
+  void drive_force();
+  void drive_correct(double hf);
   void substep(double h, double vc_time = 0.0);  // all of them
   GridFields &fields() { return g_; }
   const LocalGrid &grid() const { return grid_; }

@@ -262,6 +262,61 @@ TEST(Options, InertKeywordsRefused) {
   EXPECT_EQ(error_of(kBase + "viscosity 1e-3 boundary xlo shear 1e-3"), "");
 }
 
+// superficial_velocity: a number or v_name on a periodic axis; refusals name the keyword, what it
+// expects and the value; fix_modify changes the value on the fix command's axis only.
+TEST(Options, SuperficialVelocity) {
+  auto periodic_z = [](const std::string &words) {
+    std::vector<std::string> w = {"f", "all", "mpm/fluid"};
+    std::istringstream is(words);
+    for (std::string s; is >> s;) w.push_back(s);
+    std::vector<char *> argv;
+    for (auto &s : w) argv.push_back(&s[0]);
+    mpm::ParseEnv env = box_env();
+    env.periodic[2] = true;
+    return mpm::parse_options(static_cast<int>(argv.size()), argv.data(), env);
+  };
+  mpm::Options o = periodic_z(kBase + "superficial_velocity z 0.05");
+  EXPECT_TRUE(o.drive.active);
+  EXPECT_EQ(o.drive.axis, 2);
+  EXPECT_DOUBLE_EQ(o.drive.target, 0.05);
+  EXPECT_TRUE(o.drive.variable.empty());
+  o = periodic_z(kBase + "superficial_velocity z v_U");
+  EXPECT_EQ(o.drive.variable, "U");
+  EXPECT_FALSE(parse(kBase).drive.active);
+  EXPECT_EQ(error_of(kBase + "superficial_velocity z 0.05"),
+            "Fix mpm/fluid: keyword 'superficial_velocity' expects a periodic axis (the flux it holds leaves the box "
+            "through one face and enters through the other), got 'z', along which the box is not periodic (boundary p "
+            "in that dimension)");
+  EXPECT_EQ(error_of(kBase + "superficial_velocity w 0.05"),
+            "Fix mpm/fluid: keyword 'superficial_velocity' expects an axis x, y or z, got 'w'");
+  EXPECT_EQ(error_of(kBase + "superficial_velocity z nan"),
+            "Fix mpm/fluid: keyword 'superficial_velocity' expects a finite superficial velocity (velocity) or v_name "
+            "of an equal-style variable, got 'nan'");
+  EXPECT_NE(error_of(kBase + "superficial_velocity z").find("got nothing"), std::string::npos);
+  try {
+    periodic_z(kBase + "superficial_velocity z 0.05 gate z 1 lower never");
+    ADD_FAILURE() << "gate across the driven axis accepted";
+  } catch (const mpm::Error &e) {
+    EXPECT_NE(std::string(e.what()).find("keyword 'gate' across axis z stops the flux"), std::string::npos) << e.what();
+  }
+  // fix_modify: a new value or variable on the same axis
+  o = periodic_z(kBase + "superficial_velocity z 0.05");
+  std::vector<std::string> w = {"superficial_velocity", "z", "0.1"};
+  std::vector<char *> a = {&w[0][0], &w[1][0], &w[2][0]};
+  EXPECT_EQ(mpm::modify_option(o, 3, a.data()), 3);
+  EXPECT_DOUBLE_EQ(o.drive.target, 0.1);
+  w = {"superficial_velocity", "x", "0.2"};
+  a = {&w[0][0], &w[1][0], &w[2][0]};
+  EXPECT_THROW(mpm::modify_option(o, 3, a.data()), mpm::Error);
+  EXPECT_EQ(o.drive.axis, 2);
+  EXPECT_DOUBLE_EQ(o.drive.target, 0.1);  // unchanged by the refused call
+  mpm::Options none = parse(kBase);
+  w = {"superficial_velocity", "z", "0.1"};
+  a = {&w[0][0], &w[1][0], &w[2][0]};
+  EXPECT_THROW(mpm::modify_option(none, 3, a.data()), mpm::Error);
+  EXPECT_FALSE(none.drive.active);
+}
+
 TEST(Options, RepeatedKeywordWarned) {
   const mpm::Options o = parse(kBase + "cfl 0.3 cfl 0.4 boundary xlo freeslip boundary xhi freeslip");
   ASSERT_EQ(o.warnings.size(), 1u);
