@@ -154,7 +154,10 @@ void Projection::acceleration_pressure(const double *vel, const double *theta, d
   });
   grid_.forward(acc_.data(), 3);
   acceleration_rhs(grid_, lab_, geo_, acc_.data(), theta, rhs_.data());
-  solve_rhs(p_acc_.data(), step, "the solve for the pressure of the acceleration (keyword 'pressure_output' or 'grain_pressure' acceleration)");
+  // (the operator of the projection's solve, the exact exchange's coefficients included: one
+  // matrix for both solves)
+  solve_rhs(p_acc_.data(), step, "the solve for the pressure of the acceleration (keyword 'pressure_output' or 'grain_pressure' acceleration)",
+            true);
   // behind mesh walls extrapolated linearly with its own gradient, as the multiplier (at rest
   // beside a 30 degree wall one pressure per row of points to 2e-11 rho g dx; with the mean of the
   // neighbours behind the wall instead, 0.27 rho g dx)
