@@ -198,6 +198,11 @@ double Projection::solve_pressure(const double *vel, const double *p2g, double m
   theta_now_ = theta;
   if (theta)
     for (std::size_t n = 0; n < beta_.size(); ++n) beta_[n] = theta[n] / opt_.rho0;
+  // the exact exchange's nodes (with grains) and the reaction of the grains' pressure force in u*:
+  // the solve makes the velocity with it divergence-free (exact_correction)
+  const double s = 1.0 + h * opt_.damping, hs = h / s;
+  exchange_weights(theta, p2g);
+  if (exact_) add_grain_reaction(p2g, hs);
   pressure_rhs(grid_, lab_, geo_, u_.data(), th, theta_prev, h, rhs_.data());
   // grid damping c (update_grid): u* = (u_old + h f / m) / s, s = 1 + h c, and the step is
   // s u = u_old + h f / m - h grad p / rho, i.e. u = u* - (h / s) grad p / rho. The solve gives
@@ -205,9 +210,7 @@ double Projection::solve_pressure(const double *vel, const double *p2g, double m
   // rest is rho g depth. Solving with h instead gave p / s, the multiplier of the damped u*:
   // 1 / (1 + 1e-3 s x 20 1/s) = 0.980 of rho g depth in the closed mesh box at rest
   // (docs/theory/projection.md, "Mesh walls: the pressure beside a mesh floor").
-  const double s = 1.0 + h * opt_.damping, hs = h / s;
   if (s != 1.0) grid_.for_owned([&](int, int, int, std::size_t n) { rhs_[n] *= s; });
-  exchange_weights(theta, p2g);
   last_ = solve_rhs(p_.data(), step, "the pressure projection", true);
   // for the points and grains: the padding nodes behind the box walls carry the pressure (and
   // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
@@ -394,6 +397,20 @@ void Projection::exchange_weights(const double *theta, const double *p2g) {
   });
   grid_.forward(wexact_.data(), 3);
   grid_.forward(beta3_.data(), 3);
+}
+
+// u_ (u*) plus h r / m along the directions where the node (or its host) takes the exact exchange
+// (exchange_weights), owned nodes, halos forwarded: the velocity the solve projects
+void Projection::add_grain_reaction(const double *p2g, double hs) {
+  if (!grain_reaction_) return;
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    const std::size_t c = lab_.kind[n] == kFluid ? n : host_[n];
+    if (c == static_cast<std::size_t>(-1)) return;
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    for (int d = 0; d < 3; ++d)
+      if (wexact_[3 * c + d] > 0.0) u_[3 * n + d] += hs * grain_reaction_[3 * n + d] / m;
+  });
+  grid_.forward(u_.data(), 3);
 }
 
 // the correction of the exact exchange (exchange_weights) at the owned FLUID nodes that take it:

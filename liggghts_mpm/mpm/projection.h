@@ -202,6 +202,7 @@ class Projection {
   std::vector<std::uint8_t> pass_of_;  // 0: the host is a face neighbour, 1: a neighbour's host
   const double *grain_reaction_ = nullptr;
   void exchange_weights(const double *theta, const double *p2g);
+  void add_grain_reaction(const double *p2g, double hs);
   void exact_correction(const double *vel, const double *p2g, double hs);
   std::vector<double> frac_, u_ext_;  // mesh walls (make_labels, project)
   bool mesh_ = false;
