@@ -319,8 +319,9 @@ void FluidSolver::couple_kernel(double h) {
   double *const gdr = g_.dr.data();
   if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
 
-  // projection: the grains feel the nodal gradient of the last solve (the one the fluid felt),
-  // and the fluid gets no pressure reaction (its share -theta grad p is in the projection)
+  // projection: the grains feel the nodal gradient of the last solve (grain_pressure); the fluid
+  // gets no pressure reaction as a force: the projection takes it along the periodic directions
+  // (the exact exchange, set_grain_reaction) and elsewhere its share -theta grad p is its correction
   const bool proj = opt.projection;
   const bool weak = opt.grad_p == GradP::Weak || proj;
   grain_pressure_inputs<NS>(proj, weak);
