@@ -176,7 +176,9 @@ void Projection::load_terms(const double *vel, const double *p2g, double mmin, c
       double g = 0.0;
       for (int q = 0; q < 2; ++q) g += c[q] * (q ? 1.0 : -1.0) * (load_pressure(nb[q]) - load_pressure(n)) * inv_dx;
       const double J = s * m * (u_[3 * n + d] - us[d]);
-      if ((exact_ && wexact_[3 * n + d] > 0.0) || std::fabs(g - grad_[3 * n + d]) > 1e-9 * (std::fabs(g) + std::fabs(grad_[3 * n + d])) + 1e-300) {
+      // (the exact exchange's components are not of that form)
+      const bool exact = exact_ && wexact_[3 * n + d] > 0.0;
+      if (exact || std::fabs(g - grad_[3 * n + d]) > 1e-9 * (std::fabs(g) + std::fabs(grad_[3 * n + d])) + 1e-300) {
         lr_[3 * n + d] += J;
         continue;
       }
@@ -363,7 +365,8 @@ void Projection::exchange_weights(const double *theta, const double *p2g) {
         for (int side = -1; side <= 1; side += 2) {
           std::size_t m = n;
           if (!open_face(grid_, lab_, i, j, k, d, side, &m)) continue;
-          const bool cand = pass == 0 ? lab_.kind[m] == kFluid : (wet_empty(m) && host_[m] != kNone && pass_of_[m] == 0);
+          const bool cand =
+              pass == 0 ? lab_.kind[m] == kFluid : (wet_empty(m) && host_[m] != kNone && pass_of_[m] == 0);
           if (!cand || !(lab_.level[m] > best)) continue;
           best = lab_.level[m];
           h = pass == 0 ? m : host_[m];
