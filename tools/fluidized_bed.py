@@ -31,18 +31,9 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "tests", "cases"))
+from cases import read_csv  # noqa: E402  (the case drivers' CSV reader, plain Python)
 INPUT = os.path.join(HERE, "..", "inputs", "fluidized_bed", "in.fluidized_bed")
-
-
-def read_csv(path):
-    with open(path) as f:
-        rows = [ln.strip() for ln in f if ln.strip()]
-    names = rows[0].split(",")
-    cols = {n: [] for n in names}
-    for r in rows[1:]:
-        for n, v in zip(names, r.split(",")):
-            cols[n].append(float(v))
-    return cols
 
 
 def read_result(log):
