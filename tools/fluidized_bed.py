@@ -33,6 +33,10 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tests", "cases"))
 from cases import read_csv  # noqa: E402  (the case drivers' CSV reader, plain Python)
+sys.path.insert(0, HERE)
+# per-bead drag coefficient K (F = K w) of the fix's ergun_wenyu law, consistent form
+# (docs/theory/drag.md), written out in suspension.py from the formulas, not taken from the code
+from suspension import k_ergun_wenyu  # noqa: E402
 INPUT = os.path.join(HERE, "..", "inputs", "fluidized_bed", "in.fluidized_bed")
 
 
@@ -54,17 +58,6 @@ def ergun_dp(U, eps, H, d, rho, mu):
 def wen_yu_umf(d, rhop, rho, mu, g):
     ar = rho * (rhop - rho) * g * d ** 3 / mu ** 2
     return (math.sqrt(33.7 ** 2 + 0.0408 * ar) - 33.7) * mu / (rho * d)
-
-
-def k_ergun_wenyu(rho, mu, d, th, w):
-    """Per-bead drag coefficient K (F = K w) of the fix's ergun_wenyu law, consistent form
-    (docs/theory/drag.md), written out here from the formulas, not taken from the code."""
-    v = math.pi * d ** 3 / 6
-    re_ = th * rho * w * d / mu
-    if th <= 0.8:
-        return v * mu / (d * d * th) * (150 * (1 - th) + 1.75 * re_)
-    cdre = 24 * (1 + 0.15 * re_ ** 0.687) if re_ <= 1000 else 0.43 * re_
-    return v * 0.75 * mu / d ** 2 * cdre * th ** -2.7
 
 
 def bisect(f, lo, hi, n=200):
