@@ -117,6 +117,9 @@ SPEC = {
     "probe": ([(("words", ["point", "box"]), "point"), (R(0, 0.4), "0.1"), (R(0, 0.05), "0.02"), (R(0, 0.3), "0.1")],
               "eos"),
     "probe_window": ([(R(0, INF, False, True), "0.01")], "probe"),
+    # the box is not periodic: every use is refused naming the keyword (the valid ones are tested by
+    # mpm_case.flow_drive_*)
+    "superficial_velocity": ([(AXIS, "z"), (R(-INF, INF, True, True), "0.01")], "eos"),
 }
 
 BAD_REAL = ["0", "-1", "nan", "inf", "-inf", "1e308", "-1e308", "1e-308", "1e400", "99999999999999999999",
