@@ -10,6 +10,7 @@
 
 #include "mpm/coupling.h"
 #include "mpm/error.h"
+#include "mpm/projection.h"
 #include "mpm/solver.h"
 
 namespace mpm {
@@ -246,7 +247,7 @@ template <int NS>
     const bool mobile = (pts.mask[k] & pts.integrated_bits) != 0;
     if (!mobile) ak[0] = ak[1] = ak[2] = 0.0;
     const Row4 r0 = {K, K * v[k][0], K * v[k][1], K * v[k][2]};
-    const Row4 r1 = proj ? Row4{rmass[k], 0.0, 0.0, 0.0} : Row4{rmass[k], -Fp[0], -Fp[1], -Fp[2]};
+    const Row4 r1 = {rmass[k], -Fp[0], -Fp[1], -Fp[2]};
     const Row4 r2 = {K * ak[0], K * ak[1], K * ak[2], mobile ? 0.0 : K};
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
       double *q = gdr + DrRec::N * n;
@@ -269,6 +270,7 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
   // held random bed 0.92 with h = 8.6 ms; proportional to h and to the viscosity).
   const double *pgrad = opt.projection && g_.gw.size() == 3 * grid_.size() ? g_.gw.data() : nullptr;
   const double inv_rho = 1.0 / opt.eos.rho0;
+  const bool proj = opt.projection;
   // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned
   // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -286,14 +288,16 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
       const double ag[3] = {q[DrRec::KA] / K, q[DrRec::KA + 1] / K, q[DrRec::KA + 2] / K};
       const double *f = &g_.p2g[P2gRec::N * n + P2gRec::F];
       const double mf = st[StRec::M];
-      double af[3] = {(f[0] + q[DrRec::FP]) / mf, (f[1] + q[DrRec::FP + 1]) / mf, (f[2] + q[DrRec::FP + 2]) / mf};
+      // (projection: the pressure reaction is not a force of u*; Projection::exact_correction)
+      const double fp[3] = {proj ? 0.0 : q[DrRec::FP], proj ? 0.0 : q[DrRec::FP + 1], proj ? 0.0 : q[DrRec::FP + 2]};
+      double af[3] = {(f[0] + fp[0]) / mf, (f[1] + fp[1]) / mf, (f[2] + fp[2]) / mf};
       if (pgrad)
         for (int d = 0; d < 3; ++d) af[d] -= pgrad[3 * n + d] * inv_rho;
       const double mg = q[DrRec::KFIX] > 0.0 ? HUGE_VAL : q[DrRec::M];
       drag_implicit_impulse(vg, st + StRec::U, mg, mf, K, h, J, ag, af);
     }
     for (int d = 0; d < 3; ++d) {
-      rx[d] = (opt.reaction_points ? 0.0 : q[DrRec::FP + d]) - J[d] / h;  // force on the fluid
+      rx[d] = (opt.reaction_points || proj ? 0.0 : q[DrRec::FP + d]) - J[d] / h;  // force on the fluid
       q[DrRec::J + d] = q[DrRec::K] > 0.0 ? J[d] / q[DrRec::K] : 0.0;  // impulse per unit K, to the grains
     }
   });
@@ -325,8 +329,9 @@ void FluidSolver::couple_kernel(double h) {
   double *const gdr = g_.dr.data();
   if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
 
-  // projection: the grains feel the nodal gradient of the last solve (the one the fluid felt),
-  // and the fluid gets no pressure reaction (its share -theta grad p is in the projection)
+  // projection: the grains feel the nodal gradient of the last solve (grain_pressure); the fluid
+  // gets no pressure reaction as a force: the projection takes it along the periodic directions
+  // (the exact exchange, set_grain_reaction) and elsewhere its share -theta grad p is its correction
   const bool proj = opt.projection;
   const bool weak = opt.grad_p == GradP::Weak || proj;
   grain_pressure_inputs<NS>(proj, weak);
@@ -374,6 +379,15 @@ void FluidSolver::couple_kernel(double h) {
 
   drag_exchange(dbox, h);
   if (opt.reaction_points && !proj) route_reaction<NS>();
+  // projection: the reaction of the grains' pressure force at the owned nodes, for the projection's
+  // exact exchange along the periodic directions (Projection::exact_correction)
+  if (proj) {
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+      const bool in = dbox.contains(i, j, k);
+      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = in ? gdr[DrRec::N * n + DrRec::FP + d] : 0.0;
+    });
+    proj_->set_grain_reaction(g_.rp.data());
+  }
   grid_.forward(g_.dr.data(), DrRec::N);
   grain_drag_forces<NS>(Kgrain, h);
   // pfit and dr are 0 at the next call (they are allocated 0 and no other code writes them): only

@@ -142,7 +142,12 @@ bool PressureSolver::unknown(const NodeLabels &labels, int i, int j, int k, std:
   return c.empty() || c[n] < 0.0 || long(c[n]) != node_key(i, j, k);
 }
 
-bool PressureSolver::assemble_values(const NodeLabels &labels, const double *beta) {
+// the coefficient of the face of n towards m along d: the mean of the two nodes' (solve's beta3)
+static inline double face_beta(const double *beta, const double *beta3, std::size_t n, std::size_t m, int d) {
+  return beta3 ? 0.5 * (beta3[3 * n + d] + beta3[3 * m + d]) : 0.5 * (beta[n] + beta[m]);
+}
+
+bool PressureSolver::assemble_values(const NodeLabels &labels, const double *beta, const double *beta3) {
   std::vector<double> v(h_->values.size(), 0.0);
   std::size_t row = 0;
   for_box(grid_, h_->box, [&](int i, int j, int k, std::size_t n) {
@@ -155,7 +160,7 @@ bool PressureSolver::assemble_values(const NodeLabels &labels, const double *bet
       for (int side = -1; side <= 1; side += 2) {
         std::size_t m;
         if (!open_face(grid_, labels, i, j, k, d, side, &m)) continue;
-        const double c = geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]) * surface_scale(labels, n, m);
+        const double c = geo_.area(d, i, j, k) * face_beta(beta, beta3, n, m, d) * surface_scale(labels, n, m);
         r[0] += c;
         int q[3] = {i, j, k};
         q[d] += side;
@@ -225,15 +230,15 @@ void PressureSolver::setup_solver() {
 }
 
 PressureResult PressureSolver::solve(const NodeLabels &labels_in, const double *beta, const double *rhs,
-                                     double *p, const double *p_empty) {
+                                     double *p, const double *p_empty, const double *beta3) {
   PressureResult res;
   const double t0 = MPI_Wtime();
   NodeLabels walled;
   const NodeLabels &labels = wall_in_enclosed(labels_in, walled, res);
   update_active_box(labels);
-  prepare_operator(labels, beta, res);
+  prepare_operator(labels, beta, beta3, res);
   const double t1 = MPI_Wtime();
-  load_vectors(labels, beta, rhs, p, p_empty, res);
+  load_vectors(labels, beta, beta3, rhs, p, p_empty, res);
   run_pcg(res);
   const double t2 = MPI_Wtime();
   res.setup_seconds = res.rebuilt ? t1 - t0 : 0.0;
@@ -324,7 +329,8 @@ void PressureSolver::update_active_box(const NodeLabels &labels) {
    matrix definite (PCG + PFMG stalls on the semidefinite one) without changing the solution of
    the compatible system up to its constant; p is returned with zero mean per set
    (store_solution). Then the matrix, and the preconditioner if it changed. Collective. */
-void PressureSolver::prepare_operator(const NodeLabels &labels, const double *beta, PressureResult &res) {
+void PressureSolver::prepare_operator(const NodeLabels &labels, const double *beta, const double *beta3,
+                                      PressureResult &res) {
   const IndexBox &ob = grid_.owned();
   long counts[3] = {0, 0, 0}, gcounts[3];  // EMPTY nodes, FLUID nodes, FLUID nodes with a closed face
   grid_.for_owned([&](int, int, int, std::size_t n) {
@@ -343,7 +349,7 @@ void PressureSolver::prepare_operator(const NodeLabels &labels, const double *be
   res.singular = gcounts[0] == 0 && gcounts[1] > 0;
   comp_.clear();
   if (res.singular || gcounts[2] > 0) res.sealed = seal_components(labels);
-  if (assemble_values(labels, beta) || !h_->pcg) {
+  if (assemble_values(labels, beta, beta3) || !h_->pcg) {
     setup_solver();
     res.rebuilt = true;
   }
@@ -352,8 +358,8 @@ void PressureSolver::prepare_operator(const NodeLabels &labels, const double *be
 /* hypre's b (right-hand side of -dx^2 L p = -dx^2 rhs, EMPTY neighbours' values moved over; per
    sealed set made compatible, its pinned node 0) and x (the first guess p) on the active box.
    Collective (sealed sets). */
-void PressureSolver::load_vectors(const NodeLabels &labels, const double *beta, const double *rhs, const double *p,
-                                  const double *p_empty, PressureResult &res) {
+void PressureSolver::load_vectors(const NodeLabels &labels, const double *beta, const double *beta3, const double *rhs,
+                                  const double *p, const double *p_empty, PressureResult &res) {
   Hypre &h = *h_;
   const IndexBox &ab = h.box;
   const double dx2 = grid_.spec().dx * grid_.spec().dx;
@@ -371,7 +377,7 @@ void PressureSolver::load_vectors(const NodeLabels &labels, const double *beta, 
         for (int side = -1; side <= 1; side += 2) {
           std::size_t m;
           if (open_face(grid_, labels, i, j, k, d, side, &m) && labels.kind[m] == kEmpty)
-            b += geo_.area(d, i, j, k) * 0.5 * (beta[n] + beta[m]) * surface_scale(labels, n, m) * p_empty[m];
+            b += geo_.area(d, i, j, k) * face_beta(beta, beta3, n, m, d) * surface_scale(labels, n, m) * p_empty[m];
         }
     if (!comp_.empty() && comp_[n] >= 0.0) {
       auto &e = bsums[long(comp_[n])];

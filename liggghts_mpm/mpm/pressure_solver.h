@@ -72,9 +72,11 @@ class PressureSolver {
      The hypre grid is rebuilt when the owned boxes change, the matrix and the
      preconditioner when labels, beta or the geometry differ from the last call.
      Without any EMPTY node the operator has the constants as null space: the mean of rhs
-     over the FLUID nodes is removed (reported) and p is returned with zero mean. */
+     over the FLUID nodes is removed (reported) and p is returned with zero mean.
+     beta3 (null: beta in every direction): per node and direction (3 n + d) the coefficient of the
+     faces along d (the face's coefficient the mean of its two nodes', as with beta). */
   PressureResult solve(const NodeLabels &labels, const double *beta, const double *rhs, double *p,
-                       const double *p_empty = nullptr);
+                       const double *p_empty = nullptr, const double *beta3 = nullptr);
 
   const PressureSettings &settings() const { return settings_; }
   const ProjectionGeometry &geometry() const { return geo_; }
@@ -82,7 +84,7 @@ class PressureSolver {
  private:
   struct Hypre;
   void build_grid(const IndexBox &box);
-  bool assemble_values(const NodeLabels &labels, const double *beta);
+  bool assemble_values(const NodeLabels &labels, const double *beta, const double *beta3);
   void setup_solver();
   bool any_periodic() const;
   long node_key(int i, int j, int k) const;
@@ -92,9 +94,9 @@ class PressureSolver {
   // solve's steps, in order (pressure_solver.cpp)
   const NodeLabels &wall_in_enclosed(const NodeLabels &labels_in, NodeLabels &walled, PressureResult &res) const;
   void update_active_box(const NodeLabels &labels);
-  void prepare_operator(const NodeLabels &labels, const double *beta, PressureResult &res);
-  void load_vectors(const NodeLabels &labels, const double *beta, const double *rhs, const double *p,
-                    const double *p_empty, PressureResult &res);
+  void prepare_operator(const NodeLabels &labels, const double *beta, const double *beta3, PressureResult &res);
+  void load_vectors(const NodeLabels &labels, const double *beta, const double *beta3, const double *rhs,
+                    const double *p, const double *p_empty, PressureResult &res);
   void run_pcg(PressureResult &res);
   void store_solution(const NodeLabels &labels, double *p, const double *p_empty);
   std::map<long, std::pair<double, long>> component_sums(const std::map<long, std::pair<double, long>> &mine) const;

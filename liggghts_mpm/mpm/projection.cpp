@@ -84,10 +84,11 @@ void Projection::form_gradient(std::vector<double> &p, std::vector<double> &grad
   if (mesh_) fill_wall_gradient(grad);
 }
 
-PressureResult Projection::solve_rhs(double *p, long step, const char *subject) {
+PressureResult Projection::solve_rhs(double *p, long step, const char *subject, bool exact) {
   try {
     const double t0 = MPI_Wtime();
-    const PressureResult r = solver_->solve(lab_, beta_.data(), rhs_.data(), p);
+    const PressureResult r =
+        solver_->solve(lab_, beta_.data(), rhs_.data(), p, nullptr, exact && exact_ ? beta3_.data() : nullptr);
     solver_seconds_ += MPI_Wtime() - t0;
     ++solves_;  // every solve (the acceleration pressure's too), as the time
     iterations_summed_ += r.iterations;
@@ -142,6 +143,7 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   make_labels(p2g, mmin, theta, bc.walls(), {u_.data(), 3});
   const double hs = solve_pressure(vel, p2g, mmin, theta, h, step);
   correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), hs, u_.data());
+  if (exact_) exact_correction(vel, p2g, hs);
   grid_.forward(u_.data(), 3);
   if (pvol && opt_.volume_correction > 0.0 && vc_time > 0.0)
     volume_drift(pvol, theta, h, std::min(opt_.volume_correction * vc_time, 1.0), step);
@@ -174,7 +176,9 @@ void Projection::load_terms(const double *vel, const double *p2g, double mmin, c
       double g = 0.0;
       for (int q = 0; q < 2; ++q) g += c[q] * (q ? 1.0 : -1.0) * (load_pressure(nb[q]) - load_pressure(n)) * inv_dx;
       const double J = s * m * (u_[3 * n + d] - us[d]);
-      if (std::fabs(g - grad_[3 * n + d]) > 1e-9 * (std::fabs(g) + std::fabs(grad_[3 * n + d])) + 1e-300) {
+      // (the exact exchange's components are not of that form)
+      const bool exact = exact_ && wexact_[3 * n + d] > 0.0;
+      if (exact || std::fabs(g - grad_[3 * n + d]) > 1e-9 * (std::fabs(g) + std::fabs(grad_[3 * n + d])) + 1e-300) {
         lr_[3 * n + d] += J;
         continue;
       }
@@ -196,6 +200,11 @@ double Projection::solve_pressure(const double *vel, const double *p2g, double m
   theta_now_ = theta;
   if (theta)
     for (std::size_t n = 0; n < beta_.size(); ++n) beta_[n] = theta[n] / opt_.rho0;
+  // the exact exchange's nodes (with grains) and the reaction of the grains' pressure force in u*:
+  // the solve makes the velocity with it divergence-free (exact_correction)
+  const double s = 1.0 + h * opt_.damping, hs = h / s;
+  exchange_weights(theta, p2g);
+  if (exact_) add_grain_reaction(p2g, hs);
   pressure_rhs(grid_, lab_, geo_, u_.data(), th, theta_prev, h, rhs_.data());
   // grid damping c (update_grid): u* = (u_old + h f / m) / s, s = 1 + h c, and the step is
   // s u = u_old + h f / m - h grad p / rho, i.e. u = u* - (h / s) grad p / rho. The solve gives
@@ -203,14 +212,20 @@ double Projection::solve_pressure(const double *vel, const double *p2g, double m
   // rest is rho g depth. Solving with h instead gave p / s, the multiplier of the damped u*:
   // 1 / (1 + 1e-3 s x 20 1/s) = 0.980 of rho g depth in the closed mesh box at rest
   // (docs/theory/projection.md, "Mesh walls: the pressure beside a mesh floor").
-  const double s = 1.0 + h * opt_.damping, hs = h / s;
   if (s != 1.0) grid_.for_owned([&](int, int, int, std::size_t n) { rhs_[n] *= s; });
-  last_ = solve_rhs(p_.data(), step, "the pressure projection");
+  last_ = solve_rhs(p_.data(), step, "the pressure projection", true);
   // for the points and grains: the padding nodes behind the box walls carry the pressure (and
   // gradient) of the wall node in front (the solve holds them at 0; interpolated as they are,
   // they would lower the pressure of the points next to a wall by half a cell's hydrostatic step)
   // (first the nodes behind mesh walls, which the padding nodes behind them then copy)
   form_gradient(p_, grad_, p2g, mmin, true, true);
+  if (exact_) {
+    // the plain mean of the two face gradients (exact_correction reads it where both neighbours
+    // along the direction are FLUID, where the EMPTY nodes' extrapolated pressure is not read)
+    gplain_.assign(3 * grid_.size(), 0.0);
+    pressure_gradient(grid_, lab_, p_.data(), gplain_.data(), nullptr);
+    grid_.forward(gplain_.data(), 3);
+  }
   extend_for_points(p_, grad_, p2g, mmin, p_ext_, &grad_ext_);
   if (theta && !mesh_) mirror_to_padding(grad_, grad_ext_);
   if (theta) {
@@ -274,6 +289,16 @@ void Projection::padding_velocity(double *v, int i, int j, int k, bool grains, d
   if (grid_.in_patch(q[0], q[1], q[2])) mq = grid_.index(q[0], q[1], q[2]);
   const bool mq_fluid = lab_.kind[mq] != kSolid;
   for (int d = 0; d < 3; ++d) ut[d] = mq_fluid ? v[d] - hs * inv_rho_[mq] * grad_[3 * mq + d] : 0.0;
+  if (exact_ && grains && mq_fluid) {
+    // the exact exchange at the mirror node: this node's mass shares its full-volume correction
+    // (the folded mass) and receives the reaction of the grains' pressure force here
+    const std::size_t n = grid_.index(i, j, k);
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    for (int d = 0; d < 3; ++d)
+      if (wexact_[3 * mq + d] > 0.0)
+        ut[d] = v[d] - hs * wexact_[3 * mq + d] * gplain_[3 * mq + d] +
+                (grain_reaction_ ? hs * grain_reaction_[3 * n + d] / m : 0.0);
+  }
   for (int d = 0; d < 3; ++d) v[d] = wall_fluid ? u_[3 * c + d] : 0.0;
   if (grains && !mesh_)
     for (int d = 0; d < 3; ++d)
@@ -300,6 +325,118 @@ void Projection::mirror_normal(double *v, int i, int j, int k, const double *p2g
   const bool fluid = lab_.kind[mn] != kSolid && mm > mmin && mm > 0.0;
   for (int d = 0; d < 3; ++d)
     if (out[d]) v[d] = fluid ? -u_[3 * mn + d] : 0.0;
+}
+
+/* Exact exchange of momentum with the grains (docs/theory/projection.md, "Momentum of grains and
+   fluid"), along the periodic directions d of a run with grains and box walls only: at a FLUID
+   node whose two neighbours along d are FLUID the fluid's momentum changes by
+   -h V_n Gp_n,d + h r_n,d, Gp the plain mean of the two face gradients (sum_n V_n Gp_n,d telescopes
+   to 0 along a periodic row), r the reaction of the pressure force the grains received at the
+   node: the pressure creates no momentum along d whatever gradient the grains read. The velocity
+   change is that over the folded mass (the node's and its mirror images' in the padding, which
+   share it: padding_velocity); the operator's coefficient of those faces is theta_n V_n / m_n in
+   place of theta_n / rho0, so that the corrected fluxes keep the divergence constraint. Along the
+   walls' normals and elsewhere (the surface, EMPTY nodes, runs without grains) as before, 1 / rho0:
+   a fluid at rest keeps the hydrostatic pressure exactly. */
+void Projection::exchange_weights(const double *theta, const double *p2g) {
+  const GridSpec &gs = opt_.grid;
+  exact_ = theta && !mesh_ && opt_.surface_ghost && (gs.periodic[0] || gs.periodic[1] || gs.periodic[2]);
+  if (!exact_) return;
+  const double dx = gs.dx, dx3 = dx * dx * dx;
+  wexact_.assign(3 * grid_.size(), 0.0);
+  beta3_.assign(3 * grid_.size(), 0.0);
+  // the EMPTY nodes holding fluid (the mass the B-spline spreads beyond the surface) share the
+  // correction of a FLUID node, their host, as the padding nodes share their mirror node's: the
+  // host's mass in the correction includes theirs. The host of one next to FLUID nodes is the
+  // deepest of them (largest level); of one next to such EMPTY nodes only, the host of the one of
+  // them with the largest level. Found on the whole patch (halos too), so that an owned node's
+  // second layer is the same on every rank; one without either keeps the 1 / rho0 form
+  constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  host_.assign(grid_.size(), kNone);
+  pass_of_.assign(grid_.size(), 0);
+  host_mass_.assign(grid_.size(), 0.0);
+  auto wet_empty = [&](std::size_t n) { return lab_.kind[n] == kEmpty && lab_.wet[n]; };
+  for (int pass = 0; pass < 2; ++pass)
+    grid_.for_box(grid_.patch(), [&](int i, int j, int k, std::size_t n) {
+      if (!wet_empty(n) || host_[n] != kNone) return;
+      double best = -1e300;
+      std::size_t h = kNone;
+      for (int d = 0; d < 3; ++d)
+        for (int side = -1; side <= 1; side += 2) {
+          std::size_t m = n;
+          if (!open_face(grid_, lab_, i, j, k, d, side, &m)) continue;
+          const bool cand =
+              pass == 0 ? lab_.kind[m] == kFluid : (wet_empty(m) && host_[m] != kNone && pass_of_[m] == 0);
+          if (!cand || !(lab_.level[m] > best)) continue;
+          best = lab_.level[m];
+          h = pass == 0 ? m : host_[m];
+        }
+      if (h != kNone) {
+        host_[n] = h;
+        pass_of_[n] = static_cast<std::uint8_t>(pass);
+      }
+    });
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    if (host_[n] != kNone) host_mass_[host_[n]] += p2g[P2gRec::N * n + P2gRec::M];
+  });
+  grid_.reverse_sum(host_mass_.data(), 1);
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    for (int d = 0; d < 3; ++d) beta3_[3 * n + d] = beta_[n];
+    if (lab_.kind[n] != kFluid) return;
+    const double mf = folded_mass(i, j, k) + host_mass_[n];
+    if (!(mf > 0.0)) return;
+    for (int d = 0; d < 3; ++d) {
+      if (!gs.periodic[d]) continue;
+      bool inner = true;
+      for (int side = -1; side <= 1 && inner; side += 2) {
+        std::size_t m = n;
+        inner = open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kFluid;
+      }
+      if (!inner) continue;
+      const double w = geo_.volume(i, j, k) * dx3 / mf;
+      wexact_[3 * n + d] = w;
+      beta3_[3 * n + d] = theta[n] * w;
+    }
+  });
+  grid_.forward(wexact_.data(), 3);
+  grid_.forward(beta3_.data(), 3);
+}
+
+// u_ (u*) plus h r / m along the directions where the node (or its host) takes the exact exchange
+// (exchange_weights), owned nodes, halos forwarded: the velocity the solve projects
+void Projection::add_grain_reaction(const double *p2g, double hs) {
+  if (!grain_reaction_) return;
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    const std::size_t c = lab_.kind[n] == kFluid ? n : host_[n];
+    if (c == static_cast<std::size_t>(-1)) return;
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    for (int d = 0; d < 3; ++d)
+      if (wexact_[3 * c + d] > 0.0) u_[3 * n + d] += hs * grain_reaction_[3 * n + d] / m;
+  });
+  grid_.forward(u_.data(), 3);
+}
+
+// the correction of the exact exchange (exchange_weights) at the owned FLUID nodes that take it:
+// u = u* - h V Gp / m_fold + h r / m along those directions (u_ holds the 1 / rho0 form there)
+void Projection::exact_correction(const double *vel, const double *p2g, double hs) {
+  grid_.for_owned([&](int, int, int, std::size_t n) {
+    const double m = p2g[P2gRec::N * n + P2gRec::M];
+    for (int d = 0; d < 3; ++d) {
+      const double w = wexact_[3 * n + d];
+      if (!(w > 0.0)) continue;
+      const double us = vel[VelRec::N * n + VelRec::V_NEW + d];
+      u_[3 * n + d] = us - hs * w * gplain_[3 * n + d] + (grain_reaction_ ? hs * grain_reaction_[3 * n + d] / m : 0.0);
+    }
+    // an EMPTY node holding fluid: its host's correction
+    const std::size_t c = host_[n];
+    if (c == static_cast<std::size_t>(-1)) return;
+    for (int d = 0; d < 3; ++d) {
+      const double w = wexact_[3 * c + d];
+      if (!(w > 0.0)) continue;
+      const double us = vel[VelRec::N * n + VelRec::V_NEW + d];
+      u_[3 * n + d] = us - hs * w * gplain_[3 * c + d] + (grain_reaction_ ? hs * grain_reaction_[3 * n + d] / m : 0.0);
+    }
+  });
 }
 
 }  // namespace mpm

@@ -74,6 +74,10 @@ class Projection {
   // walls with the pressure of the wall node in front (for interpolation to points); with
   // pressure_output acceleration the pressure of the fluid's acceleration (acceleration_pressure)
   const std::vector<double> &pressure() const { return opt_.pressure_acceleration ? p_acc_ext_ : p_ext_; }
+  // the force of the grains' pressure force on the fluid (its reaction, 3 per node, owned nodes)
+  // for the next project: with grains, the fluid receives it along the periodic directions
+  // (exact_correction); null: none
+  void set_grain_reaction(const double *r) { grain_reaction_ = r; }
   // nodal pressure gradient for the grains (owned nodes and halos; padding nodes with the wall
   // node's): of the last solve, the one the fluid felt; with grain_pressure acceleration that of
   // the pressure of the fluid's acceleration
@@ -137,7 +141,7 @@ class Projection {
                      bool above_surface, bool with_p);
   // one solve of the operator with rhs_ into p (warm start), timed into solver_seconds_; a solve
   // that does not converge is an error naming subject and the step
-  PressureResult solve_rhs(double *p, long step, const char *subject);
+  PressureResult solve_rhs(double *p, long step, const char *subject, bool exact = false);
   // p and its nodal gradient for the points and grains: behind mesh walls extrapolated linearly
   // with the extended gradient (grad read only with mesh walls), then into the padding nodes
   void extend_for_points(const std::vector<double> &p, const std::vector<double> &grad, const double *p2g,
@@ -189,6 +193,17 @@ class Projection {
   const double *theta_now_ = nullptr;  // the fluid fraction of this step (null: 1), for the gradient
   std::vector<double> u_, theta_, beta_, rhs_, p_, p_ext_, grad_, grad_ext_, inv_rho_;
   std::vector<double> fold_mass_;   // node mass, owned and halos (ghost surface's fill)
+  // Exact exchange with grains along the periodic directions (exchange_weights, exact_correction):
+  // per node and direction V_n / (folded mass) where the node takes the full-volume correction (0
+  // elsewhere), the operator's coefficients, the plain nodal gradient; the grains' reaction
+  bool exact_ = false;
+  std::vector<double> wexact_, beta3_, gplain_, host_mass_;
+  std::vector<std::size_t> host_;  // per EMPTY node holding fluid: its FLUID host (exchange_weights)
+  std::vector<std::uint8_t> pass_of_;  // 0: the host is a face neighbour, 1: a neighbour's host
+  const double *grain_reaction_ = nullptr;
+  void exchange_weights(const double *theta, const double *p2g);
+  void add_grain_reaction(const double *p2g, double hs);
+  void exact_correction(const double *vel, const double *p2g, double hs);
   std::vector<double> frac_, u_ext_;  // mesh walls (make_labels, project)
   bool mesh_ = false;
   std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)

@@ -154,6 +154,8 @@ void Projection::acceleration_pressure(const double *vel, const double *theta, d
   });
   grid_.forward(acc_.data(), 3);
   acceleration_rhs(grid_, lab_, geo_, acc_.data(), theta, rhs_.data());
+  // (with theta / rho0 in every direction, also where the projection's solve has the exact
+  // exchange's coefficients: the pressure of the acceleration of the fluid as it is)
   solve_rhs(p_acc_.data(), step, "the solve for the pressure of the acceleration (keyword 'pressure_output' or 'grain_pressure' acceleration)");
   // behind mesh walls extrapolated linearly with its own gradient, as the multiplier (at rest
   // beside a 30 degree wall one pressure per row of points to 2e-11 rho g dx; with the mean of the
