@@ -419,7 +419,7 @@ void FixMpmFluid::note_every(mpm::FluidSolver &s) {
   }
   if (cap >= 1 && s.opt.fluid_every > cap) s.opt.fluid_every = static_cast<int>(cap);
   const int n = s.opt.fluid_every;
-  s.state.next_fluid_step = static_cast<long>(update->ntimestep) + n;
+  s.state.next_fluid_step = now + n;
   s.state.last_every = n;
   every_run[0] = every_run[2] == 0.0 ? n : std::min(every_run[0], double(n));
   every_run[1] = std::max(every_run[1], double(n));

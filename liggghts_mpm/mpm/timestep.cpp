@@ -34,14 +34,13 @@ double FluidSolver::stable_dt() {
       const double rho = s[C_RHO];
       rho_max = std::max(rho_max, rho);
       mrho_max = std::max(mrho_max, -rho);
-      if (every_auto && !eos_scale) {
+      if (eos_scale || every_auto) {  // the external acceleration: eos's pressure scale, every auto's surface limit
         const double *f = pts.f[i], m = pts.rmass[i];
         a2max = std::max(a2max, (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) / (m * m));
       }
       if (eos_scale) {
         p_max = std::max(p_max, s[C_P]);
-        const double *f = pts.f[i], *x = pts.x[i], m = pts.rmass[i];
-        a2max = std::max(a2max, (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) / (m * m));
+        const double *x = pts.x[i];
         for (int d = 0; d < 3; ++d) {
           ext[2 * d] = std::max(ext[2 * d], x[d]);
           ext[2 * d + 1] = std::max(ext[2 * d + 1], -x[d]);
