@@ -58,6 +58,15 @@ int tee_close(void *cookie) {
   return rc;
 }
 
+// LIGGGHTS' error->all and error->one append, one time in five, a "comment from the off" or a "tip
+// of the day" after the ERROR line, and they print it from the buffer of a std::string that has
+// already been destroyed: a line of garbage in the screen and the log after the error. They do so
+// only when the library's version string contains "PUBLIC"; the instance's string (its own buffer)
+// is made to spell it "Public" after the banner has been printed (restart files carry that spelling).
+void quiet_error_jokes(LAMMPS_NS::LAMMPS *lmp) {
+  if (char *at = std::strstr(lmp->universe->version, "PUBLIC")) std::memcpy(at, "Public", 6);
+}
+
 }  // namespace
 
 // Every abort of this executable goes through here (the MPI profiling interface: libliggghts'
@@ -121,6 +130,7 @@ int main(int argc, char **argv) {
       delete tee;
     }
   }
+  quiet_error_jokes(lmp);
   mpm::register_styles(lmp);
   if (help) {
     if (lmp->universe->me == 0) mpm::print_help(lmp, LIGGGHTS_MPM_VERSION);

@@ -98,7 +98,14 @@ PressureResult Projection::solve_rhs(double *p, long step, const char *subject, 
     os << "Fix mpm/fluid: " << subject << " did not converge at step " << step << ": " << e.iterations
        << " PCG iterations (keyword 'max_iterations' " << opt_.pressure_max_iterations << "), relative residual "
        << e.residual << " (keyword 'tolerance' " << opt_.pressure_tolerance << ")";
-    if (std::isnan(e.residual)) os << "; " << e.what();  // hypre failed (INF or NaN), not a slow convergence
+    if (std::isnan(e.residual)) {
+      os << "; " << e.what();  // hypre failed (INF or NaN), not a slow convergence
+    } else if (e.iterations < opt_.pressure_max_iterations) {
+      // PCG stopped before max_iterations without converging: a breakdown (a step length <= 0),
+      // which more iterations or a looser tolerance do not cure
+      os << "; PCG broke down before 'max_iterations' (the preconditioned operator was not positive definite "
+            "for this state), so neither more iterations nor another tolerance helps: please report the input";
+    }
     throw Error(os.str());
   }
 }

@@ -760,6 +760,56 @@ TEST(PressureSolver, ClosedBoxFullOfFluid) {
   EXPECT_LT(std::fabs(PS) / VS[1], 1e-12);
 }
 
+// A box periodic along all three directions, full of fluid with a fluid fraction that varies over
+// two decades and a random source, for 40 seeds: every solve converges to L p = the compatible
+// source. Returns the number of solves that did not converge.
+int periodic_random_fields(int nx, int ny, int nz) {
+  mpm::GridSpec g = cube(nx, ny, nz, 0.0045);
+  for (int d = 0; d < 3; ++d) g.periodic[d] = true;
+  int worst_iterations = 0, failed = 0;
+  double worst = 0.0;
+  for (int seed = 0; seed < 40; ++seed) {
+    Problem P(g, MPI_COMM_WORLD, 0.5);
+    P.each_patch([&](int i, int j, int k, std::size_t n) { P.beta[n] = std::pow(10.0, -2.0 * hash01(i, j, k, 100 + seed)) / 1000.0; });
+    P.grid.for_owned([&](int i, int j, int k, std::size_t n) { P.rhs[n] = hash01(i, j, k, 200 + seed) - 0.5; });
+    mpm::PressureSolver solver(P.grid, MPI_COMM_WORLD, tight(1e-10), P.geo);
+    try {
+      const mpm::PressureResult r = solver.solve(P.lab, P.beta.data(), P.rhs.data(), P.p.data());
+      worst_iterations = std::max(worst_iterations, r.iterations);
+      std::vector<double> Lp(P.grid.size());
+      mpm::apply_laplacian(P.grid, P.lab, P.geo, P.beta.data(), P.p.data(), Lp.data());
+      double loc[2] = {0.0, 0.0}, glob[2];
+      P.grid.for_owned([&](int, int, int, std::size_t n) {
+        loc[0] += P.rhs[n];
+        loc[1] += 1.0;
+      });
+      MPI_Allreduce(loc, glob, 2, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+      const double mean = glob[0] / glob[1];
+      worst = std::max(worst, P.max_owned([&](int, int, int, std::size_t n) { return std::fabs(Lp[n] - (P.rhs[n] - mean)); }));
+    } catch (const mpm::PressureSolveError &e) {
+      ++failed;
+      if (root()) std::printf("[ periodic ] %d x %d x %d, seed %d: %s\n", nx, ny, nz, seed, e.what());
+    }
+  }
+  if (root())
+    std::printf("[ periodic ] %d x %d x %d fully periodic, 40 random fields: %d did not converge, at most %d PCG "
+                "iterations, max |L p - compatible source| %.1e\n", nx, ny, nz, failed, worst_iterations, worst);
+  EXPECT_LT(worst, 1e-6);
+  return failed;
+}
+
+TEST(PressureSolver, PeriodicBoxOfOddLengthConverges) {
+  // The coarsening of PFMG stops at a periodic direction of odd length (the fluidized bed's
+  // 4 x 4 x 19 cells at 2 x 2 x 19). With Galerkin coarse operators and weighted Jacobi, PCG broke
+  // down on 23 / 32 / 16 / 2 of the 40 fields of these boxes (a few iterations, then a residual of
+  // order 0.1); not on 4 x 4 x 20, 8 x 8 x 8 or 6 x 6 x 6.
+  EXPECT_EQ(periodic_random_fields(4, 4, 19), 0);
+  EXPECT_EQ(periodic_random_fields(2, 2, 19), 0);
+  EXPECT_EQ(periodic_random_fields(8, 8, 19), 0);
+  EXPECT_EQ(periodic_random_fields(4, 4, 9), 0);
+  EXPECT_EQ(periodic_random_fields(8, 8, 8), 0);
+}
+
 // ---- 6. Two ranks against one --------------------------------------------------------------------
 
 TEST(PressureSolver, TwoRanksMatchOne) {
