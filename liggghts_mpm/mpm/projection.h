@@ -157,6 +157,15 @@ class Projection {
     return grid_.in_patch(q[0], q[1], q[2]) ? grid_.index(q[0], q[1], q[2]) : grid_.index(i, j, k);
   }
   void mirror_normal(double *v, int i, int j, int k, const double *p2g, double mmin) const;
+  // node (i, j, k) lies on an outflow face (keyword boundary ... outflow)
+  bool on_outflow(int i, int j, int k) const {
+    const int idx[3] = {i, j, k};
+    for (int d = 0; d < 3; ++d)
+      if ((idx[d] == 0 && opt_.face[2 * d].kind == BcKind::Outflow) ||
+          (idx[d] == opt_.grid.ncell[d] && opt_.face[2 * d + 1].kind == BcKind::Outflow))
+        return !opt_.grid.periodic[d];
+    return false;
+  }
   double folded_mass(int i, int j, int k) const;
   double mirror_sum(const std::vector<double> &a, int i, int j, int k) const;
   void extrapolate_above_surface(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,

@@ -28,6 +28,9 @@ Face face_of(const LocalGrid &grid, const NodeLabels &lab, const ProjectionGeome
     const std::size_t lower = side > 0 ? n : f.m;
     if (((lab.closed[lower] >> d) & 1u) && !lab.wall_u.empty()) f.wall_u = lab.wall_u[3 * lower + d];
   }
+  // a face across a grid face (to the padding or beyond the grid): that face's velocity (inflow)
+  const GridSpec &gs = grid.spec();
+  if (f.wall && !gs.periodic[d] && (q[d] < 0 || q[d] > gs.ncell[d])) f.wall_u = lab.grid_face_u[2 * d + (side > 0)];
   return f;
 }
 

@@ -80,6 +80,7 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
                              LocalGrid::Field with) {
   const bool sparse = grid_.restricted();
   lab_.reset(grid_, sparse ? &work_ : nullptr);
+  for (int f = 0; f < 6; ++f) lab_.grid_face_u[f] = opt_.face_velocity(f);
   mesh_ = walls != nullptr;
   if (mesh_) mesh_wall_labels(*walls);
   const double dx = opt_.grid.dx, full = opt_.rho0 * dx * dx * dx;
@@ -108,6 +109,8 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
       lab_.kind[n] = kEmpty;
     }
+    // the nodes on an outflow face hold p = 0 (a Dirichlet face: EMPTY, wet when they hold fluid)
+    if (on_outflow(i, j, k)) lab_.kind[n] = kEmpty;
   });
   if (opt_.surface_ghost) {
     // the EMPTY nodes holding fluid: their velocity enters the surface faces' flux (surface_weight)
