@@ -554,17 +554,9 @@ int modify_value(Options &o, const Keyword &k, int narg, char **arg) {
     if (narg < 3)
       bad_arg("fix_modify boundary", "a face and 'noslip', 'freeslip', 'partial f', 'shear delta' or 'inflow U'", nullptr);
     Args a{narg, arg, 0};  // arg[0] is the keyword, as in the fix command
-    Options before = o;
+    const Options before = o;
     parse_face(o, a);
-    // the inflow's points and the global vector's entries of the flow are set up by the fix command
-    for (int f = 0; f < 6; ++f)
-      if ((o.face[f].flow() || before.face[f].flow()) && o.face[f].kind != before.face[f].kind) {
-        const std::string face = kFaceNames[f];
-        o = before;
-        throw Error("Fix mpm/fluid: fix_modify boundary cannot make face " + face +
-                    " an inflow or outflow face or change one (the points it creates and removes and their "
-                    "entries of the global vector are set up by the fix command); give it there");
-      }
+    check_flow_change(before, o);
     return a.iarg;
   }
   if (narg < 2) bad_arg(arg[0], k.help, nullptr);

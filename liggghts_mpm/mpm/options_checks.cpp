@@ -245,6 +245,17 @@ void check_drive(const Options &o) {
                 " stops the flux that keyword 'superficial_velocity' holds along it; remove one of them");
 }
 
+void check_flow_change(const Options &before, Options &o) {
+  static const char *const names[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
+  for (int f = 0; f < 6; ++f)
+    if ((o.face[f].flow() || before.face[f].flow()) && o.face[f].kind != before.face[f].kind) {
+      o = before;
+      throw Error(std::string("Fix mpm/fluid: fix_modify boundary cannot make face ") + names[f] +
+                  " an inflow or outflow face or change one (the points it creates and removes and their "
+                  "entries of the global vector are set up by the fix command); give it there");
+    }
+}
+
 void check_inert(const Options &o, const std::vector<std::string> &seen, const char *command) {
   for (const Inert &r : kInert)
     if (std::find(seen.begin(), seen.end(), r.keyword) != seen.end() && r.inert(o))
