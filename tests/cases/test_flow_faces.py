@@ -140,6 +140,8 @@ def case_bad_input(r):
                                            "dimension, got yhi",)),
         ("f", "pressure eos bulk 2e6 boundary zhi outflow", "",
          ("keyword 'boundary zhi outflow' needs 'pressure projection'",)),
+        ("f", "boundary zhi outflow mesh_wall nosuch freeslip", "",
+         ("keyword 'boundary zhi outflow' cannot be combined with keyword 'mesh_wall'",)),
         ("f", "boundary zlo noslip", "fix_modify f boundary zlo inflow 0.05\nrun 1",
          ("fix_modify boundary cannot make face zlo an inflow or outflow face",)),
         ("f", "boundary zhi outflow", "fix_modify f boundary zhi noslip\nrun 1",
