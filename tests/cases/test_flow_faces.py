@@ -15,8 +15,8 @@ Cases:
                outflow face) while the top layer reaches the face, never above it, and at most half a
                point spacing's head below it once that layer has left (the fluid the points hold then
                ends half a spacing below the face; measured 0.47 of a spacing's head).
-  np2_vs_np1   2 ranks (the column cut across its height: one rank creates, the other removes)
-               against 1: mass, mass in, mass out, points and velocity at every output to 1e-9.
+  np2_vs_np1   2 ranks (the column cut across its height: one rank creates, the other removes; and
+               cut along x: each rank creates and removes its half of every layer) against 1: mass, mass in, mass out, points and velocity at every output to 1e-9.
   restart      the run split by write_restart / read_restart on a step on which a layer has left
                and waits for its removal (deleted at the resumed run's setup): every output of the resumed run equals the uninterrupted
                run's (depth owed and mass counters in the restart file) to 1e-10.
@@ -78,14 +78,19 @@ def case_balance(r):
 def case_np2_vs_np1(r):
     v = {"U": 0.0937, "fillh": 0.15, "nhalf": 200, "every": 10}
     d1, _ = r.run("flow_faces/np1", INP, v)
-    d2, _ = r.run("flow_faces/np2", INP, v, np=2)
-    f1, f2 = read_csv(os.path.join(d1, "flow.csv")), read_csv(os.path.join(d2, "flow.csv"))
-    check(len(f1["step"]) == len(f2["step"]) == 40, "40 outputs on 1 and on 2 ranks")
+    f1 = read_csv(os.path.join(d1, "flow.csv"))
     check(f1["min"][-1] > 0.0 and f1["mout"][-1] > 0.0, "points were created and removed")
-    rel = max(abs(a - b) / max(abs(a), 1e-30) for k in ("mass", "min", "mout", "points", "vz", "p")
-              for a, b in zip(f1[k], f2[k]))
-    print(f"  largest relative difference of mass, in, out, points, vz, p (2 ranks against 1): {rel:.1e}")
-    check(rel < 1e-9, "2 ranks = 1 rank to 1e-9 at every output")
+    # the column cut across its height (one rank creates, the other removes) and along x (both
+    # create and remove, each its half of every layer)
+    for cut, procs in (("z", {"procz": 2}), ("x", {"procx": 2})):
+        d2, _ = r.run(f"flow_faces/np2_{cut}", INP, dict(v, **procs), np=2)
+        f2 = read_csv(os.path.join(d2, "flow.csv"))
+        check(len(f1["step"]) == len(f2["step"]) == 40, f"cut along {cut}: 40 outputs on 1 and on 2 ranks")
+        rel = max(abs(a - b) / max(abs(a), 1e-30) for k in ("mass", "min", "mout", "points", "vz", "p")
+                  for a, b in zip(f1[k], f2[k]))
+        print(f"  cut along {cut}: largest relative difference of mass, in, out, points, vz, p (2 ranks against 1): "
+              f"{rel:.1e}")
+        check(rel < 1e-9, f"cut along {cut}: 2 ranks = 1 rank to 1e-9 at every output")
 
 
 def case_restart(r):
