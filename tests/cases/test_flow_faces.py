@@ -155,6 +155,11 @@ def case_bad_input(r):
     for i, (zb, args, post, needles) in enumerate(cases):
         r.expect_error(f"flow_faces/bad_input/{i}", BAD.format(zb=zb, args=args, post=post), needles,
                        f"'{args} {post}' refused")
+    # the inflow's speed enters the step limit at the setup (before a step, not once the fluid moves)
+    p, msg = r.run_script("flow_faces/bad_input/fast", BAD.format(zb="f", args="boundary zlo inflow 20", post=""))
+    check(p.returncode != 0 and "|v|max = 20)" in msg and "reduce the timestep to 0.00025" in msg
+          and "during the run" not in msg and "Loop time" not in p.stdout,
+          f"an inflow of 20 m/s refused at the setup by the advective step limit (got: {msg.strip()[:160]})")
     # accepted: fix_modify of an inflow's velocity between runs
     p, msg = r.run_script("flow_faces/bad_input/ok", BAD.format(
         zb="f", args="boundary zlo inflow 0.05 boundary zhi outflow",
