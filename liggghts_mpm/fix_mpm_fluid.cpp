@@ -69,7 +69,11 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   time_integrate = 1;  // the fix moves its material points itself
   vector_flag = 1;
   size_vector = mpm::FluidSolver::global_size(static_cast<int>(mesh_specs.size()),
-                                              static_cast<int>(solver->opt.probes.size()), solver->opt.drive.active);
+                                              static_cast<int>(solver->opt.probes.size()), solver->opt.drive.active,
+                                              solver->opt.flow_faces());
+  // inflow and outflow faces: points are created and removed on steps that exchange atoms
+  force_reneighbor = solver->opt.flow_faces() ? 1 : 0;
+  next_reneighbor = -1;
   vector_cache.assign(size_vector, 0.0);
   global_freq = 1;
   extvector = 0;
@@ -91,7 +95,7 @@ FixMpmFluid::~FixMpmFluid() {
 }
 
 int FixMpmFluid::setmask() {
-  return PRE_FINAL_INTEGRATE | END_OF_STEP;
+  return PRE_FINAL_INTEGRATE | END_OF_STEP | (solver->opt.flow_faces() ? PRE_EXCHANGE : 0);
 }
 
 // the screen of liggghts_mpm copies a line "ERROR on proc" into the log file (main.cpp); a rank
@@ -386,6 +390,7 @@ void FixMpmFluid::pre_final_integrate() {
             "solved with its own mean (the water in it cannot be compressed; noted once)\n";
       print(os.str());
     }
+    schedule_flow();
     if (s.opt.coupled && fix_dragforce)
       for (int k = 0; k < atom->nlocal; ++k)
         if (atom->mask[k] & couple_groupbit)

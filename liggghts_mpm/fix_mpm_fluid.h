@@ -37,6 +37,9 @@ class FixMpmFluid : public Fix {
   void setup(int) override;
   void post_run() override;
   void pre_final_integrate() override;
+  // inflow and outflow faces (fix_mpm_fluid_flow.cpp): points removed and created
+  void setup_pre_exchange() override;
+  void pre_exchange() override;
   // fix balance/mpm moved the subdomain cuts inside a run: the grid patch follows at the next step
   void subdomain_changed();
   // this rank's work in the fluid and the coupling since the fix was made: their wall time less
@@ -85,6 +88,12 @@ class FixMpmFluid : public Fix {
   void create_point(const double *x, double vol);
   void finish_fill(int nlocal_before, double vol);
   void check_fill_memory(class Region *region, const int lo[3], const int hi[3]);
+  // inflow and outflow faces: the points that left removed, the inflow's layers due created (all
+  // ranks, on a step that exchanges atoms); schedule_flow: after a fluid step, such a step next if
+  // there is work for it
+  void flow_exchange();
+  void schedule_flow();
+  int create_inflow_layer(int f, double pos);
   void refresh_walls();
   void add_grain_force();
   void fluid_step_ahead(mpm::FluidSolver &s);  // every N > 1: the fluid step with the grains (N-1)/2 steps ahead

@@ -306,7 +306,7 @@ void FixMpmFluid::check_group_atoms() {
   for (int i = 0; i < atom->nlocal; ++i) {
     const bool same_type = atom->type[i] == point_type;
     if (is_point(i)) {
-      if (pdata[i][mpm::C_FLAG] != 1.0) ++loc[same_type ? 1 : 0];
+      if (pdata[i][mpm::C_FLAG] != 1.0 && pdata[i][mpm::C_FLAG] != mpm::kPointGone) ++loc[same_type ? 1 : 0];
     } else if (same_type)
       ++loc[2];
   }

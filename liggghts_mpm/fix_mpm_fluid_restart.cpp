@@ -35,7 +35,10 @@ void FixMpmFluid::unpack_restart(int nlocal, int nth) {
 int FixMpmFluid::size_restart(int) { return NCOL + 1; }
 int FixMpmFluid::maxsize_restart() { return NCOL + 1; }
 
-/* The fix's global restart data. Format 3: R_VERSION = -3, the fields of format 2, the driving
+/* The fix's global restart data. Format 4: R_VERSION = -4, the fields of format 3, then the inflow
+   and outflow faces' state (R_DEPTH0..5: per face the depth its inflow owes; R_MIN, R_MOUT: the
+   mass created and removed), then the state of the last pressure solve. Format 3 (R_VERSION = -3)
+   lacks the flow's fields: read with none owed and nothing created or removed. Format 3: the fields of format 2, the driving
    gradient of superficial_velocity (R_DRIVE) and the state of every auto (R_NEXT..R_TAU: the host
    step of the next fluid step, the N of the last one, the volume correction's countdown, the
    grains' shortest drag response time), then the state of the last pressure solve
@@ -47,9 +50,10 @@ int FixMpmFluid::maxsize_restart() { return NCOL + 1; }
    the d(theta)/dt source (a warning says so). */
 namespace {
 enum { R_FILLED, R_PMASS, R_SP0, R_SP1, R_SP2, R_CLAMPED, R_GATE, R_NSUB, R_THETA, R_TIME, R_TYPE, R_DRIVE,
-       R_NEXT, R_LASTN, R_VCDUE, R_TAU, R_COUNT };
-constexpr double kRestartFormat = 3.0;
+       R_NEXT, R_LASTN, R_VCDUE, R_TAU, R_DEPTH0, R_MIN = R_DEPTH0 + 6, R_MOUT, R_COUNT };
+constexpr double kRestartFormat = 4.0;
 constexpr int kCountFormat2 = R_DRIVE;  // the fields of formats 1 and 2
+constexpr int kCountFormat3 = R_DEPTH0;  // the fields of format 3
 }
 
 void FixMpmFluid::write_restart(FILE *fp) {
@@ -71,6 +75,9 @@ void FixMpmFluid::write_restart(FILE *fp) {
   v[R_LASTN] = st.last_every;
   v[R_VCDUE] = st.vc_due;
   v[R_TAU] = st.grain_tau;  // HUGE_VAL (finite) when no grain moved
+  for (int f = 0; f < 6; ++f) v[R_DEPTH0 + f] = st.inflow_depth[f];
+  v[R_MIN] = st.mass_in;
+  v[R_MOUT] = st.mass_out;
   mpm::ProjectionState ps;
   guarded([&] { ps = solver->projection_state(); });  // collective
   ps.pack(list);
@@ -88,7 +95,8 @@ void FixMpmFluid::restart(char *buf) {
   const double *list = reinterpret_cast<const double *>(buf);
   const bool format1 = list[0] >= 0.0;  // R_FILLED first
   const bool format2 = list[0] == -2.0;
-  if (!format1 && !format2 && list[0] != -kRestartFormat) {
+  const bool format3 = list[0] == -3.0;
+  if (!format1 && !format2 && !format3 && list[0] != -kRestartFormat) {
     std::ostringstream os;
     os << "Fix mpm/fluid: the restart file's fix data has format " << -list[0] << "; this build reads formats 1, 2 and "
        << kRestartFormat << " (write the restart file again with the build that will read it)";
@@ -118,6 +126,11 @@ void FixMpmFluid::restart(char *buf) {
   st.last_every = schedule ? static_cast<int>(v[R_LASTN]) : 1;
   st.vc_due = schedule ? v[R_VCDUE] : 0.0;
   st.grain_tau = schedule ? v[R_TAU] : HUGE_VAL;
+  // inflow and outflow faces: the depth owed and the mass created and removed go on (none before format 4)
+  const bool flow = schedule && !format3;
+  for (int f = 0; f < 6; ++f) st.inflow_depth[f] = flow ? v[R_DEPTH0 + f] : 0.0;
+  st.mass_in = flow ? v[R_MIN] : 0.0;
+  st.mass_out = flow ? v[R_MOUT] : 0.0;
   // the last pressure solve (warm start, the grains' gradient, theta for d(theta)/dt)
   st.projection = mpm::ProjectionState();
   if (format1) {
@@ -128,7 +141,7 @@ void FixMpmFluid::restart(char *buf) {
     return;
   }
   mpm::ProjectionState ps;
-  guarded([&] { ps.unpack(v + (format2 ? kCountFormat2 : R_COUNT)); });
+  guarded([&] { ps.unpack(v + (format2 ? kCountFormat2 : format3 ? kCountFormat3 : R_COUNT)); });
   if (!ps.valid || !solver->opt.projection) return;
   const mpm::GridSpec &gs = solver->opt.grid;
   bool fits = true;

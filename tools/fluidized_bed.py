@@ -18,6 +18,7 @@ superficial velocity U, the means over the last half of the stage):
 
     fluidized_bed.py run --exe build/liggghts_mpm --work DIR [--var NAME VALUE ...] [--figure PNG]
     fluidized_bed.py analyse DIR [--figure PNG]
+    fluidized_bed.py analyse_open DIR     (a run of in.fluidized_bed_open: fed through the floor)
 
 Prints the table of docs/validation/fluidized_bed.md and the acceptance lines. Standard library for
 the analysis (tests/cases/test_fluidized_bed.py imports it); matplotlib only for --figure.
@@ -248,6 +249,41 @@ def run(exe, work, variables, np=1, mpirun=None):
         raise RuntimeError("liggghts_mpm exited with %d:\n%s" % (p.returncode, "\n".join(p.stdout.splitlines()[-15:])))
 
 
+def analyse_open(folder, out=sys.stdout):
+    """The run of in.fluidized_bed_open (the water fed through the floor, drained at the top): per
+    stage (the means over its second half) dP from the two probes against Ergun at the bed's
+    voidage at rest and the buoyant weight per area W/A, the bed height; the water's mass against the
+    fill's + in - out at every output, and the range of the mass in the box over each stage's second
+    half in layers of points across the inflow (rho A dx / 2, fill 2 2 2)."""
+    with open(os.path.join(folder, "log.txt")) as f:
+        p = read_result(f.read())
+    cols = read_csv(os.path.join(folder, "fluidized_bed_open.csv"))
+    A, V = p["L"] * p["L"], math.pi * p["d"] ** 3 / 6.0
+    W = p["beads"] * V * (p["rhop"] - p["rho"]) * p["g"] / A
+    layer = p["rho"] * A * p["dx"] / 2.0
+    bal = [m - a + b for m, a, b in zip(cols["mass"], cols["min"], cols["mout"])]
+    res = {"W": W, "H0": p["H0"], "eps0": p["eps0"], "balance": (max(bal) - min(bal)) / bal[0], "stages": []}
+    print(f"beads {int(p['beads'])}, H0 {p['H0'] * 1e3:.2f} mm, eps0 {p['eps0']:.4f}, W/A {W:.2f} Pa; "
+          f"water mass - in + out over {len(bal)} outputs: spread {res['balance']:.1e} of it", file=out)
+    print("| U (m/s) | dP (Pa) | sd dP (Pa) | dP / (W/A) | Ergun at eps0 (Pa) | H / H0 | mass in the box: range (layers) | "
+          "in, out (layers) |", file=out)
+    print("|---|---|---|---|---|---|---|---|", file=out)
+    for s in sorted(set(cols["stage"])):
+        idx = [i for i, v in enumerate(cols["stage"]) if v == s]
+        idx = idx[len(idx) // 2:]
+        mean = lambda k: sum(cols[k][i] for i in idx) / len(idx)  # noqa: E731
+        dp = mean("dP")
+        sd = math.sqrt(sum((cols["dP"][i] - dp) ** 2 for i in idx) / len(idx))
+        U, H = cols["U"][idx[0]], 2.0 * mean("zmean")
+        ms = [cols["mass"][i] for i in idx]
+        st = {"U": U, "dP": dp, "sd": sd, "H": H, "range": (max(ms) - min(ms)) / layer}
+        res["stages"].append(st)
+        print(f"| {U:.4f} | {dp:.2f} | {sd:.2f} | {dp / W:.4f} | {ergun_dp(U, p['eps0'], p['H0'], p['d'], p['rho'], p['mu']):.2f} "
+              f"| {H / p['H0']:.4f} | {st['range']:.3f} | {cols['min'][idx[-1]] / layer:.2f}, "
+              f"{cols['mout'][idx[-1]] / layer:.2f} |", file=out)
+    return res
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -259,10 +295,14 @@ def main():
     a = sub.add_parser("analyse")
     a.add_argument("folder")
     a.add_argument("--figure")
+    o = sub.add_parser("analyse_open")
+    o.add_argument("folder")
     args = ap.parse_args()
     if args.cmd == "run":
         run(args.exe, args.work, args.var)
         analyse(args.work, args.figure)
+    elif args.cmd == "analyse_open":
+        analyse_open(args.folder)
     else:
         analyse(args.folder, args.figure)
 

@@ -156,6 +156,15 @@ CONFLICTS = [
     ("output_no_field", "output 10 o points", "eos", "output"),
 ]
 
+# boundary FACE inflow U | outflow: the inflow's velocity, and the combinations refused
+FLOW_U = R(0, INF, True, True)
+FLOW_CONFLICTS = [
+    ("inflow_all", "boundary all inflow 0.05", "proj"),
+    ("outflow_eos", "boundary zhi outflow", "eos"),
+    ("inflow_eos", "boundary zlo inflow 0.05", "eos"),
+    ("outflow_mesh_wall", "boundary zhi outflow mesh_wall nosuch freeslip", "mesh_proj"),
+]
+
 BAL_SPEC = {
     "dim": [(AXIS, "x")],
     "every": [(("int", 0, 2 ** 31 - 1), "5")],
@@ -194,7 +203,7 @@ def script(context, extra, post="", pre=""):
         base = base.replace(" fill col 2 2 2 type 1", "")
     if context in ("couple", "couple_proj", "couple_bare"):
         post = NVE + "\n" + post
-    if context == "mesh":
+    if context in ("mesh", "mesh_proj"):
         pre += "fix nosuch all property/global x scalar 1\n"
     return FLUID.format(pre=pre, args=base + " " + extra, post=post)
 
@@ -278,6 +287,14 @@ def cases(quick):
         out.append((f"fix_modify/{kw}/not_modifiable", script("eos", "", post=f"fix_modify fluid {kw} 1"), kw, "bad"))
     for label, extra, ctx, kw in (CONFLICTS if not quick else CONFLICTS[::4]):
         out.append((f"conflict/{label}", script(ctx, extra), kw, "bad"))
+    # boundary FACE inflow U (the row above varies the face and the partial kind): U, a real > 0
+    for v in (BAD_REAL if not quick else QUICK_REAL[:3]) + [None]:
+        if in_range(FLOW_U, v):
+            continue
+        extra = "boundary zlo inflow" + (" " + v if v is not None else "")
+        out.append((f"boundary/inflow/{v if v is not None else 'missing'}", script("proj", extra), "boundary", "bad"))
+    for label, extra, ctx in (FLOW_CONFLICTS if not quick else FLOW_CONFLICTS[::2]):
+        out.append((f"conflict/{label}", script(ctx, extra), "boundary", "bad"))
     # fix balance/mpm
     for ikw, (kw, slots) in enumerate(BAL_SPEC.items()):
         example = [ex for _, ex in slots]

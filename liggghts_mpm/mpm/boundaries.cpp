@@ -35,6 +35,13 @@ void Boundaries::apply(double *vel, int i, int j, int k, double h, double m) {
     // face the exact decay over h under the wall stress mu v_t / delta on the fluid within a cell
     // of the face, rate nu / (delta dx) (as mesh_wall ... shear, docs/theory/mesh_walls.md)
     const Face &f = opt_->face[fc];
+    // outflow: no velocity condition (zero normal gradient; the projection holds p = 0 there);
+    // inflow: the inflow's velocity, normal to the face, no tangential component
+    if (f.kind == BcKind::Outflow) continue;
+    if (f.kind == BcKind::Inflow) {
+      for (int e = 0; e < 3; ++e) vel[e] = (e == d) ? opt_->face_velocity(fc) : 0.0;
+      continue;
+    }
     const double keep = f.kind == BcKind::Shear
                             ? wall_slip_decay(wall_layer_rate(opt_->viscosity / opt_->eos.rho0, f.delta, gs.dx), h)
                             : 1.0 - f.sticky;
@@ -179,10 +186,11 @@ void Boundaries::add_mesh_traction(const double *xp, double V, double p, double 
       }
 }
 
-int Boundaries::put_back(double x[3], double v[3], const double xold[3], double m) {
+int Boundaries::put_back(double x[3], double v[3], const double xold[3], double m, bool *gone) {
   const GridSpec &gs = opt_->grid;
   const double eps = 1e-6 * gs.dx;
   int n = 0;
+  if (gone) *gone = false;
   if (walls_ && near_wall(x)) {
     const double v0[3] = {v[0], v[1], v[2]};
     int wall = -1;
@@ -199,8 +207,14 @@ int Boundaries::put_back(double x[3], double v[3], const double xold[3], double 
     const double lo = gs.origin[d], hi = gs.upper(d);
     if (x[d] < lo || x[d] > hi) {
       if (x[d] < lo - gs.dx || x[d] > hi + gs.dx) continue;  // the shape functions report it
+      const bool out = opt_->face[2 * d + (x[d] < lo ? 0 : 1)].kind == BcKind::Outflow;
       x[d] = x[d] < lo ? lo + eps : hi - eps;
       v[d] = 0.0;
+      // through an outflow face: the point has left (the caller removes it), not put back
+      if (out && gone) {
+        *gone = true;
+        continue;
+      }
       ++n;
     }
   }

@@ -54,7 +54,9 @@ class Boundaries {
   // closed gate. Returns the number of corrections.
   // m > 0 with record_loads on: the momentum a mesh wall gives the point, m (v after - v before),
   // is added to that wall's load.
-  int put_back(double x[3], double v[3], const double xold[3], double m = 0.0);
+  // gone (not null): set when the point left through an outflow face (placed on its inner side,
+  // velocity along it 0, not counted as a correction)
+  int put_back(double x[3], double v[3], const double xold[3], double m = 0.0, bool *gone = nullptr);
 
   // Wall loads (mesh_wall ... loads yes; docs/theory/mesh_walls.md, "Force and torque on a mesh"):
   // the momentum the mesh walls give the fluid, per wall 6 values (impulse, and its moment about

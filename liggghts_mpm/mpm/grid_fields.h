@@ -18,10 +18,14 @@ enum Column {
   C_TAU = 3,     // deviatoric stress xx yy zz yz xz xy (6), Pa
   C_AFF = 9,     // APIC affine velocity / velocity gradient, row-major (9), 1/s
   C_THETA = 18,  // fluid volume fraction at the point
-  C_FLAG = 19,   // 1 for a point set up by this fix
+  C_FLAG = 19,   // 1 for a point set up by this fix (kPointGone: left through an outflow face)
   C_FGRAIN = 20, // on a grain of the coupled group: force of the fluid on it (3), N
   NCOL = 23
 };
+
+// C_FLAG of a point that left through an outflow face: no longer fluid, removed by the host at
+// its next exchange of atoms (FixMpmFluid::flow_exchange)
+constexpr double kPointGone = 2.0;
 
 // P2G: mass, momentum (3) | force (3), pad
 struct P2gRec { enum { M = 0, MV = 1, F = 4, N = 8 }; };

@@ -115,6 +115,8 @@ void parse_grain_pressure(Options &o, Args &a, const ParseEnv &) {
 }
 
 
+const char *const kBoundaryKinds = "'noslip', 'freeslip', 'partial f', 'shear delta', 'inflow U' or 'outflow'";
+
 // boundary FACE KIND [value], also for fix_modify (a.iarg at the keyword)
 void parse_face(Options &o, Args &a) {
   const char *name = a.at(1), *kind = a.at(2);
@@ -148,14 +150,28 @@ void parse_face(Options &o, Args &a) {
     fc.kind = BcKind::Shear;
     fc.sticky = 0.0;
     used = 4;
+  } else if (strcmp(kind, "inflow") == 0) {
+    const char *what = "a normal velocity U > 0 (velocity, into the grid) of the inflow";
+    if (a.iarg + 3 >= a.narg) bad_arg("boundary inflow", what, nullptr);
+    if (!parse_double(a.at(3), fc.inflow) || !(fc.inflow > 0.0) || !std::isfinite(fc.inflow))
+      bad_arg("boundary inflow", what, a.at(3));
+    fc.kind = BcKind::Inflow;
+    fc.sticky = 1.0;
+    used = 4;
+  } else if (strcmp(kind, "outflow") == 0) {
+    fc.kind = BcKind::Outflow;
+    fc.sticky = 0.0;
   } else
-    bad_arg("boundary", "'noslip', 'freeslip', 'partial f' or 'shear delta'", kind);
+    bad_arg("boundary", kBoundaryKinds, kind);
+  if (fc.flow() && f0 != f1)
+    bad_arg("boundary", "one face (xlo xhi ylo yhi zlo zhi) for 'inflow' or 'outflow'", name);
   for (int f = f0; f <= f1; ++f) o.face[f] = fc;
   a.iarg += used;
 }
 
 void parse_boundary(Options &o, Args &a, const ParseEnv &) {
-  a.need(2, "boundary", "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip', 'partial f' or 'shear delta'");
+  a.need(2, "boundary", "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip', 'partial f', 'shear delta', "
+                       "'inflow U' or 'outflow'");
   parse_face(o, a);
 }
 
@@ -386,8 +402,8 @@ const std::vector<Keyword> kTable = {
      nullptr, 0, 0, false, false, nullptr, parse_update, false},
     {"model", "standard | yang2016", "-", "", "standard", "'standard' or 'yang2016'",
      nullptr, 0, 0, false, false, nullptr, parse_model, false},
-    {"boundary", "face kind [value]", "-", "sticky in [0,1], delta > 0", "all noslip",
-     "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip', 'partial f' or 'shear delta'",
+    {"boundary", "face kind [value]", "-, length, velocity", "sticky in [0,1], delta > 0, inflow U > 0", "all noslip",
+     "a face (xlo xhi ylo yhi zlo zhi all) and 'noslip', 'freeslip', 'partial f', 'shear delta', 'inflow U' or 'outflow'",
      nullptr, 0, 0, false, false, nullptr, parse_boundary, true},
     {"gate", "dim pos lower|upper time|never", "length, time", "inside the grid, time >= 0", "none",
      "'dim pos lower|upper release_time'", nullptr, 0, 0, false, false, nullptr, parse_gate, true},
@@ -536,9 +552,11 @@ int modify_value(Options &o, const Keyword &k, int narg, char **arg) {
   if (strcmp(arg[0], "superficial_velocity") == 0) return modify_drive(o, narg, arg);
   if (strcmp(arg[0], "boundary") == 0) {
     if (narg < 3)
-      bad_arg("fix_modify boundary", "a face and 'noslip', 'freeslip', 'partial f' or 'shear delta'", nullptr);
+      bad_arg("fix_modify boundary", "a face and 'noslip', 'freeslip', 'partial f', 'shear delta' or 'inflow U'", nullptr);
     Args a{narg, arg, 0};  // arg[0] is the keyword, as in the fix command
+    const Options before = o;
     parse_face(o, a);
+    check_flow_change(before, o);
     return a.iarg;
   }
   if (narg < 2) bad_arg(arg[0], k.help, nullptr);

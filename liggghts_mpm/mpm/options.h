@@ -20,12 +20,17 @@
 
 namespace mpm {
 
-enum class BcKind { NoSlip, FreeSlip, Partial, Shear };
+enum class BcKind { NoSlip, FreeSlip, Partial, Shear, Inflow, Outflow };
 // Shear: wall stress mu v_t / delta of an unresolved wall layer delta (docs/theory/mesh_walls.md)
+// Inflow: the fluid enters at the normal speed 'inflow' (> 0), no tangential velocity; points are
+// created in layers inside the face (flow_faces.cpp). Outflow: p = 0, no velocity condition; points
+// that leave through it are removed (docs/fix_mpm_fluid.md, "Flow in and out").
 struct Face {
   BcKind kind = BcKind::NoSlip;
   double sticky = 1.0;
   double delta = 0.0;
+  double inflow = 0.0;  // Inflow: normal speed into the grid (velocity)
+  bool flow() const { return kind == BcKind::Inflow || kind == BcKind::Outflow; }
 };
 struct Gate {
   bool active = false;
@@ -133,6 +138,18 @@ struct Options {
   std::vector<std::string> out_point_fields, out_grid_fields;
   // warnings of the parser (a keyword given twice), printed by the fix
   std::vector<std::string> warnings;
+
+  // some face is an inflow or an outflow (boundary ... inflow U | outflow)
+  bool flow_faces() const {
+    for (const Face &f : face)
+      if (f.flow()) return true;
+    return false;
+  }
+  // the velocity along +d of grid face f's inflow (f = 2 d: +U, f = 2 d + 1: -U; 0 for other kinds)
+  double face_velocity(int f) const {
+    if (face[f].kind != BcKind::Inflow) return 0.0;
+    return (f % 2 == 0 ? 1.0 : -1.0) * face[f].inflow;
+  }
 };
 
 // What the parser needs to know of the simulation around it (LIGGGHTS' box, groups, types).

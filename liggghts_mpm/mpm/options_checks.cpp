@@ -162,6 +162,31 @@ void check_derived(const Options &o) {
   }
 }
 
+// boundary ... inflow U | outflow: a non-periodic face, the pressure projection, no mesh walls
+void check_flow_faces(const Options &o, const std::vector<std::string> &seen) {
+  static const char *const names[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
+  for (int f = 0; f < 6; ++f) {
+    const Face &fc = o.face[f];
+    if (!fc.flow()) continue;
+    const std::string kw = std::string("boundary ") + names[f] + (fc.kind == BcKind::Inflow ? " inflow" : " outflow");
+    if (o.grid.periodic[f / 2])
+      throw Error("Fix mpm/fluid: keyword '" + kw + "' expects a face of a non-periodic dimension, got " + names[f] +
+                  ", along which the box is periodic (boundary p in that dimension; what leaves through one face "
+                  "enters through the other)");
+    // eos: a point's pressure comes from its own density, which a face with p = 0 does not reach,
+    // and points created at the reference density into a compressed fluid would shock it
+    if (!o.projection)
+      throw Error("Fix mpm/fluid: keyword '" + kw + "' needs 'pressure projection' (the default): the weakly "
+                  "compressible model ('pressure eos') has no pressure condition on a face, so an outflow would "
+                  "not hold p = 0 and new points at the reference density would meet a compressed fluid");
+    // the labels beside mesh walls do not hold the face's node plane as an open surface
+    if (std::find(seen.begin(), seen.end(), "mesh_wall") != seen.end())
+      throw Error("Fix mpm/fluid: keyword '" + kw + "' cannot be combined with keyword 'mesh_wall' (a mesh may lie on "
+                  "or cross the face, which would close it; the projection beside mesh walls has no open grid "
+                  "faces): use grid faces, or give the fluid a free surface instead of an outflow");
+  }
+}
+
 }  // namespace
 
 // superficial_velocity axis U|v_name (also fix_modify; a.iarg at the keyword)
@@ -218,6 +243,17 @@ void check_drive(const Options &o) {
   if (o.gate.active && o.gate.dim == dr.axis)
     throw Error(std::string("Fix mpm/fluid: keyword 'gate' across axis ") + "xyz"[dr.axis] +
                 " stops the flux that keyword 'superficial_velocity' holds along it; remove one of them");
+}
+
+void check_flow_change(const Options &before, Options &o) {
+  static const char *const names[6] = {"xlo", "xhi", "ylo", "yhi", "zlo", "zhi"};
+  for (int f = 0; f < 6; ++f)
+    if ((o.face[f].flow() || before.face[f].flow()) && o.face[f].kind != before.face[f].kind) {
+      o = before;
+      throw Error(std::string("Fix mpm/fluid: fix_modify boundary cannot make face ") + names[f] +
+                  " an inflow or outflow face or change one (the points it creates and removes and their "
+                  "entries of the global vector are set up by the fix command); give it there");
+    }
 }
 
 void check_inert(const Options &o, const std::vector<std::string> &seen, const char *command) {
@@ -287,6 +323,7 @@ void finish_options(Options &o, const std::vector<std::string> &seen, const bool
   if (g.active && !o.grid.periodic[g.dim] && (g.pos <= o.grid.origin[g.dim] || g.pos >= o.grid.upper(g.dim)))
     throw Error("Fix mpm/fluid: keyword 'gate' expects a position inside the grid");
   check_drive(o);
+  check_flow_faces(o, seen);
   for (const Probe &p : o.probes)
     for (int d = 0; d < 3; ++d)
       if (!(p.lo[d] >= o.grid.origin[d] && p.hi[d] <= o.grid.upper(d))) {

@@ -17,6 +17,9 @@ void parse_drive(Options &o, Args &a);
 int modify_drive(Options &o, int narg, char **arg);
 // keyword superficial_velocity on a periodic axis and no gate across it. Throws mpm::Error.
 void check_drive(const Options &o);
+// fix_modify boundary: no face became or stopped being an inflow or outflow face (before: the
+// settings before it); else o = before and mpm::Error naming the face.
+void check_flow_change(const Options &before, Options &o);
 // parse_options after its keywords (seen; given: cell, density, bulk): the settings that follow
 // from them, the grid fitted to the bounds and the checks. Throws mpm::Error.
 void finish_options(Options &o, const std::vector<std::string> &seen, const bool given[3], const ParseEnv &env);

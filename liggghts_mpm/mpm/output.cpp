@@ -70,7 +70,17 @@ void FluidSolver::global_vector(double *out, int walls) {
     out[kGlobalSize + c] = c < static_cast<int>(wall_mean_.size()) ? wall_mean_[c] : 0.0;
   for (std::size_t j = 0; j < opt.probes.size(); ++j)
     out[kGlobalSize + 6 * walls + j] = j < probe_mean_.size() ? probe_mean_[j] : 0.0;
-  if (opt.drive.active) out[kGlobalSize + 6 * walls + opt.probes.size()] = state.drive_gradient;
+  const std::size_t next = kGlobalSize + 6 * walls + opt.probes.size() + (opt.drive.active ? 1 : 0);
+  if (opt.drive.active) out[next - 1] = state.drive_gradient;
+  if (opt.flow_faces()) {
+    // the points that left in the last fluid step and wait for their removal count as out
+    double gone = 0.0, all = 0.0;
+    for (int i = 0; i < pts.nlocal; ++i)
+      if ((pts.mask[i] & pts.point_bit) && pts.state[i][C_FLAG] == kPointGone) gone += rmass[i];
+    MPI_Allreduce(&gone, &all, 1, MPI_DOUBLE, MPI_SUM, comm_);
+    out[next] = state.mass_in;
+    out[next + 1] = state.mass_out + all;
+  }
 }
 
 // since the fix was created: the Projection of each grid patch (a new one at every re-cut) adds

@@ -330,8 +330,16 @@ void Projection::mirror_normal(double *v, int i, int j, int k, const double *p2g
   const std::size_t mn = grid_.index(q[0], q[1], q[2]);
   const double mm = p2g[P2gRec::N * mn + P2gRec::M];
   const bool fluid = lab_.kind[mn] != kSolid && mm > mmin && mm > 0.0;
-  for (int d = 0; d < 3; ++d)
-    if (out[d]) v[d] = fluid ? -u_[3 * mn + d] : 0.0;
+  const int idx[3] = {i, j, k};
+  for (int d = 0; d < 3; ++d) {
+    if (!out[d]) continue;
+    // an outflow face: the wall node's velocity (copied by padding_velocity) stays, zero normal
+    // gradient; an inflow face: reflected about its velocity U, so that U is interpolated on it
+    const int f = 2 * d + (idx[d] < 0 ? 0 : 1);
+    if (opt_.face[f].kind == BcKind::Outflow) continue;
+    const double uf = opt_.face_velocity(f);
+    v[d] = fluid ? 2.0 * uf - u_[3 * mn + d] : uf;
+  }
 }
 
 /* Exact exchange of momentum with the grains (docs/theory/projection.md, "Momentum of grains and

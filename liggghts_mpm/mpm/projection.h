@@ -157,6 +157,15 @@ class Projection {
     return grid_.in_patch(q[0], q[1], q[2]) ? grid_.index(q[0], q[1], q[2]) : grid_.index(i, j, k);
   }
   void mirror_normal(double *v, int i, int j, int k, const double *p2g, double mmin) const;
+  // node (i, j, k) lies on a grid face of that kind (keyword boundary ... inflow U | outflow)
+  bool on_face(int i, int j, int k, BcKind kind) const {
+    const int idx[3] = {i, j, k};
+    for (int d = 0; d < 3; ++d)
+      if (!opt_.grid.periodic[d] && ((idx[d] == 0 && opt_.face[2 * d].kind == kind) ||
+                                     (idx[d] == opt_.grid.ncell[d] && opt_.face[2 * d + 1].kind == kind)))
+        return true;
+    return false;
+  }
   double folded_mass(int i, int j, int k) const;
   double mirror_sum(const std::vector<double> &a, int i, int j, int k) const;
   void extrapolate_above_surface(const double *p2g, double mmin, std::vector<double> &p, std::vector<double> &grad,
@@ -213,6 +222,7 @@ class Projection {
   void add_volume_correction(const double *pvol, const double *theta, double h, double share);
   void volume_drift(const double *pvol, const double *theta, double h, double share, long step);
   bool deep_inside(int i, int j, int k) const;
+  bool near_flow_face(int i, int j, int k) const;  // within two nodes of an inflow or outflow face
   std::vector<double> p_avg_;       // pressure_average: the nodal pressure averaged in time (sized only then)
   bool have_avg_ = false;
   double p_avg_max_ = 0.0;

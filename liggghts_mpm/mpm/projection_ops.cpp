@@ -24,10 +24,17 @@ Face face_of(const LocalGrid &grid, const NodeLabels &lab, const ProjectionGeome
   int q[3] = {i, j, k};
   q[d] += side;
   f.has_m = grid.in_patch(q[0], q[1], q[2]);
+  bool flagged = false;
   if (f.wall && f.has_m) {
     const std::size_t lower = side > 0 ? n : f.m;
-    if (((lab.closed[lower] >> d) & 1u) && !lab.wall_u.empty()) f.wall_u = lab.wall_u[3 * lower + d];
+    flagged = (lab.closed[lower] >> d) & 1u;
+    if (flagged && !lab.wall_u.empty()) f.wall_u = lab.wall_u[3 * lower + d];
   }
+  // a face across a grid face (to the padding or beyond the grid) not closed with a velocity of its
+  // own: that grid face's velocity (inflow)
+  const GridSpec &gs = grid.spec();
+  if (f.wall && !flagged && !gs.periodic[d] && (q[d] < 0 || q[d] > gs.ncell[d]))
+    f.wall_u = lab.grid_face_u[2 * d + (side > 0)];
   return f;
 }
 

@@ -40,6 +40,9 @@ struct NodeLabels {
   // to FLUID nodes (surface_weight). Empty: none (free_surface node, or set by the caller).
   std::vector<std::uint8_t> wet;
   std::vector<double> wall_u;
+  // the velocity along +d through the grid face f = 2 d (low) or 2 d + 1 (high) of a face of a
+  // node on it towards the padding or beyond the grid (keyword boundary ... inflow U; 0: at rest)
+  double grid_face_u[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   // Ghost-fluid free surface (docs/theory/projection.md, "Free surface"): per node the signed distance
   // to the free surface in units of dx, positive inside the fluid (empty: p = 0 at the EMPTY
   // nodes themselves). A face between a FLUID node n and an EMPTY node m then holds p = 0 at the

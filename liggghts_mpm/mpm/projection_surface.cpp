@@ -80,6 +80,7 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
                              LocalGrid::Field with) {
   const bool sparse = grid_.restricted();
   lab_.reset(grid_, sparse ? &work_ : nullptr);
+  for (int f = 0; f < 6; ++f) lab_.grid_face_u[f] = opt_.face_velocity(f);
   mesh_ = walls != nullptr;
   if (mesh_) mesh_wall_labels(*walls);
   const double dx = opt_.grid.dx, full = opt_.rho0 * dx * dx * dx;
@@ -108,6 +109,13 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
       lab_.kind[n] = kEmpty;
     }
+    // the nodes on an outflow face hold p = 0 (a Dirichlet face: EMPTY, wet when they hold fluid);
+    // those on an inflow face holding fluid are FLUID: the inflow's stream goes on behind the face,
+    // where there are no points yet, so their fill falls as the lattice moves off the face (by a
+    // whole layer before the next is made), and read as a free surface it held p = 0 under the
+    // column (a column fed from below lost its pressure and velocity within 0.02 s)
+    if (on_face(i, j, k, BcKind::Outflow)) lab_.kind[n] = kEmpty;
+    if (on_face(i, j, k, BcKind::Inflow) && m > mmin && m > 0.0) lab_.kind[n] = kFluid;
   });
   if (opt_.surface_ghost) {
     // the EMPTY nodes holding fluid: their velocity enters the surface faces' flux (surface_weight)

@@ -182,6 +182,7 @@ void FluidSolver::step() {
   for (int s = 0; s < state.nsub; ++s) substep(h, s == 0 ? vc_time : 0.0);
   if (samples) end_samples();
   if (opt.drive.active) drive_correct(opt.fluid_every * clock.dt);
+  inflow_advance(opt.fluid_every * clock.dt);
   if (!opt.coupled) return;
   // fluid force on the grains (mean over the sub-steps): kept in the state rows, from which the host
   // adds it to the grains' forces on each of the N DEM steps this fluid step covers (with every N;
@@ -553,7 +554,14 @@ void FluidSolver::advance_positions(double h) {
     if (box_only && xi[0] >= lo[0] && xi[0] <= hi[0] && xi[1] >= lo[1] && xi[1] <= hi[1] && xi[2] >= lo[2] &&
         xi[2] <= hi[2])
       continue;
-    state.n_clamped += bc.put_back(xi, v[i], xold, pts.rmass[i]);
+    bool gone = false;
+    state.n_clamped += bc.put_back(xi, v[i], xold, pts.rmass[i], &gone);
+    if (gone) {
+      // left through an outflow face: no longer fluid (is_point), removed by the host
+      pts.state[i][C_FLAG] = kPointGone;
+      for (int d = 0; d < 3; ++d) v[i][d] = 0.0;
+      ++gone_;
+    }
   }
 }
 

@@ -58,6 +58,10 @@ struct SolverState {
   double grain_tau = HUGE_VAL;  // this rank's shortest drag response time m/K in the last fluid step
   double drive_gradient = 0.0;    // superficial_velocity: the driving pressure gradient of the last fluid step
   ProjectionState projection;     // from a restart file, until the grid is set up (whole grid)
+  // inflow and outflow faces (flow_faces.cpp): per face the depth (length) the inflow's fluid has
+  // entered beyond its last layer of points; the mass of the points created and removed, all ranks
+  double inflow_depth[6] = {0, 0, 0, 0, 0, 0};
+  double mass_in = 0.0, mass_out = 0.0;
 };
 
 class FluidSolver {
@@ -118,8 +122,10 @@ class FluidSolver {
   // momentum the wall gave the fluid over the last fluid step per time (wall_loads.cpp); then per probe the pressure averaged
   // over the last completed probe window; then, with superficial_velocity (drive), the driving
   // pressure gradient of the last fluid step. walls: the number of mesh walls of the host.
-  static int global_size(int walls, int probes, bool drive = false) {
-    return kGlobalSize + 6 * walls + probes + (drive ? 1 : 0);
+  // then, with inflow or outflow faces (flow), the mass of the points created and removed since the
+  // fix was made (mass in, mass out; points that left and are not yet removed count as out)
+  static int global_size(int walls, int probes, bool drive = false, bool flow = false) {
+    return kGlobalSize + 6 * walls + probes + (drive ? 1 : 0) + (flow ? 2 : 0);
   }
   void global_vector(double *out, int walls);
   // wall_loads.cpp: the pressure field the probes read in this sub-step, added to the probes' sums
@@ -169,6 +175,17 @@ class FluidSolver {
   // by a uniform velocity increment, the gradient updated to the one that acted, the grains' share
   void drive_force();
   void drive_correct(double hf);
+  // inflow faces (flow_faces.cpp): the fluid of a fluid step of length hf entered (inflow_depth)
+  void inflow_advance(double hf);
+  // the layers of points due at inflow face f (inflow_depth over the point spacing along its
+  // normal), and the coordinate along the normal of layer j = 0 .. n-1 (j = 0 the farthest in)
+  int inflow_layers(int f) const;
+  double inflow_layer_position(int f, int j) const;
+  // after the host created the layers due: inflow_depth less them
+  void inflow_created(int f, int n);
+  // points of this rank that left through an outflow face in the last fluid step (kPointGone)
+  long points_gone() const { return gone_; }
+  void clear_gone() { gone_ = 0; }
   void substep(double h, double vc_time = 0.0);  // all of them
   GridFields &fields() { return g_; }
   const LocalGrid &grid() const { return grid_; }
@@ -244,7 +261,9 @@ class FluidSolver {
   double stable_dt();
   void coupled_limits(const double *glob);  // stable_dt: the pore-pressure wave limits
   std::string projection_limit(double dt, double dt_sub, const char *what, bool at_setup);  // check_timestep
-  bool is_point(int i) const { return (pts.mask[i] & pts.point_bit) != 0; }
+  // a material point of the fluid (not one that left through an outflow face)
+  bool is_point(int i) const { return (pts.mask[i] & pts.point_bit) != 0 && pts.state[i][C_FLAG] != kPointGone; }
+  long gone_ = 0;
   bool is_grain(int i) const { return opt.coupled && (pts.mask[i] & pts.grain_bit) != 0; }
   double mass_min() const { return opt.mass_threshold * state.point_mass_ref; }
 

@@ -67,6 +67,8 @@ double FluidSolver::stable_dt() {
                     -this->state.grain_tau};
   double glob[17];
   MPI_Allreduce(loc, glob, every_auto ? 17 : eos_scale ? 14 : 6, MPI_DOUBLE, MPI_MAX, comm_);
+  // an inflow moves the fluid at its U from the first step on: the advective limit from the start
+  for (int f = 0; f < 6; ++f) glob[0] = std::max(glob[0], opt.face[f].kind == BcKind::Inflow ? opt.face[f].inflow : 0.0);
   if (every_auto) auto_limits(glob);
   if (eos_scale) {
     // rho0 (|a|max H + |v|max^2), H the points' largest extent: hydrostatic plus dynamic pressure

@@ -24,6 +24,7 @@ computed from the inputs and the bed at rest alone:
     (measured 0.90, the distributor's share 0.10 by the balance above).
 """
 import os
+import shutil
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -69,6 +70,31 @@ def case_quick(r):
     # the plateau is the buoyant weight less what the distributor carries (the bottom layer and what
     # rests on it: measured 0.90 with 10 % on the distributor)
     check(0.85 < hi["dP"] / W < 1.02, "U = 0.05: dP between 0.85 and 1.02 times the buoyant weight per area")
+
+
+def case_open_quick(r):
+    """The same bed fed through the floor and drained at the top (inputs/fluidized_bed/
+    in.fluidized_bed_open, boundary zlo inflow U / zhi outflow), at the reduced size of 'quick': the
+    water's mass = the fill's + in - out at every output to 1e-12; over the second half of each stage
+    the mass in the box within 1.1 layers of points across the inflow (measured 1.000 and 1.041: the
+    points that leave the bed carry the mass the beads' volume left them, the new ones a full
+    layer's); the fixed bed at rest (height within 1 %); the fluidized bed's dP from the two probes
+    between 0.85 and 1.02 times the buoyant weight per area (measured 0.911) and the bed expanded."""
+    work = r.fresh("fluidized_bed/open_quick")
+    shutil.copy(os.path.join(r.inputs, "fluidized_bed", "in.fluidized_bed_open"), work)
+    r.execute(work, "in.fluidized_bed_open", dict(QUICK, nz=11), timeout=900)
+    shutil.copy(os.path.join(work, "output.txt"), os.path.join(work, "log.txt"))
+    res = fb.analyse_open(work)
+    check(res["balance"] < 1e-12, f"water mass = fill + in - out at every output ({res['balance']:.1e})")
+    st = res["stages"]
+    check(len(st) == 2, f"two stages ({len(st)})")
+    if len(st) != 2:
+        return
+    lo, hi = st
+    check(all(x["range"] < 1.1 for x in st), "the mass in the box within 1.1 layers over each stage's second half")
+    check(abs(lo["H"] / res["H0"] - 1.0) < 0.01, "U = 0.02: the bed stays at rest (height within 1 %)")
+    check(hi["H"] / res["H0"] > 1.05, "U = 0.05: the bed has expanded")
+    check(0.85 < hi["dP"] / res["W"] < 1.02, "U = 0.05: dP between 0.85 and 1.02 times the buoyant weight per area")
 
 
 if __name__ == "__main__":

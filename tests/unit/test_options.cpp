@@ -356,3 +356,53 @@ TEST(Options, ReferencePageListsExactlyTheTableKeywords) {
 }
 
 }  // namespace
+
+// boundary FACE inflow U | outflow: the parsed faces and velocities, and the refusals (the value,
+// 'all', a periodic face, pressure eos, mesh_wall, fix_modify changing a face's kind)
+TEST(Options, BoundaryInflowOutflow) {
+  const std::string proj = "cell 0.5 density 1000 fill col 2 2 2 type 1 ";
+  mpm::Options o = parse(proj + "boundary zlo inflow 0.05 boundary zhi outflow");
+  EXPECT_EQ(o.face[4].kind, mpm::BcKind::Inflow);
+  EXPECT_DOUBLE_EQ(o.face[4].inflow, 0.05);
+  EXPECT_EQ(o.face[5].kind, mpm::BcKind::Outflow);
+  EXPECT_TRUE(o.flow_faces());
+  EXPECT_DOUBLE_EQ(o.face_velocity(4), 0.05);   // along +z at the low face
+  EXPECT_DOUBLE_EQ(o.face_velocity(5), 0.0);    // an outflow imposes no velocity
+  EXPECT_DOUBLE_EQ(parse(proj + "boundary xhi inflow 0.2").face_velocity(1), -0.2);  // into the grid: -x
+  EXPECT_FALSE(parse(proj).flow_faces());
+  const std::string inflow = "Fix mpm/fluid: keyword 'boundary inflow' expects a normal velocity U > 0 (velocity, into "
+                             "the grid) of the inflow, got ";
+  EXPECT_EQ(error_of(proj + "boundary zlo inflow 0"), inflow + "'0'");
+  EXPECT_EQ(error_of(proj + "boundary zlo inflow -1"), inflow + "'-1'");
+  EXPECT_EQ(error_of(proj + "boundary zlo inflow nan"), inflow + "'nan'");
+  EXPECT_EQ(error_of(proj + "boundary zlo inflow"), inflow + "nothing");
+  EXPECT_NE(error_of(proj + "boundary all outflow").find("expects one face (xlo xhi ylo yhi zlo zhi) for 'inflow' or "
+                                                         "'outflow', got 'all'"), std::string::npos);
+  EXPECT_NE(error_of(kBase + "boundary zhi outflow").find("keyword 'boundary zhi outflow' needs 'pressure projection'"),
+            std::string::npos);
+  mpm::ParseEnv env = box_env();
+  env.periodic[0] = true;
+  std::vector<std::string> w = {"f", "all", "mpm/fluid", "cell", "0.5", "density", "1000", "boundary", "xlo", "inflow", "1"};
+  std::vector<char *> argv;
+  for (auto &s : w) argv.push_back(&s[0]);
+  try {
+    mpm::parse_options(static_cast<int>(argv.size()), argv.data(), env);
+    ADD_FAILURE() << "an inflow on a periodic face accepted";
+  } catch (const mpm::Error &e) {
+    EXPECT_NE(std::string(e.what()).find("keyword 'boundary xlo inflow' expects a face of a non-periodic dimension, got "
+                                         "xlo"), std::string::npos) << e.what();
+  }
+  // fix_modify: an inflow's U may change, a face's kind to or from inflow / outflow not
+  std::vector<std::string> b = {"boundary", "zlo", "inflow", "0.1"};
+  std::vector<char *> ab = {&b[0][0], &b[1][0], &b[2][0], &b[3][0]};
+  EXPECT_EQ(mpm::modify_option(o, 4, ab.data()), 4);
+  EXPECT_DOUBLE_EQ(o.face[4].inflow, 0.1);
+  b = {"boundary", "zhi", "noslip"};
+  ab = {&b[0][0], &b[1][0], &b[2][0]};
+  EXPECT_THROW(mpm::modify_option(o, 3, ab.data()), mpm::Error);
+  EXPECT_EQ(o.face[5].kind, mpm::BcKind::Outflow);
+  b = {"boundary", "xlo", "outflow"};
+  ab = {&b[0][0], &b[1][0], &b[2][0]};
+  EXPECT_THROW(mpm::modify_option(o, 3, ab.data()), mpm::Error);
+  EXPECT_EQ(o.face[0].kind, mpm::BcKind::NoSlip);
+}
