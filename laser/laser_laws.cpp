@@ -7,11 +7,13 @@
 namespace laser {
 
 RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf, double lo,
-                       double hi, double xtol, int maxit) {
+                       double hi, double xtol, int maxit, double x0, bool signs_known) {
   RootResult r;
-  double flo, fhi, d;
-  fdf(lo, flo, d);
-  fdf(hi, fhi, d);
+  double flo = -1.0, fhi = 1.0, d;
+  if (!signs_known) {
+    fdf(lo, flo, d);
+    fdf(hi, fhi, d);
+  }
   if (flo == 0.0) { r.x = lo; r.converged = true; return r; }
   if (fhi == 0.0) { r.x = hi; r.converged = true; return r; }
   if ((flo > 0.0) == (fhi > 0.0) || !std::isfinite(flo) || !std::isfinite(fhi)) {
@@ -19,7 +21,8 @@ RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf,
     return r;
   }
   if (flo > 0.0) std::swap(lo, hi);  // orient so that f(lo) < 0 < f(hi)
-  double x = 0.5 * (lo + hi), dxold = std::fabs(hi - lo), dx = dxold;
+  const bool inside = x0 > std::min(lo, hi) && x0 < std::max(lo, hi);
+  double x = inside ? x0 : 0.5 * (lo + hi), dxold = std::fabs(hi - lo), dx = dxold;
   double f, df;
   fdf(x, f, df);
   for (int it = 1; it <= maxit; ++it) {
@@ -45,7 +48,7 @@ RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf,
 }
 
 RootResult illinois_root(const std::function<double(double)>& f, double a, double b, double fa,
-                         double fb, double xtol, int maxit) {
+                         double fb, double xtol, int maxit, double ftol) {
   RootResult r;
   if ((fa > 0.0) == (fb > 0.0) && fa != 0.0 && fb != 0.0) {
     r.x = std::numeric_limits<double>::quiet_NaN();
@@ -58,7 +61,7 @@ RootResult illinois_root(const std::function<double(double)>& f, double a, doubl
     c = (fa * b - fb * a) / (fa - fb);
     if (!(c > std::min(a, b) && c < std::max(a, b))) c = 0.5 * (a + b);
     const double fc = f(c);
-    if (fc == 0.0 || std::fabs(b - a) <= xtol) { r.converged = true; break; }
+    if (std::fabs(fc) <= ftol || std::fabs(b - a) <= xtol) { r.converged = true; break; }
     if ((fc > 0.0) == (fb > 0.0)) {
       b = c; fb = fc;
       if (side == -1) fa *= 0.5;
@@ -172,7 +175,7 @@ InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bo
   return s;
 }
 
-InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected) {
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected, double phi_guess) {
   InterfaceState s;
   const double E = gaussian_beam(xi);
   s.phi = G.theta_m;
@@ -195,7 +198,8 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       };
       if (residual(hi, nullptr) > 0.0) {
         auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
-        const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+        // residual(theta_m) = r0 < 0 < residual(hi): the bracket's signs are known
+        const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
         s.phi = rr.x;
         s.iterations = rr.iterations;
         s.converged = rr.converged;
@@ -238,7 +242,7 @@ double layer_content(const InterfaceState& s, double g, double b2) {
 }
 
 InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
-                                    bool advected, double kappa, double H_old) {
+                                    bool advected, double kappa, double H_old, double phi_guess) {
   if (!(g > 0.0) || !(beta >= 0.0) || !(kappa >= 0.0)) return solve_interface(G, xi, g, 0.0, advected);
   const double E = gaussian_beam(xi);
   // content0(phi) = theta_sat g c(Pe(phi)) >= 0, so the flow's part is >= beta theta_sat - gamma - kappa H_old
@@ -277,7 +281,7 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
     const double hi = G.theta_m + avail * (1.0 - G.theta_m) / (G.kprime * (1.0 / g + beta));
     if (residual(hi, nullptr) > 0.0) {
       auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
-      rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+      rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);  // signs checked above
       phi = rr.x;
     } else {
       phi = hi;
@@ -346,6 +350,8 @@ double curvature_factor(double a, double d) {
   y = std::min(std::fabs(y), 1.0);
   return convex ? y / std::asin(y) : std::asin(y) / y;
 }
+
+double curvature_factor_conduction(double a, double d) { return curvature_factor(-a, d); }
 
 double flow_shape(const FlowProfile& P, double A, double xi) {
   return P.rising ? A * std::pow(xi, 1.0 / P.m) : A * xi * std::exp(-xi / P.xi_p);
