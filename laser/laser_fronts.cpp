@@ -68,21 +68,24 @@ void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n
   double phi_last = n.itf.phi;  // the root of the last evaluation starts the next one
   double g_last = -1.0;         // and its state is kept for the root
   InterfaceState st;
+  auto rate_of = [&](const InterfaceState& s) {
+    const double d2 = std::max(melting_rate(G_, geo.Cc, grad_n, geo.J, s.grad_bottom, cfg_.moving_origin), 0.0);
+    const double d1 = std::max(recession_rate(G_, n.xi, s), 0.0);
+    return d2 - d1 + n.v;
+  };
   auto rate = [&](double g) {
     st = solve_interface(G_, n.xi, g, b2_at(g), advected_, phi_last);
     g_last = g;
     if (st.theta_sat > 0.0) phi_last = st.phi;
-    const double d2 =
-        std::max(melting_rate(G_, geo.Cc, grad_n, geo.J, st.grad_bottom, cfg_.moving_origin), 0.0);
-    const double d1 = std::max(recession_rate(G_, n.xi, st), 0.0);
-    return d2 - d1 + n.v;
+    return rate_of(st);
   };
   const double g_old = n.g;
   auto F = [&](double g) { return g - g_old - dtn * rate(g); };
   // F rises with g; the explicit predictor g_p = g_old + dtn R(g_old) and g_old bracket
   // the root (F(g_old) = -dtn R(g_old), F(g_p) = dtn (R(g_old) - R(g_p))), a bracket
-  // narrower than [0, g_p] that saves most of the iterations (each one solves (4-29))
-  const double R0 = rate(g_old), g_p = g_old + dtn * R0;
+  // narrower than [0, g_p] that saves most of the iterations (each one solves (4-29)).
+  // R(g_old) from the state the step started with (solve_interfaces: (4-29) at g_old, b2)
+  const double R0 = rate_of(n.itf), g_p = g_old + dtn * R0;
   double lo = std::min(g_old, std::max(g_p, 0.0)), hi = std::max(g_old, g_p);
   double Flo = lo == g_old ? -dtn * R0 : F(lo), Fhi = hi == g_old ? -dtn * R0 : F(hi);
   if (Flo > 0.0) { lo = 0.0; Flo = F(0.0); }  // not monotone here: the wide bracket

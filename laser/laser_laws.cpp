@@ -100,6 +100,9 @@ Groups make_groups(const Material& m, double I0, double R) {
           (R * std::sqrt(m.hlv));
   G.hls_hlv = m.hls / m.hlv;
   G.p0 = m.p0;
+  // vapour_term (below) at theta_m, the same expression
+  G.vapour_melt = std::exp(G.Hlv * (1.0 - 1.0 / G.theta_m)) * (1.0 + G.Lambda * G.theta_m) /
+                  (G.Iprime * std::sqrt(G.theta_m));
   return G;
 }
 
@@ -183,11 +186,11 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
   double F = 1.0;
   if (!(g > 0.0)) {
     // Vanishing layer: all that is not evaporated at T_m is conducted through.
-    const double q = std::max(E - vapour_term(G, G.theta_m, nullptr), 0.0) / G.kprime;
+    const double q = std::max(E - G.vapour_melt, 0.0) / G.kprime;
     s.grad_top = s.grad_bottom = q;
   } else {
     const double avail = E - G.kprime * b2 * g;
-    const double r0 = vapour_term(G, G.theta_m, nullptr) - avail;
+    const double r0 = G.vapour_melt - avail;
     if (r0 < 0.0) {
       // Upper bracket: the conduction-only root, where the vapour term is > 0.
       const double hi = G.theta_m + avail * g * (1.0 - G.theta_m) / G.kprime;
@@ -209,12 +212,19 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       }
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
       if (advected) {
-        s.w = std::max(flux_recession_rate(G, s.phi), 0.0);
+        // vapour term, recession rate and pressure from one exponential (the expressions of
+        // vapour_term and flux_recession_rate)
+        const double e = std::exp(G.Hlv * (1.0 - 1.0 / s.phi)), sq = std::sqrt(s.phi);
+        const double v = e * (1.0 + G.Lambda * s.phi) / (G.Iprime * sq);
+        s.w = std::max(G.Ni * v - G.Psi * (G.p0 * e / G.p_scale) * sq, 0.0);
         s.peclet = s.w * g;
         F = peclet_factor(s.peclet);
-        const double th = s.theta_sat;
-        s.residual = (vapour_term(G, s.phi, nullptr) + G.kprime * (th / g * F + b2 * g) - E) / E;
-        (void)th;
+        s.residual = (v + G.kprime * (s.theta_sat / g * F + b2 * g) - E) / E;
+        s.grad_top = s.theta_sat / g * F + b2 * g;
+        s.grad_bottom = s.theta_sat / g * F * std::exp(-s.peclet) - b2 * g;
+        s.p_pa = G.p0 * e;
+        s.p_star = s.p_pa / G.p_scale;
+        return s;
       } else {
         s.residual = interface_residual(G, s.phi, xi, g, b2) / E;
       }
@@ -269,7 +279,7 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
   double phi = G.theta_m;
   RootResult rr;
   rr.converged = true;
-  if (vapour_term(G, G.theta_m, nullptr) - avail < 0.0) {
+  if (G.vapour_melt - avail < 0.0) {
     auto residual = [&](double p, double* df) {
       const double r = advected ? advected_residual(G, p, xi, g, 0.0, df) : interface_residual(G, p, xi, g, 0.0, df);
       double dpart = 0.0;

@@ -95,6 +95,7 @@ struct Groups {
   double Na = 0, Nc = 0, k = 0, Ste = 0, theta_i = 0, theta_m = 0;
   double kprime = 0, Iprime = 0, Lambda = 0, Hlv = 0, Ni = 0, Psi = 0, hls_hlv = 0;
   double p0 = 0;  // Pa, to restore dimensional pressure
+  double vapour_melt = 0;  // vapour term of (4-29) at T_m (the bracket of every interface solve)
 };
 
 // Builds the groups defined after (3-4a), (3-22), (3-24), (3-25), (3-26).
