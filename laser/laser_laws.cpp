@@ -131,34 +131,52 @@ double peclet_factor(double Pe) {
   return Pe / -std::expm1(-Pe);
 }
 
-double flux_recession_rate(const Groups& G, double phi, double* dw) {
-  double dv = 0;
-  const double v = vapour_term(G, phi, dw ? &dv : nullptr);
-  const double p_star = G.p0 * std::exp(G.Hlv * (1.0 - 1.0 / phi)) / G.p_scale;
-  const double sq = std::sqrt(phi);
-  if (dw) *dw = G.Ni * dv - G.Psi * p_star * (G.Hlv / (phi * phi) * sq + 0.5 / sq);
-  return G.Ni * v - G.Psi * p_star * sq;
-}
-
-double advected_residual(const Groups& G, double phi, double xi, double g, double b2, double* dres) {
-  // one exponential for the vapour term, the pressure and the flux velocity
+namespace {
+// The vapour term (vapour_term), its derivative, and the flux recession rate
+// N_i v - Psi p* sqrt(phi) with its derivative, from one exponential.
+struct VapourParts {
+  double v = 0, dv = 0, w = 0, dw = 0;  // w, dw: not clipped at 0
+};
+VapourParts vapour_parts(const Groups& G, double phi, bool deriv) {
+  VapourParts q;
   const double e = std::exp(G.Hlv * (1.0 - 1.0 / phi));
   const double sq = std::sqrt(phi);
-  const double v = e * (1.0 + G.Lambda * phi) / (G.Iprime * sq);
+  q.v = e * (1.0 + G.Lambda * phi) / (G.Iprime * sq);
   const double p_star = G.p0 * e / G.p_scale;
+  q.w = G.Ni * q.v - G.Psi * p_star * sq;
+  if (deriv) {
+    q.dv = q.v * (G.Hlv / (phi * phi) + G.Lambda / (1.0 + G.Lambda * phi) - 0.5 / phi);
+    q.dw = G.Ni * q.dv - G.Psi * p_star * (G.Hlv / (phi * phi) * sq + 0.5 / sq);
+  }
+  return q;
+}
+// advected_residual from the vapour parts at phi
+double advected_residual_of(const Groups& G, const VapourParts& q, double phi, double xi, double g, double b2,
+                            double* dres) {
   const double th = (phi - G.theta_m) / (1.0 - G.theta_m);
-  const double w = std::max(G.Ni * v - G.Psi * p_star * sq, 0.0);
+  const double w = std::max(q.w, 0.0);
   const double Pe = w * g;
   const double em = -std::expm1(-Pe);  // 1 - exp(-Pe)
   const double F = Pe < 1e-6 ? 1.0 + 0.5 * Pe : Pe / em;
   if (dres) {
-    const double dv = v * (G.Hlv / (phi * phi) + G.Lambda / (1.0 + G.Lambda * phi) - 0.5 / phi);
-    const double dw = w > 0.0 ? G.Ni * dv - G.Psi * p_star * (G.Hlv / (phi * phi) * sq + 0.5 / sq) : 0.0;
+    const double dw = w > 0.0 ? q.dw : 0.0;
     // F'(Pe) = (1 - e^-Pe (1 + Pe)) / (1 - e^-Pe)^2
     const double dF = Pe < 1e-6 ? 0.5 : (em - Pe * (1.0 - em)) / (em * em);
-    *dres = dv + G.kprime * (F / (g * (1.0 - G.theta_m)) + th * dF * dw);
+    *dres = q.dv + G.kprime * (F / (g * (1.0 - G.theta_m)) + th * dF * dw);
   }
-  return v + G.kprime * (th / g * F + b2 * g) - gaussian_beam(xi);
+  return q.v + G.kprime * (th / g * F + b2 * g) - gaussian_beam(xi);
+}
+}  // namespace
+
+double flux_recession_rate(const Groups& G, double phi, double* dw) {
+  const VapourParts q = vapour_parts(G, phi, dw != nullptr);
+  if (dw) *dw = q.dw;
+  return q.w;
+}
+
+double advected_residual(const Groups& G, double phi, double xi, double g, double b2, double* dres) {
+  // one exponential for the vapour term, the pressure and the flux velocity
+  return advected_residual_of(G, vapour_parts(G, phi, dres != nullptr), phi, xi, g, b2, dres);
 }
 
 InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bool advected) {
@@ -257,11 +275,14 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
   const double E = gaussian_beam(xi);
   // content0(phi) = theta_sat g c(Pe(phi)) >= 0, so the flow's part is >= beta theta_sat - gamma - kappa H_old
   const double avail = E + G.kprime * (gamma + kappa * H_old);
-  auto content0 = [&](double p, double* dcont) {
+  // q: the vapour parts at p where the caller has them (one exponential per evaluation)
+  auto content0 = [&](double p, double* dcont, const VapourParts* q) {
     const double th = (p - G.theta_m) / (1.0 - G.theta_m);
     double c = 0.5, dc = 0.0, Pe = 0.0, dw = 0.0;
     if (advected) {
-      const double w = flux_recession_rate(G, p, &dw);
+      const VapourParts qp = q ? *q : vapour_parts(G, p, true);
+      const double w = qp.w;
+      dw = qp.dw;
       Pe = std::max(w, 0.0) * g;
       if (!(w > 0.0)) dw = 0.0;
       c = content_factor(Pe, &dc);
@@ -269,10 +290,10 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
     if (dcont) *dcont = g * (c / (1.0 - G.theta_m) + th * dc * g * dw);
     return th * g * c;
   };
-  auto flow_part = [&](double p, double* dpart) {  // b2 g
+  auto flow_part = [&](double p, double* dpart, const VapourParts* q) {  // b2 g
     const double th = (p - G.theta_m) / (1.0 - G.theta_m);
     double dcont = 0.0;
-    const double cont = kappa > 0.0 ? content0(p, dpart ? &dcont : nullptr) : 0.0;
+    const double cont = kappa > 0.0 ? content0(p, dpart ? &dcont : nullptr, q) : 0.0;
     if (dpart) *dpart = beta / (1.0 - G.theta_m) + kappa * dcont;
     return beta * th - gamma + (kappa > 0.0 ? kappa * (cont - H_old) : 0.0);
   };
@@ -281,9 +302,16 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
   rr.converged = true;
   if (G.vapour_melt - avail < 0.0) {
     auto residual = [&](double p, double* df) {
-      const double r = advected ? advected_residual(G, p, xi, g, 0.0, df) : interface_residual(G, p, xi, g, 0.0, df);
+      double r;
+      VapourParts q;
+      if (advected) {
+        q = vapour_parts(G, p, true);
+        r = advected_residual_of(G, q, p, xi, g, 0.0, df);
+      } else {
+        r = interface_residual(G, p, xi, g, 0.0, df);
+      }
       double dpart = 0.0;
-      const double part = flow_part(p, df ? &dpart : nullptr);
+      const double part = flow_part(p, df ? &dpart : nullptr, advected ? &q : nullptr);
       if (df) *df += G.kprime * dpart;
       return r + G.kprime * part;
     };
@@ -297,7 +325,7 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
       phi = hi;
     }
   }
-  const double b2 = flow_part(phi, nullptr) / g;
+  const double b2 = flow_part(phi, nullptr, nullptr) / g;
   InterfaceState s = interface_at(G, phi, g, b2, advected);
   s.iterations = rr.iterations;
   s.converged = rr.converged;
