@@ -51,7 +51,7 @@ Drill::Geometry Drill::front_geometry(int i, const std::vector<double>& S2old, d
     const double d = h * geo.J;
     if (std::fabs(a * d) >= 2.0 && res_.curvature_clamps++ == 0)
       first_clamp_ = "first at xi = " + fmt(nodes_[i].xi, 4) + ", t = " + fmt(tb * G_.t_scale, 4) + " s";
-    geo.Cc = curvature_factor(a, d);
+    geo.Cc = cfg_.curvature_form == CurvatureForm::Text ? curvature_factor(a, d) : curvature_factor_conduction(a, d);
   }
   return geo;
 }
@@ -65,28 +65,41 @@ void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n
   // held over the step; holding b2 itself would let b2 g grow with g_new.
   const double b2g = n.b2 * n.g;
   auto b2_at = [&](double g) { return g > 0.0 ? b2g / g : 0.0; };
-  auto rate = [&](double g) {
-    const InterfaceState st = solve_interface(G_, n.xi, g, b2_at(g), advected_);
-    const double d2 =
-        std::max(melting_rate(G_, geo.Cc, grad_n, geo.J, st.grad_bottom, cfg_.moving_origin), 0.0);
-    const double d1 = std::max(recession_rate(G_, n.xi, st), 0.0);
+  double phi_last = n.itf.phi;  // the root of the last evaluation starts the next one
+  double g_last = -1.0;         // and its state is kept for the root
+  InterfaceState st;
+  auto rate_of = [&](const InterfaceState& s) {
+    const double d2 = std::max(melting_rate(G_, geo.Cc, grad_n, geo.J, s.grad_bottom, cfg_.moving_origin), 0.0);
+    const double d1 = std::max(recession_rate(G_, n.xi, s), 0.0);
     return d2 - d1 + n.v;
+  };
+  auto rate = [&](double g) {
+    st = solve_interface(G_, n.xi, g, b2_at(g), advected_, phi_last);
+    g_last = g;
+    if (st.theta_sat > 0.0) phi_last = st.phi;
+    return rate_of(st);
   };
   const double g_old = n.g;
   auto F = [&](double g) { return g - g_old - dtn * rate(g); };
+  // F rises with g; the explicit predictor g_p = g_old + dtn R(g_old) and g_old bracket
+  // the root (F(g_old) = -dtn R(g_old), F(g_p) = dtn (R(g_old) - R(g_p))), a bracket
+  // narrower than [0, g_p] that saves most of the iterations (each one solves (4-29)).
+  // R(g_old) from the state the step started with (solve_interfaces: (4-29) at g_old, b2)
+  const double R0 = rate_of(n.itf), g_p = g_old + dtn * R0;
+  double lo = std::min(g_old, std::max(g_p, 0.0)), hi = std::max(g_old, g_p);
+  double Flo = lo == g_old ? -dtn * R0 : F(lo), Fhi = hi == g_old ? -dtn * R0 : F(hi);
+  if (Flo > 0.0) { lo = 0.0; Flo = F(0.0); }  // not monotone here: the wide bracket
+  for (int k = 0; Fhi < 0.0 && k < 60; ++k) { hi = 2.0 * hi + 1e-12; Fhi = F(hi); }
   double g_new;
-  const double F0 = F(0.0);
-  if (F0 >= 0.0) {
-    g_new = 0.0;
+  if (Flo >= 0.0) {
+    g_new = lo;  // lo = 0: the layer is used up within the step
   } else {
-    const double R0 = rate(g_old);
-    double hi = R0 > 0.0 ? g_old + dtn * R0 : g_old;
-    double Fhi = F(hi);
-    for (int k = 0; Fhi < 0.0 && k < 60; ++k) { hi = 2.0 * hi + 1e-12; Fhi = F(hi); }
-    g_new = illinois_root(F, 0.0, hi, F0, Fhi, 1e-12 * std::max(hi, 1e-12)).x;
+    // F' >= 1 (R does not rise with g): |F| <= tol puts g within tol of the root
+    const double tol = 1e-12 * std::max(hi, 1e-12);
+    g_new = illinois_root(F, lo, hi, Flo, Fhi, tol, 200, tol).x;
   }
   n.b2 = b2_at(g_new);
-  n.itf = solve_interface(G_, n.xi, g_new, n.b2, advected_);
+  n.itf = g_new == g_last ? st : solve_interface(G_, n.xi, g_new, n.b2, advected_, phi_last);
 }
 
 // (3-40) melting and (3-25) recession rates; a negative melting rate is

@@ -7,11 +7,13 @@
 namespace laser {
 
 RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf, double lo,
-                       double hi, double xtol, int maxit) {
+                       double hi, double xtol, int maxit, double x0, bool signs_known) {
   RootResult r;
-  double flo, fhi, d;
-  fdf(lo, flo, d);
-  fdf(hi, fhi, d);
+  double flo = -1.0, fhi = 1.0, d;
+  if (!signs_known) {
+    fdf(lo, flo, d);
+    fdf(hi, fhi, d);
+  }
   if (flo == 0.0) { r.x = lo; r.converged = true; return r; }
   if (fhi == 0.0) { r.x = hi; r.converged = true; return r; }
   if ((flo > 0.0) == (fhi > 0.0) || !std::isfinite(flo) || !std::isfinite(fhi)) {
@@ -19,7 +21,8 @@ RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf,
     return r;
   }
   if (flo > 0.0) std::swap(lo, hi);  // orient so that f(lo) < 0 < f(hi)
-  double x = 0.5 * (lo + hi), dxold = std::fabs(hi - lo), dx = dxold;
+  const bool inside = x0 > std::min(lo, hi) && x0 < std::max(lo, hi);
+  double x = inside ? x0 : 0.5 * (lo + hi), dxold = std::fabs(hi - lo), dx = dxold;
   double f, df;
   fdf(x, f, df);
   for (int it = 1; it <= maxit; ++it) {
@@ -45,7 +48,7 @@ RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf,
 }
 
 RootResult illinois_root(const std::function<double(double)>& f, double a, double b, double fa,
-                         double fb, double xtol, int maxit) {
+                         double fb, double xtol, int maxit, double ftol) {
   RootResult r;
   if ((fa > 0.0) == (fb > 0.0) && fa != 0.0 && fb != 0.0) {
     r.x = std::numeric_limits<double>::quiet_NaN();
@@ -58,7 +61,7 @@ RootResult illinois_root(const std::function<double(double)>& f, double a, doubl
     c = (fa * b - fb * a) / (fa - fb);
     if (!(c > std::min(a, b) && c < std::max(a, b))) c = 0.5 * (a + b);
     const double fc = f(c);
-    if (fc == 0.0 || std::fabs(b - a) <= xtol) { r.converged = true; break; }
+    if (std::fabs(fc) <= ftol || std::fabs(b - a) <= xtol) { r.converged = true; break; }
     if ((fc > 0.0) == (fb > 0.0)) {
       b = c; fb = fc;
       if (side == -1) fa *= 0.5;
@@ -97,6 +100,9 @@ Groups make_groups(const Material& m, double I0, double R) {
           (R * std::sqrt(m.hlv));
   G.hls_hlv = m.hls / m.hlv;
   G.p0 = m.p0;
+  // vapour_term (below) at theta_m, the same expression
+  G.vapour_melt = std::exp(G.Hlv * (1.0 - 1.0 / G.theta_m)) * (1.0 + G.Lambda * G.theta_m) /
+                  (G.Iprime * std::sqrt(G.theta_m));
   return G;
 }
 
@@ -125,34 +131,52 @@ double peclet_factor(double Pe) {
   return Pe / -std::expm1(-Pe);
 }
 
-double flux_recession_rate(const Groups& G, double phi, double* dw) {
-  double dv = 0;
-  const double v = vapour_term(G, phi, dw ? &dv : nullptr);
-  const double p_star = G.p0 * std::exp(G.Hlv * (1.0 - 1.0 / phi)) / G.p_scale;
-  const double sq = std::sqrt(phi);
-  if (dw) *dw = G.Ni * dv - G.Psi * p_star * (G.Hlv / (phi * phi) * sq + 0.5 / sq);
-  return G.Ni * v - G.Psi * p_star * sq;
-}
-
-double advected_residual(const Groups& G, double phi, double xi, double g, double b2, double* dres) {
-  // one exponential for the vapour term, the pressure and the flux velocity
+namespace {
+// The vapour term (vapour_term), its derivative, and the flux recession rate
+// N_i v - Psi p* sqrt(phi) with its derivative, from one exponential.
+struct VapourParts {
+  double v = 0, dv = 0, w = 0, dw = 0;  // w, dw: not clipped at 0
+};
+VapourParts vapour_parts(const Groups& G, double phi, bool deriv) {
+  VapourParts q;
   const double e = std::exp(G.Hlv * (1.0 - 1.0 / phi));
   const double sq = std::sqrt(phi);
-  const double v = e * (1.0 + G.Lambda * phi) / (G.Iprime * sq);
+  q.v = e * (1.0 + G.Lambda * phi) / (G.Iprime * sq);
   const double p_star = G.p0 * e / G.p_scale;
+  q.w = G.Ni * q.v - G.Psi * p_star * sq;
+  if (deriv) {
+    q.dv = q.v * (G.Hlv / (phi * phi) + G.Lambda / (1.0 + G.Lambda * phi) - 0.5 / phi);
+    q.dw = G.Ni * q.dv - G.Psi * p_star * (G.Hlv / (phi * phi) * sq + 0.5 / sq);
+  }
+  return q;
+}
+// advected_residual from the vapour parts at phi
+double advected_residual_of(const Groups& G, const VapourParts& q, double phi, double xi, double g, double b2,
+                            double* dres) {
   const double th = (phi - G.theta_m) / (1.0 - G.theta_m);
-  const double w = std::max(G.Ni * v - G.Psi * p_star * sq, 0.0);
+  const double w = std::max(q.w, 0.0);
   const double Pe = w * g;
   const double em = -std::expm1(-Pe);  // 1 - exp(-Pe)
   const double F = Pe < 1e-6 ? 1.0 + 0.5 * Pe : Pe / em;
   if (dres) {
-    const double dv = v * (G.Hlv / (phi * phi) + G.Lambda / (1.0 + G.Lambda * phi) - 0.5 / phi);
-    const double dw = w > 0.0 ? G.Ni * dv - G.Psi * p_star * (G.Hlv / (phi * phi) * sq + 0.5 / sq) : 0.0;
+    const double dw = w > 0.0 ? q.dw : 0.0;
     // F'(Pe) = (1 - e^-Pe (1 + Pe)) / (1 - e^-Pe)^2
     const double dF = Pe < 1e-6 ? 0.5 : (em - Pe * (1.0 - em)) / (em * em);
-    *dres = dv + G.kprime * (F / (g * (1.0 - G.theta_m)) + th * dF * dw);
+    *dres = q.dv + G.kprime * (F / (g * (1.0 - G.theta_m)) + th * dF * dw);
   }
-  return v + G.kprime * (th / g * F + b2 * g) - gaussian_beam(xi);
+  return q.v + G.kprime * (th / g * F + b2 * g) - gaussian_beam(xi);
+}
+}  // namespace
+
+double flux_recession_rate(const Groups& G, double phi, double* dw) {
+  const VapourParts q = vapour_parts(G, phi, dw != nullptr);
+  if (dw) *dw = q.dw;
+  return q.w;
+}
+
+double advected_residual(const Groups& G, double phi, double xi, double g, double b2, double* dres) {
+  // one exponential for the vapour term, the pressure and the flux velocity
+  return advected_residual_of(G, vapour_parts(G, phi, dres != nullptr), phi, xi, g, b2, dres);
 }
 
 InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bool advected) {
@@ -172,7 +196,7 @@ InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bo
   return s;
 }
 
-InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected) {
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected, double phi_guess) {
   InterfaceState s;
   const double E = gaussian_beam(xi);
   s.phi = G.theta_m;
@@ -180,11 +204,11 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
   double F = 1.0;
   if (!(g > 0.0)) {
     // Vanishing layer: all that is not evaporated at T_m is conducted through.
-    const double q = std::max(E - vapour_term(G, G.theta_m, nullptr), 0.0) / G.kprime;
+    const double q = std::max(E - G.vapour_melt, 0.0) / G.kprime;
     s.grad_top = s.grad_bottom = q;
   } else {
     const double avail = E - G.kprime * b2 * g;
-    const double r0 = vapour_term(G, G.theta_m, nullptr) - avail;
+    const double r0 = G.vapour_melt - avail;
     if (r0 < 0.0) {
       // Upper bracket: the conduction-only root, where the vapour term is > 0.
       const double hi = G.theta_m + avail * g * (1.0 - G.theta_m) / G.kprime;
@@ -195,7 +219,8 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       };
       if (residual(hi, nullptr) > 0.0) {
         auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
-        const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+        // residual(theta_m) = r0 < 0 < residual(hi): the bracket's signs are known
+        const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
         s.phi = rr.x;
         s.iterations = rr.iterations;
         s.converged = rr.converged;
@@ -205,12 +230,19 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       }
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
       if (advected) {
-        s.w = std::max(flux_recession_rate(G, s.phi), 0.0);
+        // vapour term, recession rate and pressure from one exponential (the expressions of
+        // vapour_term and flux_recession_rate)
+        const double e = std::exp(G.Hlv * (1.0 - 1.0 / s.phi)), sq = std::sqrt(s.phi);
+        const double v = e * (1.0 + G.Lambda * s.phi) / (G.Iprime * sq);
+        s.w = std::max(G.Ni * v - G.Psi * (G.p0 * e / G.p_scale) * sq, 0.0);
         s.peclet = s.w * g;
         F = peclet_factor(s.peclet);
-        const double th = s.theta_sat;
-        s.residual = (vapour_term(G, s.phi, nullptr) + G.kprime * (th / g * F + b2 * g) - E) / E;
-        (void)th;
+        s.residual = (v + G.kprime * (s.theta_sat / g * F + b2 * g) - E) / E;
+        s.grad_top = s.theta_sat / g * F + b2 * g;
+        s.grad_bottom = s.theta_sat / g * F * std::exp(-s.peclet) - b2 * g;
+        s.p_pa = G.p0 * e;
+        s.p_star = s.p_pa / G.p_scale;
+        return s;
       } else {
         s.residual = interface_residual(G, s.phi, xi, g, b2) / E;
       }
@@ -238,16 +270,19 @@ double layer_content(const InterfaceState& s, double g, double b2) {
 }
 
 InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
-                                    bool advected, double kappa, double H_old) {
+                                    bool advected, double kappa, double H_old, double phi_guess) {
   if (!(g > 0.0) || !(beta >= 0.0) || !(kappa >= 0.0)) return solve_interface(G, xi, g, 0.0, advected);
   const double E = gaussian_beam(xi);
   // content0(phi) = theta_sat g c(Pe(phi)) >= 0, so the flow's part is >= beta theta_sat - gamma - kappa H_old
   const double avail = E + G.kprime * (gamma + kappa * H_old);
-  auto content0 = [&](double p, double* dcont) {
+  // q: the vapour parts at p where the caller has them (one exponential per evaluation)
+  auto content0 = [&](double p, double* dcont, const VapourParts* q) {
     const double th = (p - G.theta_m) / (1.0 - G.theta_m);
     double c = 0.5, dc = 0.0, Pe = 0.0, dw = 0.0;
     if (advected) {
-      const double w = flux_recession_rate(G, p, &dw);
+      const VapourParts qp = q ? *q : vapour_parts(G, p, true);
+      const double w = qp.w;
+      dw = qp.dw;
       Pe = std::max(w, 0.0) * g;
       if (!(w > 0.0)) dw = 0.0;
       c = content_factor(Pe, &dc);
@@ -255,21 +290,28 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
     if (dcont) *dcont = g * (c / (1.0 - G.theta_m) + th * dc * g * dw);
     return th * g * c;
   };
-  auto flow_part = [&](double p, double* dpart) {  // b2 g
+  auto flow_part = [&](double p, double* dpart, const VapourParts* q) {  // b2 g
     const double th = (p - G.theta_m) / (1.0 - G.theta_m);
     double dcont = 0.0;
-    const double cont = kappa > 0.0 ? content0(p, dpart ? &dcont : nullptr) : 0.0;
+    const double cont = kappa > 0.0 ? content0(p, dpart ? &dcont : nullptr, q) : 0.0;
     if (dpart) *dpart = beta / (1.0 - G.theta_m) + kappa * dcont;
     return beta * th - gamma + (kappa > 0.0 ? kappa * (cont - H_old) : 0.0);
   };
   double phi = G.theta_m;
   RootResult rr;
   rr.converged = true;
-  if (vapour_term(G, G.theta_m, nullptr) - avail < 0.0) {
+  if (G.vapour_melt - avail < 0.0) {
     auto residual = [&](double p, double* df) {
-      const double r = advected ? advected_residual(G, p, xi, g, 0.0, df) : interface_residual(G, p, xi, g, 0.0, df);
+      double r;
+      VapourParts q;
+      if (advected) {
+        q = vapour_parts(G, p, true);
+        r = advected_residual_of(G, q, p, xi, g, 0.0, df);
+      } else {
+        r = interface_residual(G, p, xi, g, 0.0, df);
+      }
       double dpart = 0.0;
-      const double part = flow_part(p, df ? &dpart : nullptr);
+      const double part = flow_part(p, df ? &dpart : nullptr, advected ? &q : nullptr);
       if (df) *df += G.kprime * dpart;
       return r + G.kprime * part;
     };
@@ -277,13 +319,13 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
     const double hi = G.theta_m + avail * (1.0 - G.theta_m) / (G.kprime * (1.0 / g + beta));
     if (residual(hi, nullptr) > 0.0) {
       auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
-      rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi);
+      rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);  // signs checked above
       phi = rr.x;
     } else {
       phi = hi;
     }
   }
-  const double b2 = flow_part(phi, nullptr) / g;
+  const double b2 = flow_part(phi, nullptr, nullptr) / g;
   InterfaceState s = interface_at(G, phi, g, b2, advected);
   s.iterations = rr.iterations;
   s.converged = rr.converged;
@@ -346,6 +388,8 @@ double curvature_factor(double a, double d) {
   y = std::min(std::fabs(y), 1.0);
   return convex ? y / std::asin(y) : std::asin(y) / y;
 }
+
+double curvature_factor_conduction(double a, double d) { return curvature_factor(-a, d); }
 
 double flow_shape(const FlowProfile& P, double A, double xi) {
   return P.rising ? A * std::pow(xi, 1.0 / P.m) : A * xi * std::exp(-xi / P.xi_p);

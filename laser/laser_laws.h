@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 
 namespace laser {
@@ -22,14 +23,18 @@ struct RootResult {
 
 // Safeguarded Newton ("rtsafe"): f(lo) and f(hi) must have opposite signs; a
 // Newton step that leaves the current bracket, or does not halve the bracket
-// fast enough, is replaced by bisection, so the iteration never diverges.
+// fast enough, is replaced by bisection, so the iteration never diverges. It starts
+// from x0 where x0 lies inside the bracket, else from its midpoint. signs_known: the
+// caller has checked f(lo) < 0 < f(hi), and the ends are not evaluated again.
 RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf,
-                       double lo, double hi, double xtol, int maxit = 200);
+                       double lo, double hi, double xtol, int maxit = 200,
+                       double x0 = std::numeric_limits<double>::quiet_NaN(), bool signs_known = false);
 
 // Derivative-free bracketed root (Illinois variant of regula falsi): f(a) and
-// f(b) of opposite sign; superlinear and never leaves [a, b].
+// f(b) of opposite sign; superlinear and never leaves [a, b]. Stops when the bracket is
+// below xtol or |f| <= ftol (for f' >= 1, |f(x)| bounds the distance to the root).
 RootResult illinois_root(const std::function<double(double)>& f, double a, double b, double fa,
-                         double fb, double xtol, int maxit = 200);
+                         double fb, double xtol, int maxit = 200, double ftol = 0.0);
 
 // --------------------------------------------------------- Clausius-Clapeyron
 // (3-15): vapour pressure [Pa] at the surface temperature T [K].
@@ -90,6 +95,7 @@ struct Groups {
   double Na = 0, Nc = 0, k = 0, Ste = 0, theta_i = 0, theta_m = 0;
   double kprime = 0, Iprime = 0, Lambda = 0, Hlv = 0, Ni = 0, Psi = 0, hls_hlv = 0;
   double p0 = 0;  // Pa, to restore dimensional pressure
+  double vapour_melt = 0;  // vapour term of (4-29) at T_m (the bracket of every interface solve)
 };
 
 // Builds the groups defined after (3-4a), (3-22), (3-24), (3-25), (3-26).
@@ -135,7 +141,10 @@ InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bo
 // surface gradient is theta_sat/g F(w g) and the bottom one smaller by
 // exp(-w g); their difference w theta_sat heats the vaporized liquid from T_m
 // to T_sat (docs/theory/laser_model.md, "Energy-consistent melt layer").
-InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected = false);
+// phi_guess (inside the bracket) starts the Newton iteration: the same root to 1e-15,
+// fewer iterations when the caller knows a nearby one.
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected = false,
+                               double phi_guess = std::numeric_limits<double>::quiet_NaN());
 // The same with the flow's part of the gradients tied to the surface temperature,
 // b2 g = beta theta_sat - gamma (beta >= 0): the layer gives the heat its outflow
 // carries at its own temperature and takes gamma from upstream (--melt-heat flux,
@@ -148,7 +157,8 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
 // caller scales beta and gamma by s = 1/(1 + g^2/(12 dtau))); kappa = 0 is the
 // quasi-steady layer.
 InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
-                                    bool advected = false, double kappa = 0.0, double H_old = 0.0);
+                                    bool advected = false, double kappa = 0.0, double H_old = 0.0,
+                                    double phi_guess = std::numeric_limits<double>::quiet_NaN());
 // Content factor of the layer's profile without b2: int_0^g theta dzeta = theta_sat g c(Pe),
 // c(Pe) = 1/Pe - 1/(e^Pe - 1) for the advected (exponential) profile, 1/2 for the
 // linear one (Pe = 0); dc receives c'(Pe).
@@ -182,6 +192,10 @@ double stefan_gradient_mean(double theta_i, double Na, double tau_m, double ta, 
 // ------------------------------------------------- interface corrections
 // Curvature factor (3-37) for curvature a and arc d; clamps |a d| < 2.
 double curvature_factor(double a, double d);
+// The same with the branches exchanged, 1/curvature_factor(a, d) = curvature_factor(-a, d):
+// C_c >= 1 where the front bulges into the solid (a > 0), as conduction into the
+// curved solid requires (docs/theory/laser_model.md 2.5; --curvature-factor conduction).
+double curvature_factor_conduction(double a, double d);
 
 // (3-40): melting rate dS2/dtau (unclamped) from the solid gradient grad_n
 // (d theta_s/dn at the front, < 0), the slope factor J = sqrt(1 + S2'^2), the

@@ -1,4 +1,5 @@
-// Names of the model choices and the number format of messages (laser_params.h).
+// Names of the model choices, the number format of messages and the cross-parameter
+// checks of a case (laser_params.h).
 #include <sstream>
 
 #include "laser_params.h"
@@ -31,5 +32,33 @@ const char* to_string(SolidModel m) {
 }
 const char* to_string(MeltEnergy m) { return m == MeltEnergy::Advected ? "advected" : "text"; }
 const char* to_string(MeltFlow m) { return m == MeltFlow::Conservative ? "conservative" : "text"; }
+const char* to_string(CurvatureForm m) { return m == CurvatureForm::Text ? "text" : "conduction"; }
+
+void validate(Config& c) {
+  const Material& m = c.mat;
+  if (!(m.Tm > m.Ti))
+    throw UsageError("--T-initial: must be below --T-melt (" + fmt(m.Tm) + " K), got " + fmt(m.Ti) + " K");
+  if (!(m.Tc > m.Tsat0))
+    throw UsageError("--T-critical: must be above --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tc) + " K");
+  if (!(m.Tsat0 > m.Tm))
+    throw UsageError("--T-melt: must be below --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tm) + " K");
+  if (c.melt_heat == MeltHeat::Flux && c.melt_flow != MeltFlow::Conservative)
+    throw UsageError("--melt-heat: flux needs --melt-flow conservative (the face fluxes are the conservative flow's), "
+                     "got --melt-flow text");
+  if (c.melt_content == MeltContent::Transient && !c.flux_heat())
+    throw UsageError("--melt-content: transient needs --melt-heat flux (the layer's content is balanced against the "
+                     "face heat fluxes; (4-27) is quasi-steady), got --melt-heat ode");
+  if (c.melt_content == MeltContent::Transient && c.model == FlowModel::Conduction)
+    throw UsageError("--melt-content: transient needs a melt flow model (the layer's content changes through b2 of "
+                     "(4-25), which --model conduction does not have), got --model conduction");
+  if (c.dtau > 0.0) c.dt = c.dtau * c.R * c.R / (m.kl / (m.rho * m.cpl));
+  if (c.dt > 0.0 && !(c.dt < c.tp))
+    throw UsageError(std::string(c.dtau > 0 ? "--dtau" : "--dt") + ": the time step " + fmt(c.dt) +
+                     " s must be shorter than the pulse (--pulse " + fmt(c.tp) + " s)");
+  if (c.xi_max > 0.0 && c.xi_max < 2.0 * c.dxi)
+    throw UsageError("--xi-max: must be 0 (automatic) or at least 2 --dxi = " + fmt(2 * c.dxi) + ", got " +
+                     fmt(c.xi_max));
+}
+
 
 }  // namespace laser

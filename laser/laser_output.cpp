@@ -402,6 +402,7 @@ ordered_json case_json(const Config& cfg) {
                {"melt_flow", to_string(cfg.melt_flow)},
                {"melt_heat", cfg.flux_heat() ? "flux" : "ode"},
                {"melt_content", cfg.transient_content() ? "transient" : "steady"},
+               {"curvature_factor", cfg.curvature ? to_string(cfg.curvature_form) : "off"},
                {"recoil_fraction_of_p_sat", num(cfg.recoil)},
                {"absorptivity", num(cfg.absorptivity)},
                {"melt_update", cfg.implicit_melt ? "implicit" : "explicit"},

@@ -323,6 +323,13 @@ void add_model_params(std::vector<Param>& t) {
                    &Config::shift));
   t.push_back(flag("no-curvature", "curvature", "model", "switch off the curvature factor (3-37)",
                    &Config::curvature, false));
+  t.push_back(choice(
+      "curvature-factor", "model", {"conduction", "text"},
+      "curvature factor C_c of (3-37): conduction = its branches as conduction into the curved solid sets them "
+      "(C_c >= 1 where the front bulges into the solid; damps node-scale modes of the front), text = (3-37) as "
+      "printed (C_c <= 1 there)",
+      [](Config& c, const std::string& v) { c.curvature_form = v == "text" ? CurvatureForm::Text : CurvatureForm::Conduction; },
+      [](const Config& c) { return std::string(to_string(c.curvature_form)); }));
   t.push_back(flag("no-moving-origin", "moving_origin", "model",
                    "switch off the moving-origin term in (3-39)/(3-40)", &Config::moving_origin, false));
   t.push_back(choice(
@@ -568,32 +575,6 @@ Invocation parse_command_line(int argc, const char* const* argv) {
       if (!is_preset(s)) apply_all(c, {s});
   c.config_file = config_file;
   return inv;
-}
-
-void validate(Config& c) {
-  const Material& m = c.mat;
-  if (!(m.Tm > m.Ti))
-    throw UsageError("--T-initial: must be below --T-melt (" + fmt(m.Tm) + " K), got " + fmt(m.Ti) + " K");
-  if (!(m.Tc > m.Tsat0))
-    throw UsageError("--T-critical: must be above --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tc) + " K");
-  if (!(m.Tsat0 > m.Tm))
-    throw UsageError("--T-melt: must be below --T-sat0 (" + fmt(m.Tsat0) + " K), got " + fmt(m.Tm) + " K");
-  if (c.melt_heat == MeltHeat::Flux && c.melt_flow != MeltFlow::Conservative)
-    throw UsageError("--melt-heat: flux needs --melt-flow conservative (the face fluxes are the conservative flow's), "
-                     "got --melt-flow text");
-  if (c.melt_content == MeltContent::Transient && !c.flux_heat())
-    throw UsageError("--melt-content: transient needs --melt-heat flux (the layer's content is balanced against the "
-                     "face heat fluxes; (4-27) is quasi-steady), got --melt-heat ode");
-  if (c.melt_content == MeltContent::Transient && c.model == FlowModel::Conduction)
-    throw UsageError("--melt-content: transient needs a melt flow model (the layer's content changes through b2 of "
-                     "(4-25), which --model conduction does not have), got --model conduction");
-  if (c.dtau > 0.0) c.dt = c.dtau * c.R * c.R / (m.kl / (m.rho * m.cpl));
-  if (c.dt > 0.0 && !(c.dt < c.tp))
-    throw UsageError(std::string(c.dtau > 0 ? "--dtau" : "--dt") + ": the time step " + fmt(c.dt) +
-                     " s must be shorter than the pulse (--pulse " + fmt(c.tp) + " s)");
-  if (c.xi_max > 0.0 && c.xi_max < 2.0 * c.dxi)
-    throw UsageError("--xi-max: must be 0 (automatic) or at least 2 --dxi = " + fmt(2 * c.dxi) + ", got " +
-                     fmt(c.xi_max));
 }
 
 }  // namespace laser

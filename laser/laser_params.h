@@ -34,11 +34,17 @@ enum class MeltHeat { Auto, Ode, Flux };
 // layer (what flows in is conducted out at once); Auto = transient with the face
 // heat fluxes and the implicit melt update (docs/theory/laser_model.md 2.7).
 enum class MeltContent { Auto, Transient, Steady };
+// Curvature factor of the melting front in (3-39)/(3-40): Conduction = the two
+// branches of (3-37) set by conduction into the curved solid (C_c >= 1 under a
+// front that bulges into the solid, a > 0; damps node-scale modes of the front),
+// Text = (3-37) as printed (C_c <= 1 for a > 0; feeds them; docs 2.5).
+enum class CurvatureForm { Conduction, Text };
 
 const char* to_string(FlowModel m);
 const char* to_string(SolidModel m);
 const char* to_string(MeltEnergy m);
 const char* to_string(MeltFlow m);
+const char* to_string(CurvatureForm m);
 
 struct Config {
   Material mat;
@@ -72,6 +78,7 @@ struct Config {
   double absorptivity = 1.0;  // absorbed fraction of the beam (the text: 1)
   double shift = 3.0 / (4.0 * kPi);  // (3-36): shift of the Stefan solution in tau_m
   bool curvature = true;
+  CurvatureForm curvature_form = CurvatureForm::Conduction;
   bool moving_origin = true;
   bool implicit_melt = false;  // backward Euler for g instead of (4-14)
   double dxi = 0.0125;

@@ -350,3 +350,65 @@ TEST(LaserLaws, CurvatureFactorFavoursTheDeeperNode) {
   // a smooth front (S2 = c xi^2, fixed curvature): C_c -> 1 as d(xi) -> 0
   EXPECT_LT(std::fabs(curvature_factor(0.5, 0.00625) - 1.0), std::fabs(curvature_factor(0.5, 0.05) - 1.0) / 50.0);
 }
+
+// The default curvature factor (--curvature-factor conduction, docs 2.5): the two branches
+// of (3-37) exchanged, as conduction into the curved solid sets them. The node deeper than
+// its neighbours (a > 0: the solid around it is wider than the 1-D normal solution assumes)
+// draws more heat into the solid and melts slower than its shallower neighbours at every
+// grid, so a node-scale mode of the front decays; for a resolved front it departs from 1
+// by the same (a d)^2/24 as the printed form, with the opposite sign, and both -> 1 as
+// d(xi) -> 0.
+TEST(LaserLaws, ConductionCurvatureFactorDampsNodeScaleModes) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  const double e = 2e-3;
+  const double grad_n = -5.0, grad_l = 20.0;
+  for (double h : {0.05, 0.025, 0.0125, 0.00625}) {
+    const double a_deep = 2.0 * e / (h * h), a_shallow = -a_deep;  // a = -S2'' at S2' = 0
+    const double Cd = curvature_factor_conduction(a_deep, h), Cs = curvature_factor_conduction(a_shallow, h);
+    EXPECT_GT(Cd, 1.0) << h;
+    EXPECT_LT(Cs, 1.0) << h;
+    EXPECT_NEAR(Cd * curvature_factor(a_deep, h), 1.0, 1e-14);
+    EXPECT_NEAR(Cd, curvature_factor(a_shallow, h), 1e-14);
+    EXPECT_LT(melting_rate(G, Cd, grad_n, 1.0, grad_l, true), melting_rate(G, Cs, grad_n, 1.0, grad_l, true))
+        << "the deeper node melts slower at d(xi) " << h;
+  }
+  EXPECT_NEAR(curvature_factor_conduction(2.0, 1.0), kPi / 2.0, 1e-14);
+  EXPECT_NEAR(curvature_factor_conduction(50.0, 1.0), kPi / 2.0, 1e-14);  // bounded: clamped at |a d| = 2
+  EXPECT_NEAR(curvature_factor_conduction(1e-5, 1.0), 1.0 + 1e-10 / 24.0, 3e-16);
+  for (double a : {0.5, -0.5}) {
+    const double dc = curvature_factor_conduction(a, 0.05) - 1.0, dt = curvature_factor(a, 0.05) - 1.0;
+    EXPECT_NEAR(dc, -dt, 1e-3 * std::fabs(dt));  // same size at a resolved scale, opposite sign
+    EXPECT_LT(std::fabs(curvature_factor_conduction(a, 0.00625) - 1.0), std::fabs(dc) / 50.0);
+  }
+}
+
+// The warm starts of the root finders (a guess inside the bracket; signs of the bracket
+// known) and the stop on |f| <= ftol for f' >= 1 find the same roots as the cold start.
+TEST(LaserLaws, WarmStartedRootsAreTheColdRoots) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  int checked = 0;
+  for (double xi : {0.0, 0.7, 1.5})
+    for (double g : {1e-3, 2e-2, 0.1})
+      for (bool adv : {false, true}) {
+        const InterfaceState cold = solve_interface(G, xi, g, 0.0, adv);
+        if (!(cold.theta_sat > 0.0)) continue;
+        for (double guess : {G.theta_m + 1e-9, cold.phi * 1.01, cold.phi * 0.99, 0.5 * (G.theta_m + cold.phi)}) {
+          const InterfaceState warm = solve_interface(G, xi, g, 0.0, adv, guess);
+          EXPECT_NEAR(warm.phi, cold.phi, 4e-15 * cold.phi) << xi << " " << g << " " << guess;
+          EXPECT_TRUE(warm.converged);
+          const InterfaceState wf = solve_interface_flux(G, xi, g, 0.3, 0.1, adv, 2.0, 1e-3, guess);
+          const InterfaceState cf = solve_interface_flux(G, xi, g, 0.3, 0.1, adv, 2.0, 1e-3);
+          EXPECT_NEAR(wf.phi, cf.phi, 4e-15 * cf.phi);
+          ++checked;
+        }
+      }
+  EXPECT_GT(checked, 20);
+  // f(x) = x - 1 + 0.3 tanh(x): f' >= 1 - ..., here f' = 1 + 0.3 sech^2 >= 1
+  auto f = [](double x) { return x - 1.0 + 0.3 * std::tanh(x); };
+  const double xtol = 1e-12;
+  const RootResult a = illinois_root(f, 0.0, 2.0, f(0.0), f(2.0), xtol);
+  const RootResult b = illinois_root(f, 0.0, 2.0, f(0.0), f(2.0), xtol, 200, xtol);
+  EXPECT_NEAR(a.x, b.x, 2 * xtol);
+  EXPECT_LE(b.iterations, a.iterations);
+  EXPECT_LE(std::fabs(f(b.x)), xtol);
+}
