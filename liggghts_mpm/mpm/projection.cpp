@@ -243,22 +243,16 @@ void Projection::set_velocities(double *vel, const double *p2g, double mmin, con
     u_ext_ = u_;
     extend_behind(u_ext_, 3, p2g, mmin);
   }
-  // the P2G velocities as they came (padding_old_velocity, the nodes behind mesh walls)
+  // the P2G velocities as they came (padding_old_velocity)
   old_.resize(3 * grid_.size());
   grid_.for_box(grid_.patch(), [&](int, int, int, std::size_t n) {
     for (int d = 0; d < 3; ++d) old_[3 * n + d] = vel[VelRec::N * n + VelRec::V_OLD + d];
   });
-  if (mesh_) {
-    old_ext_ = old_;
-    extend_behind(old_ext_, 3, p2g, mmin);
-  }
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     double *v = vel + VelRec::N * n + VelRec::V_NEW;
     const double m = p2g[P2gRec::N * n + P2gRec::M];
     if (!(m > mmin && m > 0.0)) return;  // no fluid: velocity stays 0
     if (mesh_ && behind_mesh(i, j, k, n)) {
-      // and its P2G velocity that of the fluid in front (FLIP: the increment of the fluid in front)
-      for (int d = 0; d < 3; ++d) vel[VelRec::N * n + VelRec::V_OLD + d] = old_ext_[3 * n + d];
       // the node takes the velocity of the fluid in front: its change of momentum, a wall's (load_rest)
       if (!lr_.empty())
         for (int d = 0; d < 3; ++d) lr_[3 * n + d] += bc.load_scale() * m * (u_ext_[3 * n + d] - v[d]);
