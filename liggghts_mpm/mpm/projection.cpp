@@ -250,6 +250,11 @@ void Projection::set_velocities(double *vel, const double *p2g, double mmin, con
     u_ext_ = u_;
     extend_behind(u_ext_, 3, p2g, mmin);
   }
+  // the P2G velocities as they came (padding_old_velocity)
+  old_.resize(3 * grid_.size());
+  grid_.for_box(grid_.patch(), [&](int, int, int, std::size_t n) {
+    for (int d = 0; d < 3; ++d) old_[3 * n + d] = vel[VelRec::N * n + VelRec::V_OLD + d];
+  });
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     double *v = vel + VelRec::N * n + VelRec::V_NEW;
     const double m = p2g[P2gRec::N * n + P2gRec::M];
@@ -264,6 +269,7 @@ void Projection::set_velocities(double *vel, const double *p2g, double mmin, con
     }
     if (lab_.kind[n] == kSolid) {
       padding_velocity(v, i, j, k, theta != nullptr, h, hs, bc, p2g, mmin);
+      padding_old_velocity(vel, i, j, k, theta != nullptr, p2g, mmin);
       return;
     }
     for (int d = 0; d < 3; ++d) v[d] = u_[3 * n + d];
@@ -312,6 +318,32 @@ void Projection::padding_velocity(double *v, int i, int j, int k, bool grains, d
       if (q[d] == idx[d]) v[d] = ut[d];
   bc.apply(v, i, j, k, h);
   mirror_normal(v, i, j, k, p2g, mmin);
+}
+
+/* Padding node (i, j, k) behind the box walls: its P2G velocity (V_OLD) made as padding_velocity
+   makes its new one from the nodes inside where that is a copy: the wall node's P2G velocity (the
+   new one is the wall node's with the wall condition), the normal components the mirror node's
+   reflected; the components that keep their own u* (with grains) keep their own. FLIP then gives
+   the points near the wall the increment of the node inside. With the padding node's own P2G
+   velocity, the difference between the copied velocity and it, of the same size at every step,
+   reached the points at every step: kinetic energy in proportion to the number of steps
+   (docs/theory/projection.md, "The step size"). */
+void Projection::padding_old_velocity(double *vel, int i, int j, int k, bool grains, const double *p2g,
+                                      double mmin) const {
+  const std::size_t n = grid_.index(i, j, k), c = wall_node(i, j, k);
+  const GridSpec &gs = opt_.grid;
+  const int q[3] = {gs.mirror(i, 0), gs.mirror(j, 1), gs.mirror(k, 2)};
+  const int idx[3] = {i, j, k};
+  double *vo = vel + VelRec::N * n + VelRec::V_OLD;
+  const bool wall_fluid = lab_.kind[c] != kSolid;
+  for (int d = 0; d < 3; ++d)
+    if (!(grains && !mesh_ && q[d] == idx[d])) vo[d] = wall_fluid ? old_[3 * c + d] : 0.0;
+  if (!grid_.in_patch(q[0], q[1], q[2])) return;
+  const std::size_t mn = grid_.index(q[0], q[1], q[2]);
+  const double mm = p2g[P2gRec::N * mn + P2gRec::M];
+  const bool fluid = lab_.kind[mn] != kSolid && mm > mmin && mm > 0.0;
+  for (int d = 0; d < 3; ++d)
+    if (q[d] != idx[d]) vo[d] = fluid ? -old_[3 * mn + d] : 0.0;
 }
 
 /* Padding node (i, j, k) behind the box walls: along each direction d in which it lies behind a

@@ -120,6 +120,9 @@ class Projection {
                       Boundaries &bc);
   void padding_velocity(double *v, int i, int j, int k, bool grains, double h, double hs, Boundaries &bc,
                         const double *p2g, double mmin) const;
+  // the P2G velocity (V_OLD) of a padding node made from the nodes inside as its new velocity is,
+  // so that FLIP's increment there is that of the node inside
+  void padding_old_velocity(double *vel, int i, int j, int k, bool grains, const double *p2g, double mmin) const;
   // mesh walls: closes the faces the triangles cross (with the wall velocity), makes the nodes
   // within 2 cells behind a one-sided wall SOLID, and fills frac_ (fluid-side share of a node's
   // dual cell, for the surface threshold)
@@ -213,7 +216,7 @@ class Projection {
   void exchange_weights(const double *theta, const double *p2g);
   void add_grain_reaction(const double *p2g, double hs);
   void exact_correction(const double *vel, const double *p2g, double hs);
-  std::vector<double> frac_, u_ext_;  // mesh walls (make_labels, project)
+  std::vector<double> frac_, u_ext_, old_;  // mesh walls (make_labels, project)
   bool mesh_ = false;
   std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)
   bool have_theta_last_ = false;
