@@ -250,11 +250,6 @@ void Projection::set_velocities(double *vel, const double *p2g, double mmin, con
     u_ext_ = u_;
     extend_behind(u_ext_, 3, p2g, mmin);
   }
-  // the P2G velocities as they came (padding_old_velocity)
-  old_.resize(3 * grid_.size());
-  grid_.for_box(grid_.patch(), [&](int, int, int, std::size_t n) {
-    for (int d = 0; d < 3; ++d) old_[3 * n + d] = vel[VelRec::N * n + VelRec::V_OLD + d];
-  });
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     double *v = vel + VelRec::N * n + VelRec::V_NEW;
     const double m = p2g[P2gRec::N * n + P2gRec::M];
@@ -343,16 +338,19 @@ void Projection::padding_old_velocity(double *vel, int i, int j, int k, bool gra
     if (q[d] != idx[d] && (opt_.face[2 * d + (idx[d] < 0 ? 0 : 1)].kind == BcKind::Inflow ||
                            opt_.face[2 * d + (idx[d] < 0 ? 0 : 1)].kind == BcKind::Outflow))
       return;
+  // (it reads the P2G velocities of nodes that are not SOLID, which this loop leaves as they came)
   double *vo = vel + VelRec::N * n + VelRec::V_OLD;
+  const double *old_c = vel + VelRec::N * c + VelRec::V_OLD;
   const bool wall_fluid = lab_.kind[c] != kSolid;
   for (int d = 0; d < 3; ++d)
-    if (!(grains && !mesh_ && q[d] == idx[d])) vo[d] = wall_fluid ? old_[3 * c + d] : 0.0;
+    if (!(grains && !mesh_ && q[d] == idx[d])) vo[d] = wall_fluid ? old_c[d] : 0.0;
   if (!grid_.in_patch(q[0], q[1], q[2])) return;
   const std::size_t mn = grid_.index(q[0], q[1], q[2]);
   const double mm = p2g[P2gRec::N * mn + P2gRec::M];
   const bool fluid = lab_.kind[mn] != kSolid && mm > mmin && mm > 0.0;
+  const double *old_m = vel + VelRec::N * mn + VelRec::V_OLD;
   for (int d = 0; d < 3; ++d)
-    if (q[d] != idx[d]) vo[d] = fluid ? -old_[3 * mn + d] : 0.0;
+    if (q[d] != idx[d]) vo[d] = fluid ? -old_m[d] : 0.0;
 }
 
 /* Padding node (i, j, k) behind the box walls: along each direction d in which it lies behind a

@@ -216,7 +216,7 @@ class Projection {
   void exchange_weights(const double *theta, const double *p2g);
   void add_grain_reaction(const double *p2g, double hs);
   void exact_correction(const double *vel, const double *p2g, double hs);
-  std::vector<double> frac_, u_ext_, old_;  // mesh walls (make_labels, project)
+  std::vector<double> frac_, u_ext_;  // mesh walls (make_labels, project)
   bool mesh_ = false;
   std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)
   bool have_theta_last_ = false;
