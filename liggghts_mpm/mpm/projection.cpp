@@ -335,9 +335,7 @@ void Projection::padding_old_velocity(double *vel, int i, int j, int k, bool gra
   // 1.9e-2 with the normal component reflected about 0 as at a wall, 1.2e-4 reflected about U,
   // 1.7e-11 with the node's own
   for (int d = 0; d < 3; ++d)
-    if (q[d] != idx[d] && (opt_.face[2 * d + (idx[d] < 0 ? 0 : 1)].kind == BcKind::Inflow ||
-                           opt_.face[2 * d + (idx[d] < 0 ? 0 : 1)].kind == BcKind::Outflow))
-      return;
+    if (q[d] != idx[d] && opt_.face[2 * d + (idx[d] < 0 ? 0 : 1)].flow()) return;
   // (it reads the P2G velocities of nodes that are not SOLID, which this loop leaves as they came)
   double *vo = vel + VelRec::N * n + VelRec::V_OLD;
   const double *old_c = vel + VelRec::N * c + VelRec::V_OLD;
