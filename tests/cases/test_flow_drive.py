@@ -28,7 +28,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from cases import DATA, check, driver_main, read_csv  # noqa: E402
+from cases import DATA, PREAMBLE, check, driver_main, read_csv  # noqa: E402
 
 INP = os.path.join(DATA, "in.flow_drive")
 RHO, H = 1000.0, 0.25 * 2.0e-3 / 2.0  # the input's water and time step
@@ -105,13 +105,8 @@ def case_restart(r):
             check(rel < 1e-10, f"{pressure}: {k} of the resumed run = uninterrupted run (rel. diff {rel:.1e})")
 
 
-BAD = """atom_style sphere
-atom_modify map array sort 0 0
-boundary p p {zb}
-newton off
-communicate single vel yes
-units si
-region box block 0 0.008 0 0.008 0 0.008 units box
+# the cases' preamble, periodic along x and y
+BAD = PREAMBLE.replace("boundary f f f", "boundary p p {zb}") + """region box block 0 0.008 0 0.008 0 0.008 units box
 create_box 1 box
 neighbor 0.0004 bin
 {pre}

@@ -28,7 +28,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from cases import DATA, check, driver_main, read_csv  # noqa: E402
+from cases import DATA, PREAMBLE, check, driver_main, read_csv  # noqa: E402
 
 INP = os.path.join(DATA, "in.flow_faces")
 RHO, CELL, G, DT = 1000.0, 0.01, 9.81, 5e-4  # the input's water, cell, gravity and time step
@@ -111,13 +111,8 @@ def case_restart(r):
     check(rel < 1e-10, "the resumed run = the uninterrupted run at every step")
 
 
-BAD = """atom_style sphere
-atom_modify map array sort 0 0
-boundary p p {zb}
-newton off
-communicate single vel yes
-units si
-region box block 0 0.04 0 0.04 0 0.08 units box
+# the cases' preamble, periodic along x and y
+BAD = PREAMBLE.replace("boundary f f f", "boundary p p {zb}") + """region box block 0 0.04 0 0.04 0 0.08 units box
 create_box 1 box
 neighbor 0.002 bin
 fix f all mpm/fluid cell 0.01 density 1000 viscosity 1e-3 fill box 2 2 2 type 1 {args}
