@@ -7,6 +7,7 @@
 //   laser_status.cpp    physical energy check and status
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -68,10 +69,12 @@ class Drill {
   void advance_interfaces(double ta, double tb);
   void book_beam(const Node& n, double ta, double tb);
   Geometry front_geometry(int i, const std::vector<double>& S2old, double tb);
-  void solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n, double dtn);
+  void solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n, double dtn, double wt);
+  void advance_trapezoidal(Node& n, const Geometry& geo, double grad_n, double dtn);
   Rates front_rates(const Node& n, const Geometry& geo, double grad_n, double dtn);
   void check_stability(Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn, double tb);
-  void book_energy(const Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn);
+  void book_energy(const Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn,
+                   double content_share);
   void move_fronts(Node& n, const Rates& r, double dtn);
   void melt_temperature();
   void flux_heat_march();
@@ -85,6 +88,12 @@ class Drill {
   void assess();
   void note_content_hits();
   double node_ta(const Node& n, double ta) const { return std::max(ta, n.tau_m); }
+  // trapezoidal update: share of [t0, t1] after the column's melt onset (what the flow brings
+  // before it goes over the rim, as into any column not molten); 1 for the other updates
+  double molten_share(const Node& n, double t0, double t1) const {
+    if (!cfg_.trapezoidal_melt || !(t1 > t0)) return 1.0;
+    return std::clamp((t1 - std::max(t0, n.tau_m)) / (t1 - t0), 0.0, 1.0);
+  }
 
   Config cfg_;
   Groups G_;

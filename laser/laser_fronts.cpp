@@ -56,10 +56,11 @@ Drill::Geometry Drill::front_geometry(int i, const std::vector<double>& S2old, d
   return geo;
 }
 
-// Backward Euler in g: g_new = g_old + dtau (dS2 - dS1 + v)(g_new), with the
-// solid gradient, curvature, the flow and its heat flux b2 g frozen over the step. The right side
+// Backward Euler in g: g_new = g_old + dtau R(g_new), R = dS2 - dS1 + v, with the solid
+// gradient (its mean over the step), curvature, the flow and its heat flux b2 g frozen over the
+// step; trapezoidal (wt = 1/2): g_new = g_old + dtau (R(g_old) + R(g_new))/2. The right side
 // decreases with g, so the root is unique and bracketed.
-void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n, double dtn) {
+void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n, double dtn, double wt) {
   // The flow's part of the layer's gradients, b2 g (half the heat the flow
   // carries sideways, 2 b2 g), is what the last step's (4-27) determined and is
   // held over the step; holding b2 itself would let b2 g grow with g_new.
@@ -80,12 +81,13 @@ void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n
     return rate_of(st);
   };
   const double g_old = n.g;
-  auto F = [&](double g) { return g - g_old - dtn * rate(g); };
-  // F rises with g; the explicit predictor g_p = g_old + dtn R(g_old) and g_old bracket
-  // the root (F(g_old) = -dtn R(g_old), F(g_p) = dtn (R(g_old) - R(g_p))), a bracket
-  // narrower than [0, g_p] that saves most of the iterations (each one solves (4-29)).
   // R(g_old) from the state the step started with (solve_interfaces: (4-29) at g_old, b2)
   const double R0 = rate_of(n.itf), g_p = g_old + dtn * R0;
+  auto F = [&](double g) { return g - g_old - dtn * (wt == 1.0 ? rate(g) : (1.0 - wt) * R0 + wt * rate(g)); };
+  // F rises with g; the explicit predictor g_p = g_old + dtn R(g_old) and g_old bracket
+  // the root (F(g_old) = -dtn R(g_old), F(g_p) = dtn (R(g_old) - R(g_p))), a bracket
+  // narrower than [0, g_p] that saves most of the iterations (each one solves (4-29));
+  // for the trapezoidal rule F(g_p) = dtn wt (R(g_old) - R(g_p)), the same signs.
   double lo = std::min(g_old, std::max(g_p, 0.0)), hi = std::max(g_old, g_p);
   double Flo = lo == g_old ? -dtn * R0 : F(lo), Fhi = hi == g_old ? -dtn * R0 : F(hi);
   if (Flo > 0.0) { lo = 0.0; Flo = F(0.0); }  // not monotone here: the wide bracket
@@ -103,7 +105,7 @@ void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n
 }
 
 // (3-40) melting and (3-25) recession rates; a negative melting rate is
-// clamped to 0 and the solid demand it leaves undelivered is booked.
+// clamped to 0 and the solid demand it leaves undelivered over dtn is booked.
 Drill::Rates Drill::front_rates(const Node& n, const Geometry& geo, double grad_n, double dtn) {
   Rates r;
   r.drive = geo.Cc * grad_n * geo.J + G_.k * n.itf.grad_bottom;  // right side of (3-40)
@@ -159,7 +161,10 @@ void Drill::check_stability(Node& n, const Geometry& geo, double grad_n, const R
 }
 
 // Energy terms [J] of the model's own balance (L3 of CASES.md).
-void Drill::book_energy(const Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn) {
+// dtn: the part of the step these rates hold for; content_share: the share of the layer's
+// content change booked with them (1, or 1/2 for each end of a trapezoidal step).
+void Drill::book_energy(const Node& n, const Geometry& geo, double grad_n, const Rates& r, double dtn,
+                        double content_share) {
   Energy& E = res_.energy;
   const Material& m = cfg_.mat;
   const double qscale_l = m.kl * G_.dT / cfg_.R;  // W/m2 per unit nondim gradient
@@ -180,7 +185,7 @@ void Drill::book_energy(const Node& n, const Geometry& geo, double grad_n, const
   E.melt_sensible += sensible * qscale_l * n.area * dts;
   // --melt-content transient: of the flow's 2 b2 g (determined by the last march and held
   // over this step), the part that changed the layer's own heat content stays in the column
-  const double content = n.dH * m.rho * m.cpl * G_.dT * cfg_.R * n.area;
+  const double content = content_share * n.dH * m.rho * m.cpl * G_.dT * cfg_.R * n.area;
   E.melt_content += content;
   E.flow_advected += (n.itf.grad_top - n.itf.grad_bottom - sensible) * qscale_l * n.area * dts - content;
 }
@@ -206,6 +211,21 @@ void Drill::move_fronts(Node& n, const Rates& r, double dtn) {
   }
 }
 
+// Trapezoidal step of one column: the fronts S1, S2 and g advance with the mean of the rates
+// at the start state (solve_interfaces) and at the end state (the root of the trapezoidal
+// g-equation); each end books half of the step's energy terms, so the model's balance holds
+// as for the other updates (both states satisfy (4-29)).
+void Drill::advance_trapezoidal(Node& n, const Geometry& geo, double grad_n, double dtn) {
+  const Rates r0 = front_rates(n, geo, grad_n, 0.5 * dtn);
+  book_energy(n, geo, grad_n, r0, 0.5 * dtn, 0.5);
+  solve_implicit_thickness(n, geo, grad_n, dtn, 0.5);
+  Rates r = front_rates(n, geo, grad_n, 0.5 * dtn);
+  book_energy(n, geo, grad_n, r, 0.5 * dtn, 0.5);
+  r.dS2 = 0.5 * (r0.dS2 + r.dS2);
+  r.dS1 = 0.5 * (r0.dS1 + r.dS1);
+  move_fronts(n, r, dtn);
+}
+
 void Drill::advance_interfaces(double ta, double tb) {
   const int N = static_cast<int>(nodes_.size());
   std::vector<double> S2old(N);
@@ -219,10 +239,17 @@ void Drill::advance_interfaces(double ta, double tb) {
     if (!(dtn > 0.0)) continue;
     const Geometry geo = front_geometry(i, S2old, tb);
     const double grad_n = solid_gradient_mean(n, t0, tb);
-    if (cfg_.implicit_melt) solve_implicit_thickness(n, geo, grad_n, dtn);
+    // trapezoidal rule for a column molten over the whole step with a layer; its first
+    // step (onset inside the step, the layer's stiffest state) and a used-up layer take
+    // backward Euler, which damps what the trapezoidal rule would carry on as an oscillation
+    if (cfg_.trapezoidal_melt && t0 == ta && n.g > 0.0) {
+      advance_trapezoidal(n, geo, grad_n, dtn);
+      continue;
+    }
+    if (cfg_.implicit_melt) solve_implicit_thickness(n, geo, grad_n, dtn, 1.0);
     const Rates r = front_rates(n, geo, grad_n, dtn);
     check_stability(n, geo, grad_n, r, dtn, tb);
-    book_energy(n, geo, grad_n, r, dtn);
+    book_energy(n, geo, grad_n, r, dtn, 1.0);
     move_fronts(n, r, dtn);
   }
 }

@@ -150,12 +150,11 @@ bool Drill::conservative_flow(const FlowProfile& profile, int first, double ta, 
       const double vol = std::fabs(c[k]) * g0[up] * g0[up] * dts;
       if (!(vol > 0.0)) continue;
       gs[up] -= vol / a[up];
-      if (dn < N && active[dn]) {
-        gs[dn] += vol / a[dn];
-        vin[dn] += vol / a[dn];
-      } else {
-        expelled += vol;
-      }
+      // a column melting inside the step takes what arrives after its onset (molten_share)
+      const double keep = dn < N && active[dn] ? molten_share(nodes_[dn], ta + t, ta + t + dts) : 0.0;
+      const double into = keep * vol / (keep > 0.0 ? a[dn] : 1.0);
+      if (keep > 0.0) { gs[dn] += into; vin[dn] += into; }
+      expelled += (1.0 - keep) * vol;
     }
     t = (dts == dtau - t) ? dtau : t + dts;
     if (++sub > kMaxFlowSubsteps) {

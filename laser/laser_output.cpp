@@ -405,7 +405,7 @@ ordered_json case_json(const Config& cfg) {
                {"curvature_factor", cfg.curvature ? to_string(cfg.curvature_form) : "off"},
                {"recoil_fraction_of_p_sat", num(cfg.recoil)},
                {"absorptivity", num(cfg.absorptivity)},
-               {"melt_update", cfg.implicit_melt ? "implicit" : "explicit"},
+               {"melt_update", cfg.melt_update_name()},
                {"dxi", num(cfg.dxi)},               {"material", cfg.material}};
   return j["case"];
 }

@@ -310,7 +310,7 @@ void add_model_params(std::vector<Param>& t) {
       "heat content of the melt layer with the face heat fluxes: transient = the layer's energy balance keeps "
       "the transient term of (3-3b) (inflowing heat first raises the layer's content), steady = the text's "
       "quasi-steady layer (heat brought in is conducted out in the same step); auto = transient with --melt-heat "
-      "flux and --melt-update implicit, steady otherwise (transient needs --melt-heat flux)",
+      "flux and --melt-update implicit or trapezoidal, steady otherwise (transient needs --melt-heat flux)",
       [](Config& c, const std::string& v) {
         c.melt_content = v == "transient" ? MeltContent::Transient : v == "steady" ? MeltContent::Steady : MeltContent::Auto;
       },
@@ -321,6 +321,10 @@ void add_model_params(std::vector<Param>& t) {
   t.push_back(real("shift", "model", "tau_m", 0, 10, true,
                    "backward shift of the Stefan solution for --solid shifted (3-36: 3 tau_0 = 3/(4 pi))",
                    &Config::shift));
+}
+
+// Options of [model] for the fronts and the melt thickness update.
+void add_front_params(std::vector<Param>& t) {
   t.push_back(flag("no-curvature", "curvature", "model", "switch off the curvature factor (3-37)",
                    &Config::curvature, false));
   t.push_back(choice(
@@ -333,10 +337,14 @@ void add_model_params(std::vector<Param>& t) {
   t.push_back(flag("no-moving-origin", "moving_origin", "model",
                    "switch off the moving-origin term in (3-39)/(3-40)", &Config::moving_origin, false));
   t.push_back(choice(
-      "melt-update", "model", {"explicit", "implicit"},
-      "melt thickness update: explicit = (4-14) as in the text, implicit = backward Euler in g",
-      [](Config& c, const std::string& v) { c.implicit_melt = v == "implicit"; },
-      [](const Config& c) { return std::string(c.implicit_melt ? "implicit" : "explicit"); }));
+      "melt-update", "model", {"explicit", "implicit", "trapezoidal"},
+      "melt thickness update: explicit = (4-14) as in the text, implicit = backward Euler in g, "
+      "trapezoidal = the trapezoidal rule in g, S1 and S2 (second order in the layer's own rates)",
+      [](Config& c, const std::string& v) {
+        c.implicit_melt = v != "explicit";
+        c.trapezoidal_melt = v == "trapezoidal";
+      },
+      [](const Config& c) { return std::string(c.melt_update_name()); }));
 }
 
 // Options of [numerics] and [output], in the order of --help.
@@ -402,6 +410,7 @@ const std::vector<Param>& params() {
     std::vector<Param> t;
     add_laser_params(t);
     add_model_params(t);
+    add_front_params(t);
     add_numerics_params(t);
     add_material_params(t);
     return t;

@@ -80,7 +80,11 @@ struct Config {
   bool curvature = true;
   CurvatureForm curvature_form = CurvatureForm::Conduction;
   bool moving_origin = true;
-  bool implicit_melt = false;  // backward Euler for g instead of (4-14)
+  bool implicit_melt = false;  // implicit in g instead of (4-14): backward Euler, or
+  bool trapezoidal_melt = false;  // the trapezoidal rule (implies implicit_melt)
+  const char* melt_update_name() const {
+    return trapezoidal_melt ? "trapezoidal" : implicit_melt ? "implicit" : "explicit";
+  }
   double dxi = 0.0125;
   double xi_max = 0.0;     // 0: just beyond the last node that melts within the pulse
   double dt = 0.0;         // s; 0: chosen by the time-step policy (laser_timestep.h)

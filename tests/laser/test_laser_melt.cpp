@@ -408,6 +408,7 @@ TEST(LaserStatus, TimeStepErrorNotDecreasingIsNamed) {
   c.quiet = true;
   c.tp = 100e-6;
   c.melt_content = MeltContent::Steady;
+  c.trapezoidal_melt = false;  // the figures above: the backward Euler update (--melt-update implicit)
   validate(c);
   const TimeStepPolicy policy(c);
   const Result r = policy.run(c, nullptr);
