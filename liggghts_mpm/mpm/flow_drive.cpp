@@ -50,7 +50,7 @@ void FluidSolver::drive_correct(double hf) {
   for (int k = 0; k < pts.nlocal; ++k)
     if (is_grain(k)) {
       const double r = pts.radius[k];
-      grain_force_[3 * static_cast<std::size_t>(k) + a] += G * (4.0 / 3.0) * kPi * r * r * r;
+      coup_.grain_force[3 * static_cast<std::size_t>(k) + a] += G * (4.0 / 3.0) * kPi * r * r * r;
     }
 }
 
