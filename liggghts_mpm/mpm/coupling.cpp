@@ -175,7 +175,7 @@ void FluidSolver::grain_node_state(const IndexBox &sbox, const IndexBox &rbox, b
   // keeps the right terminal slip (see mpm::drag_implicit_impulse). Grain k receives the share
   // S_jk K_k / K_j of J_j. The pressure-gradient force (7-15) is explicit (not stiff); its
   // reaction goes to the nodes too.
-// couple_kernel, per grain: Kgrain[k], the pressure force (coup_.grain_force) and the grain's shares
+// couple_kernel, per grain: Kgrain[k], the pressure force (coup_->grain_force) and the grain's shares
 // of K, K v, mass, pressure reaction and K a at the nodes of its stencil (dr).
 // (inlined into couple_kernel: as a call of its own, GCC emitted for it a register-to-register
 // vmovq encoding that valgrind 3.19 cannot decode, which stopped callgrind on coupled runs)
@@ -190,8 +190,8 @@ template <int NS>
   const int nsub = state.nsub;
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
   for (int k = 0; k < nlocal; ++k) {
-    if (!is_grain(k) || coup_.grain_shapes[k].base[0] == INT_MIN) continue;
-    const Stencil &ps = coup_.grain_shapes[k];
+    if (!is_grain(k) || coup_->grain_shapes[k].base[0] == INT_MIN) continue;
+    const Stencil &ps = coup_->grain_shapes[k];
     // one pass over the stencil: velocity of the wet nodes (and their total weight, the record's
     // 4th entry), fitted gradients of the determined nodes (and their weight), fluid fraction,
     // gradient of the nodal pressures
@@ -238,7 +238,7 @@ template <int NS>
     double Fp[3];
     pressure_gradient_force(Vk, gradp, Fp);
     if (wet <= 0.0) Fp[0] = Fp[1] = Fp[2] = 0.0;
-    for (int d = 0; d < 3; ++d) coup_.grain_force[3 * static_cast<std::size_t>(k) + d] += Fp[d] / nsub;
+    for (int d = 0; d < 3; ++d) coup_->grain_force[3 * static_cast<std::size_t>(k) + d] += Fp[d] / nsub;
     // the grain's other accelerations (contacts, gravity: its force so far, and the pressure
     // force), held over the step in the exchange
     double ak[3];
@@ -304,7 +304,7 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
 }
 
 // couple_kernel's last step: each grain's share of its nodes' drag impulses, as a force averaged
-// over the sub-steps (coup_.grain_force).
+// over the sub-steps (coup_->grain_force).
 template <int NS>
 void FluidSolver::grain_drag_forces(const std::vector<double> &Kgrain, double h) {
   const int nlocal = pts.nlocal;
@@ -312,14 +312,14 @@ void FluidSolver::grain_drag_forces(const std::vector<double> &Kgrain, double h)
   const double *const gdr = g_.dr.data();
   const int nsub = state.nsub;
   for (int k = 0; k < nlocal; ++k) {
-    if (!is_grain(k) || coup_.grain_shapes[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
-    const Stencil &ps = coup_.grain_shapes[k];
+    if (!is_grain(k) || coup_->grain_shapes[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
+    const Stencil &ps = coup_->grain_shapes[k];
     Row4 J = {0, 0, 0, 0};  // J[1..3]: the impulse per unit K of the nodes, weighted
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
       J += w * row4(gdr + DrRec::N * n);
     });
     for (int d = 0; d < 3; ++d)
-      coup_.grain_force[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
+      coup_->grain_force[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
   }
 }
 
@@ -327,7 +327,7 @@ template <int NS>
 void FluidSolver::couple_kernel(double h) {
   const int nlocal = pts.nlocal;
   double *const gdr = g_.dr.data();
-  if (static_cast<int>(coup_.grain_shapes.size()) < nlocal) coup_.grain_shapes.resize(nlocal);
+  if (static_cast<int>(coup_->grain_shapes.size()) < nlocal) coup_->grain_shapes.resize(nlocal);
 
   // projection: the grains feel the nodal gradient of the last solve (grain_pressure); the fluid
   // gets no pressure reaction as a force: the projection takes it along the periodic directions
@@ -337,7 +337,7 @@ void FluidSolver::couple_kernel(double h) {
   grain_pressure_inputs<NS>(proj, weak);
 
   // the box of the grains' stencils (fluid_fraction found them for this sub-step)
-  const IndexBox gbox = stencil_box(coup_.base_lo, coup_.base_hi, NS, grid_.patch());
+  const IndexBox gbox = stencil_box(coup_->base_lo, coup_->base_hi, NS, grid_.patch());
   const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
   // What the grains read (st) is read only at their stencils, here and, through the forward, at
   // the owned nodes of the exchanged boxes, and by the drag exchange below in the same box: st is

@@ -12,17 +12,7 @@
 
 namespace mpm {
 
-namespace {
-// wall time of a phase, added to acc (f_ID[14], f_ID[15])
-template <class Fn>
-inline void timed(double &acc, Fn &&fn) {
-  const double t0 = MPI_Wtime();
-  fn();
-  acc += MPI_Wtime() - t0;
-}
-}  // namespace
-
-FluidSolver::FluidSolver(const Options &o, MPI_Comm comm) : opt(o), comm_(comm), pressure_(PressureModel::make(opt)) {
+FluidSolver::FluidSolver(const Options &o, MPI_Comm comm) : opt(o), comm_(comm), pressure_(PressureModel::make(opt)), coup_(CouplingModel::make(opt)) {
   MPI_Comm_rank(comm_, &me_);
   MPI_Comm_size(comm_, &nprocs_);
   bc.setup(&opt, &grid_);
@@ -126,7 +116,7 @@ ProjectionState FluidSolver::projection_state() { return pressure_->restart_stat
 
 void FluidSolver::step() {
   const double h = opt.fluid_every * clock.dt / state.nsub;
-  if (opt.coupled) coup_.grain_force.assign(3 * static_cast<std::size_t>(pts.nlocal), 0.0);
+  coup_->begin_step(*this);
   // the volume correction (projection) of this fluid step, due on its first sub-step
   const double vc_time = pressure_->volume_correction_due(opt, clock, state);
   if (opt.every_auto) state.grain_tau = HUGE_VAL;  // this step's, for the next choice of N (couple_kernel)
@@ -138,26 +128,24 @@ void FluidSolver::step() {
   if (samples) end_samples();
   if (opt.drive.active) drive_correct(opt.fluid_every * clock.dt);
   inflow_advance(opt.fluid_every * clock.dt);
-  if (!opt.coupled) return;
-  // fluid force on the grains (mean over the sub-steps): kept in the state rows, from which the host
-  // adds it to the grains' forces on each of the N DEM steps this fluid step covers (with every N;
-  // FixMpmFluid::add_grain_force), so that the grains receive the impulse N dt F the fluid gave up
+  coup_->end_step(*this);
+}
+
+// GrainCoupling::end_step: the fluid force on the grains (mean over the sub-steps) kept in the
+// state rows
+void FluidSolver::store_grain_force() {
   for (int k = 0; k < pts.nlocal; ++k) {
     if (!is_grain(k)) continue;
-    for (int d = 0; d < 3; ++d) pts.state[k][C_FGRAIN + d] = coup_.grain_force[3 * k + d];
+    for (int d = 0; d < 3; ++d) pts.state[k][C_FGRAIN + d] = coup_->grain_force[3 * k + d];
   }
 }
 
 // One sub-step of chapter 8, phase by phase.
 void FluidSolver::substep(double h, double vc_time) {
   timed(io_.time_fluid, [&] { compute_shapes(); });
-  if (opt.coupled)
-    timed(io_.time_couple, [&] {
-      fluid_fraction();
-      if (state.theta_initialized) refresh_pressure();
-    });
+  coup_->fraction(*this, io_.time_couple);
   timed(io_.time_fluid, [&] { particles_to_grid(); });
-  if (opt.coupled) timed(io_.time_couple, [&] { couple_fluid_grains(h); });
+  coup_->exchange(*this, h, io_.time_couple);
   timed(io_.time_fluid, [&] {
     update_grid(h, vc_time);
     if (samples_on()) sample_pressure(h);
@@ -322,6 +310,7 @@ void FluidSolver::outside_patch(const double *x) const {
 void FluidSolver::update_grid(double h, double vc_time) {
   const double mmin = mass_min();
   const bool node_bc = !pressure_->incompressible();
+  const double *rx = coup_->fluid_force(g_);  // the drag exchange's force on the fluid (couple)
   for_owned_nodes([&](int i, int j, int k, std::size_t n) {
     const double *g = &g_.p2g[P2gRec::N * n];
     double *gv = &g_.vel[VelRec::N * n];
@@ -333,7 +322,7 @@ void FluidSolver::update_grid(double h, double vc_time) {
     double vnew[3];
     for (int d = 0; d < 3; ++d) {
       gv[VelRec::V_OLD + d] = g[P2gRec::MV + d] * inv;
-      const double f = g[P2gRec::F + d] + (opt.coupled ? g_.rx[3 * n + d] : 0.0);
+      const double f = g[P2gRec::F + d] + (rx ? rx[3 * n + d] : 0.0);
       // damping is implicit in time so that any rate is stable
       vnew[d] = (gv[VelRec::V_OLD + d] + h * f * inv) / (1.0 + h * opt.damping);
     }
@@ -350,9 +339,10 @@ void FluidSolver::project_velocity(Projection &proj, std::vector<double> &pvol, 
   const bool vc = vc_time > 0.0;
   if (vc) point_volume_to_grid(pvol);
   IndexBox work;
-  const bool sparse_proj = sparse_ && !opt.coupled && !bc.walls();
+  const double *theta = coup_->node_theta(g_);
+  const bool sparse_proj = sparse_ && !theta && !bc.walls();
   if (sparse_proj) work = projection_work_box();
-  proj.project(g_.vel.data(), g_.p2g.data(), mass_min(), opt.coupled ? g_.th.data() : nullptr, h, bc, clock.step,
+  proj.project(g_.vel.data(), g_.p2g.data(), mass_min(), theta, h, bc, clock.step,
                vc ? pvol.data() : nullptr, sparse_proj ? &work : nullptr, vc_time);
 }
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "mpm/boundaries.h"
+#include "mpm/coupling_model.h"
 #include "mpm/grid.h"
 #include "mpm/grid_fields.h"
 #include "mpm/options.h"
@@ -111,7 +112,7 @@ class FluidSolver {
   // the grains (mean over the sub-steps) goes to their state rows (C_FGRAIN) and grain_force(): the
   // host adds it to the grains' forces on each DEM step until the next fluid step.
   void step();
-  const std::vector<double> &grain_force() const { return coup_.grain_force; }
+  const std::vector<double> &grain_force() const { return coup_->grain_force; }
 
   // f_ID[1..18] (collective): mass, kinetic energy, |v|max, front, height, sub-steps, stable dt,
   // clamped, points, p max, fluid force on the grains (3), wall time of the fluid and coupling,
@@ -203,6 +204,9 @@ class FluidSolver {
   friend class PressureModel;
   friend class EosPressure;
   friend class ProjectionPressure;
+  friend class GrainCoupling;
+  void store_grain_force();     // the grains' force of the fluid step to their state rows
+  void drive_grain_share(int a);  // superficial_velocity: the grains' share of the gradient
   void project_velocity(Projection &proj, std::vector<double> &pvol, double h, double vc_time);
   void point_volume_to_grid(std::vector<double> &pvol);  // volume_correction: sum S V of the points
   void interpolate_pressure(const std::vector<double> &p);
@@ -278,7 +282,7 @@ class FluidSolver {
   // the state of each axis (solver_axes.h, pressure_model.h)
   PointWork pw_;                            // core: the points of this sub-step
   std::unique_ptr<PressureModel> pressure_; // pressure: eos or projection, chosen at construction
-  CouplingState coup_;                      // coupling
+  std::unique_ptr<CouplingModel> coup_;    // coupling: none or grains, chosen at construction
   StepLimits lim_;                          // time step
   OutputState io_;                          // io
   const double *velgrad(int i) const {

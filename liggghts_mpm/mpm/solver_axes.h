@@ -1,8 +1,11 @@
 // The state FluidSolver keeps per axis of the model (docs/design.md, "The solver's axes"): the
-// points' work arrays of the core, the time-step limits, the coupling's per-grain arrays, the
-// outputs' series, sums and timers. Each is owned by one FluidSolver and read by the phases of
-// its axis only; the pressure model's state lives behind its interface (mpm/pressure_model.h).
+// points' work arrays of the core, the time-step limits, the outputs' series, sums and timers.
+// Each is owned by one FluidSolver and read by the phases of its axis only; the pressure model's
+// and the coupling's state live behind their interfaces (mpm/pressure_model.h,
+// mpm/coupling_model.h).
 #pragma once
+#include <mpi.h>
+
 #include <cmath>
 #include <cstddef>
 #include <memory>
@@ -13,6 +16,14 @@
 namespace mpm {
 
 class Hdf5Series;
+
+// wall time of a phase, added to acc (f_ID[14], f_ID[15])
+template <class Fn>
+inline void timed(double &acc, Fn &&fn) {
+  const double t0 = MPI_Wtime();
+  fn();
+  acc += MPI_Wtime() - t0;
+}
 
 // core: the points of this sub-step, their stencils and the grid velocity and gradient at them
 struct PointWork {
@@ -64,15 +75,6 @@ struct StepLimits {
     double limit = HUGE_VAL;      // the step N dt must not exceed
     const char *which = "";
   } every;
-};
-
-// coupling: the grains' stencils and the fluid force on them
-struct CouplingState {
-  std::vector<Stencil> grain_shapes;
-  std::vector<double> grain_force;  // per local grain: fluid force averaged over sub-steps (3)
-  // fluid_fraction: the smallest and largest stencil base of this rank's grains inside the grid
-  // (couple_kernel's box of the grains' nodes)
-  int base_lo[3] = {0, 0, 0}, base_hi[3] = {-1, -1, -1};
 };
 
 // io: the HDF5 + XDMF series, the mesh walls' loads and the probes' sums, the wall-time counters
