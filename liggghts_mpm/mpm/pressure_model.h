@@ -47,9 +47,11 @@ class PressureModel {
   // the time the volume correction of this fluid step stands for (0: not due)
   virtual double volume_correction_due(const Options &opt, const Clock &clock, SolverState &state) { return 0.0; }
 
-  // the phases' pressure work: after the grid update (u*: the projection), after it (the points'
-  // pressure from the nodes), the stress update
-  virtual void correct_velocity(FluidSolver &s, double h, double vc_time) {}
+  // the phases' pressure work: P2G (the points' pressure in the internal force, the walls'
+  // traction), the grid update (the nodes' boundary conditions; u* and the projection), after it
+  // (the points' pressure from the nodes), the stress update
+  virtual void particles_to_grid(FluidSolver &s) = 0;
+  virtual void update_grid(FluidSolver &s, double h, double vc_time) = 0;
   virtual void point_pressure(FluidSolver &s) {}
   virtual void update_stress(FluidSolver &s, double h, bool theta_only) = 0;
 

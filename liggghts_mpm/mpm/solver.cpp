@@ -306,10 +306,17 @@ void FluidSolver::outside_patch(const double *x) const {
   throw LocalError(os.str());
 }
 
-/* grid momentum update (8-35), velocity (8-36), boundary conditions */
+/* grid momentum update (8-35), velocity (8-36), boundary conditions: the pressure model's
+   (EosPressure: the nodes' conditions; ProjectionPressure: u*, then the projection) */
 void FluidSolver::update_grid(double h, double vc_time) {
+  pressure_->update_grid(*this, h, vc_time);
+  grid_.forward(g_.vel.data(), VelRec::N);
+}
+
+// update_grid's sweep over the nodes; node_bc: the boundary conditions at each node (eos; the
+// projection's u* has none, its wall conditions come with the projection, Projection::project)
+void FluidSolver::grid_velocity(double h, bool node_bc) {
   const double mmin = mass_min();
-  const bool node_bc = !pressure_->incompressible();
   const double *rx = coup_->fluid_force(g_);  // the drag exchange's force on the fluid (couple)
   for_owned_nodes([&](int i, int j, int k, std::size_t n) {
     const double *g = &g_.p2g[P2gRec::N * n];
@@ -326,15 +333,12 @@ void FluidSolver::update_grid(double h, double vc_time) {
       // damping is implicit in time so that any rate is stable
       vnew[d] = (gv[VelRec::V_OLD + d] + h * f * inv) / (1.0 + h * opt.damping);
     }
-    // projection: u* here; the wall conditions come with the projection (Projection::project)
     if (node_bc) bc.apply(vnew, i, j, k, h, g[P2gRec::M]);
     for (int d = 0; d < 3; ++d) gv[VelRec::V_NEW + d] = vnew[d];
   });
-  pressure_->correct_velocity(*this, h, vc_time);
-  grid_.forward(g_.vel.data(), VelRec::N);
 }
 
-// ProjectionPressure::correct_velocity: the projection of u* (its volume correction when due)
+// ProjectionPressure::update_grid: the projection of u* (its volume correction when due)
 void FluidSolver::project_velocity(Projection &proj, std::vector<double> &pvol, double h, double vc_time) {
   const bool vc = vc_time > 0.0;
   if (vc) point_volume_to_grid(pvol);
