@@ -17,7 +17,7 @@ class EosPressure final : public PressureModel {
   double sound_speed(const Eos &eos, double rho_lo, double rho_hi) const override {
     return std::sqrt(std::max(eos.sound_speed_sq(rho_hi), eos.sound_speed_sq(rho_lo)));
   }
-  void particles_to_grid(FluidSolver &s) override { s.p2g<true>(); }
+  void particles_to_grid(FluidSolver &s) override { s.p2g(true); }
   void update_grid(FluidSolver &s, double h, double) override { s.grid_velocity(h, true); }
   void update_stress(FluidSolver &s, double h, bool theta_only) override { s.eos_stress(h, theta_only); }
 };
@@ -81,7 +81,7 @@ class ProjectionPressure final : public PressureModel {
     return vc_time;
   }
 
-  void particles_to_grid(FluidSolver &s) override { s.p2g<false>(); }
+  void particles_to_grid(FluidSolver &s) override { s.p2g(false); }
   void update_grid(FluidSolver &s, double h, double vc_time) override {
     s.grid_velocity(h, false);
     s.project_velocity(*proj_, pvol_, h, vc_time);

@@ -207,9 +207,9 @@ class FluidSolver {
   friend class GrainCoupling;
   void store_grain_force();     // the grains' force of the fluid step to their state rows
   void drive_grain_share(int a);  // superficial_velocity: the grains' share of the gradient
-  // the phases' bodies per pressure model: EOS / node_bc true for the equation of state (the
+  // the phases' bodies per pressure model: eos / node_bc true for the equation of state (the
   // points' pressure in the internal force, the walls' traction, the nodes' boundary conditions)
-  template <bool EOS> void p2g();
+  void p2g(bool eos);
   void grid_velocity(double h, bool node_bc);
   void project_velocity(Projection &proj, std::vector<double> &pvol, double h, double vc_time);
   void point_volume_to_grid(std::vector<double> &pvol);  // volume_correction: sum S V of the points
@@ -217,7 +217,7 @@ class FluidSolver {
   void eos_stress(double h, bool theta_only);
   void incompressible_stress(bool theta_only);
   // kernels (transfer.cpp, coupling.cpp), instantiated per stencil size and transfer policy
-  template <int NS, class P, bool EOS, class Fn> void p2g_kernel(Fn &&after_point);
+  template <int NS, class P, class Fn> void p2g_kernel(Fn &&after_point, bool eos);
   template <int NS, class P> void g2p_kernel();
   template <int NS, class P> void musl_scatter();
   template <int NS> void musl_gradient();

@@ -14,30 +14,27 @@ namespace mpm {
    pressure model's (EOS: the points' pressure in the internal force and the traction) */
 void FluidSolver::particles_to_grid() { pressure_->particles_to_grid(*this); }
 
-template <bool EOS>
-void FluidSolver::p2g() {
+void FluidSolver::p2g(bool eos) {
   clear_nodes(g_.p2g, P2gRec::N);
   // the boundary term of each point right after its own share, so that every node sums its
   // contributions in point order
   // (projection: the walls' reaction is the solve's pressure, not a traction of the points)
-  const bool traction = opt.shape == ShapeKind::QuadraticBSpline && EOS;
+  const bool traction = opt.shape == ShapeKind::QuadraticBSpline && eos;
   double *const g = g_.p2g.data();
   auto boundary_term = [&](int i, const Stencil &ps) {
     if (traction) bc.add_traction(ps, pts.x[i], pts.state[i][C_VOL], pts.state[i][C_P], g);
   };
-  with_policy(opt, [&](auto pol) { p2g_kernel<decltype(pol)::NS, decltype(pol), EOS>(boundary_term); });
+  with_policy(opt, [&](auto pol) { p2g_kernel<decltype(pol)::NS, decltype(pol)>(boundary_term, eos); });
   grid_.reverse_sum(g_.p2g.data(), P2gRec::N);
 }
-template void FluidSolver::p2g<true>();
-template void FluidSolver::p2g<false>();
 
-template <int NS, class P, bool EOS, class Fn>
-void FluidSolver::p2g_kernel(Fn &&after_point) {
+template <int NS, class P, class Fn>
+void FluidSolver::p2g_kernel(Fn &&after_point, bool eos) {
   double **x = pts.x, **v = pts.v, **f = pts.f;
   const double *rmass = pts.rmass;
   double *const g = g_.p2g.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  const bool eos_p = EOS;  // projection: no pressure in the internal force (u*)
+  const bool eos_p = eos;  // projection: no pressure in the internal force (u*)
   for (const int i : pw_.plist) {
     const Stencil &ps = pw_.shapes[i];
     const double *s = pts.state[i];
