@@ -292,13 +292,13 @@ void FixMpmFluid::check_gate_side() {
 // the counters at the start of a run ('run N pre no' skips setup(): post_run marks it as well)
 void FixMpmFluid::mark_run_start() {
   const mpm::FluidSolver &s = *solver;
-  run_time_start[0] = s.time_fluid;
-  run_time_start[1] = s.time_couple;
+  run_time_start[0] = s.time_fluid();
+  run_time_start[1] = s.time_couple();
   run_time_start[2] = s.time_pressure_solver();
   run_time_start[3] = static_cast<double>(s.pressure_solves());
   run_time_start[4] = static_cast<double>(s.pressure_iterations_summed());
-  run_time_start[5] = s.time_output;
-  run_time_start[6] = static_cast<double>(s.n_outputs);
+  run_time_start[5] = s.time_output();
+  run_time_start[6] = static_cast<double>(s.n_outputs());
   run_time_start[7] = s.grid().wait_seconds();
   run_stats_start = mpm::run_stats_start(s.grid());
   every_run[0] = every_run[1] = every_run[2] = 0.0;
@@ -309,8 +309,8 @@ void FixMpmFluid::mark_run_start() {
 void FixMpmFluid::post_run() {
   mpm::periodic_restarts().settle(lmp);
   const mpm::FluidSolver &s = *solver;
-  double t[4] = {s.time_fluid - run_time_start[0], s.time_couple - run_time_start[1],
-                 s.time_pressure_solver() - run_time_start[2], s.time_output - run_time_start[5]},
+  double t[4] = {s.time_fluid() - run_time_start[0], s.time_couple() - run_time_start[1],
+                 s.time_pressure_solver() - run_time_start[2], s.time_output() - run_time_start[5]},
          g[4];
   MPI_Allreduce(t, g, 4, MPI_DOUBLE, MPI_MAX, world);
   std::ostringstream os;
@@ -325,7 +325,7 @@ void FixMpmFluid::post_run() {
   if (s.opt.coupled) os << ", coupling " << g[1] << " s (" << (g[0] > 0.0 ? g[1] / g[0] : 0.0) << " of the fluid time)";
   if (s.opt.every_auto && every_run[2] > 0.0)
     os << "; every auto: " << every_run[2] << " fluid steps, N from " << every_run[0] << " to " << every_run[1];
-  const double nout = static_cast<double>(s.n_outputs) - run_time_start[6];  // the same on every rank
+  const double nout = static_cast<double>(s.n_outputs()) - run_time_start[6];  // the same on every rank
   if (nout > 0.0) os << ", output " << g[3] << " s (" << nout << " files, " << g[3] / nout << " s per file)";
   if (comm->nprocs > 1) {
     // the balance as it held: each rank's fluid and coupling time less its waits for halo

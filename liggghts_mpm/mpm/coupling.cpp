@@ -64,7 +64,7 @@ static IndexBox bounding_box(IndexBox b, const std::vector<IndexBox> &more) {
    e = (1, x_s - x_j) for the point's sample position x_s, the node collects r = sum S V p e and
    the normal matrix M = sum S V e e^T (PfitRec). VOL (reaction points with the fit):
    the same pass also sums the points' volume sum S V at every node of their stencils into rq[3 n]
-   (route_reaction), point by point in the order of plist_ as the pass of its own that it replaces
+   (route_reaction), point by point in the order of pw_.plist as the pass of its own that it replaces
    (point_sums), with the same rounding (add_product): the same sums bit for bit. */
 template <int NS, bool VOL>
 void FluidSolver::pressure_moments() {
@@ -74,8 +74,8 @@ void FluidSolver::pressure_moments() {
   double *const rq = VOL ? g_.rq.data() : nullptr;
   const double *const need = g_.need.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  for (const int i : plist_) {
-    const Stencil &ps = shapes_[i];
+  for (const int i : pw_.plist) {
+    const Stencil &ps = pw_.shapes[i];
     const double V = pts.state[i][C_VOL], p = pts.state[i][C_P];
     const double *xp = x[i];
     // With anti-locking the pressure is the cell's (its mean density): it belongs to the cell's
@@ -175,7 +175,7 @@ void FluidSolver::grain_node_state(const IndexBox &sbox, const IndexBox &rbox, b
   // keeps the right terminal slip (see mpm::drag_implicit_impulse). Grain k receives the share
   // S_jk K_k / K_j of J_j. The pressure-gradient force (7-15) is explicit (not stiff); its
   // reaction goes to the nodes too.
-// couple_kernel, per grain: Kgrain[k], the pressure force (grain_force_) and the grain's shares
+// couple_kernel, per grain: Kgrain[k], the pressure force (coup_->grain_force) and the grain's shares
 // of K, K v, mass, pressure reaction and K a at the nodes of its stencil (dr).
 // (inlined into couple_kernel: as a call of its own, GCC emitted for it a register-to-register
 // vmovq encoding that valgrind 3.19 cannot decode, which stopped callgrind on coupled runs)
@@ -190,8 +190,8 @@ template <int NS>
   const int nsub = state.nsub;
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
   for (int k = 0; k < nlocal; ++k) {
-    if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN) continue;
-    const Stencil &ps = grain_shapes_[k];
+    if (!is_grain(k) || coup_->grain_shapes[k].base[0] == INT_MIN) continue;
+    const Stencil &ps = coup_->grain_shapes[k];
     // one pass over the stencil: velocity of the wet nodes (and their total weight, the record's
     // 4th entry), fitted gradients of the determined nodes (and their weight), fluid fraction,
     // gradient of the nodal pressures
@@ -238,7 +238,7 @@ template <int NS>
     double Fp[3];
     pressure_gradient_force(Vk, gradp, Fp);
     if (wet <= 0.0) Fp[0] = Fp[1] = Fp[2] = 0.0;
-    for (int d = 0; d < 3; ++d) grain_force_[3 * static_cast<std::size_t>(k) + d] += Fp[d] / nsub;
+    for (int d = 0; d < 3; ++d) coup_->grain_force[3 * static_cast<std::size_t>(k) + d] += Fp[d] / nsub;
     // the grain's other accelerations (contacts, gravity: its force so far, and the pressure
     // force), held over the step in the exchange
     double ak[3];
@@ -268,9 +268,9 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
   // out, a fluid at rest in hydrostatic balance looked to the exchange as if it fell freely over
   // the step: the drag then pulled a held bed down by about K g h / 2 per grain (Archimedes on a
   // held random bed 0.92 with h = 8.6 ms; proportional to h and to the viscosity).
-  const double *pgrad = opt.projection && g_.gw.size() == 3 * grid_.size() ? g_.gw.data() : nullptr;
+  const double *pgrad = pressure_->incompressible() && g_.gw.size() == 3 * grid_.size() ? g_.gw.data() : nullptr;
   const double inv_rho = 1.0 / opt.eos.rho0;
-  const bool proj = opt.projection;
+  const bool proj = pressure_->incompressible();
   // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned
   // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -304,7 +304,7 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
 }
 
 // couple_kernel's last step: each grain's share of its nodes' drag impulses, as a force averaged
-// over the sub-steps (grain_force_).
+// over the sub-steps (coup_->grain_force).
 template <int NS>
 void FluidSolver::grain_drag_forces(const std::vector<double> &Kgrain, double h) {
   const int nlocal = pts.nlocal;
@@ -312,14 +312,14 @@ void FluidSolver::grain_drag_forces(const std::vector<double> &Kgrain, double h)
   const double *const gdr = g_.dr.data();
   const int nsub = state.nsub;
   for (int k = 0; k < nlocal; ++k) {
-    if (!is_grain(k) || grain_shapes_[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
-    const Stencil &ps = grain_shapes_[k];
+    if (!is_grain(k) || coup_->grain_shapes[k].base[0] == INT_MIN || Kgrain[k] <= 0.0) continue;
+    const Stencil &ps = coup_->grain_shapes[k];
     Row4 J = {0, 0, 0, 0};  // J[1..3]: the impulse per unit K of the nodes, weighted
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
       J += w * row4(gdr + DrRec::N * n);
     });
     for (int d = 0; d < 3; ++d)
-      grain_force_[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
+      coup_->grain_force[3 * static_cast<std::size_t>(k) + d] += Kgrain[k] * J[1 + d] / h / nsub;
   }
 }
 
@@ -327,17 +327,17 @@ template <int NS>
 void FluidSolver::couple_kernel(double h) {
   const int nlocal = pts.nlocal;
   double *const gdr = g_.dr.data();
-  if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
+  if (static_cast<int>(coup_->grain_shapes.size()) < nlocal) coup_->grain_shapes.resize(nlocal);
 
   // projection: the grains feel the nodal gradient of the last solve (grain_pressure); the fluid
   // gets no pressure reaction as a force: the projection takes it along the periodic directions
   // (the exact exchange, set_grain_reaction) and elsewhere its share -theta grad p is its correction
-  const bool proj = opt.projection;
+  const bool proj = pressure_->incompressible();
   const bool weak = opt.grad_p == GradP::Weak || proj;
   grain_pressure_inputs<NS>(proj, weak);
 
   // the box of the grains' stencils (fluid_fraction found them for this sub-step)
-  const IndexBox gbox = stencil_box(grain_base_lo_, grain_base_hi_, NS, grid_.patch());
+  const IndexBox gbox = stencil_box(coup_->base_lo, coup_->base_hi, NS, grid_.patch());
   const std::vector<IndexBox> xboxes = grid_.exchanged_boxes();
   // What the grains read (st) is read only at their stencils, here and, through the forward, at
   // the owned nodes of the exchanged boxes, and by the drag exchange below in the same box: st is
@@ -348,7 +348,7 @@ void FluidSolver::couple_kernel(double h) {
   if (grid_.restricted()) sbox = sbox.cut(grid_.work());
   // pfit is 0 outside the points' stencils and the exchanged boxes (with grad_p weak and the
   // projection everywhere): there the node reads a record of zeros, not the array
-  const IndexBox pbox = stencil_box(base_lo_, base_hi_, NS, grid_.patch());
+  const IndexBox pbox = stencil_box(pw_.base_lo, pw_.base_hi, NS, grid_.patch());
   const IndexBox rbox = !proj && !weak ? bounding_box(pbox, xboxes) : IndexBox();
   if (!sbox.empty()) grain_node_state(sbox, rbox, weak);
   grid_.forward(g_.st.data(), StRec::N);
@@ -386,7 +386,7 @@ void FluidSolver::couple_kernel(double h) {
       const bool in = dbox.contains(i, j, k);
       for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = in ? gdr[DrRec::N * n + DrRec::FP + d] : 0.0;
     });
-    proj_->set_grain_reaction(g_.rp.data());
+    pressure_->solve()->set_grain_reaction(g_.rp.data());
   }
   grid_.forward(g_.dr.data(), DrRec::N);
   grain_drag_forces<NS>(Kgrain, h);
@@ -412,10 +412,10 @@ void FluidSolver::point_sums() {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   double *const wk = g_.wk.data();
   std::fill(g_.wk.begin(), g_.wk.end(), 0.0);
-  for (const int i : plist_) {
+  for (const int i : pw_.plist) {
     const double *f = pts.f[i];
     const Row4 r = {pts.state[i][C_VOL], f[0], f[1], f[2]};
-    for_stencil<NS>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+    for_stencil<NS>(pw_.shapes[i], sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
       row4(wk + WkRec::N * n) += w * r;
     });
   }
@@ -552,8 +552,8 @@ void FluidSolver::through_points(const double *q, std::vector<double> &out) {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   std::fill(out.begin(), out.end(), 0.0);
   double *const o = out.data();
-  for (const int i : plist_) {
-    const Stencil &ps = shapes_[i];
+  for (const int i : pw_.plist) {
+    const Stencil &ps = pw_.shapes[i];
     Row4 qp = {0, 0, 0, 0};
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
       qp += w * Row4{q[3 * n], q[3 * n + 1], q[3 * n + 2], 0.0};

@@ -44,13 +44,16 @@ void FluidSolver::drive_correct(double hf) {
   for (int i = 0; i < pts.nlocal; ++i)
     if (is_point(i)) pts.v[i][a] += du;
   state.drive_gradient += opt.rho0 * du / hf;
-  if (!opt.coupled) return;
-  // the grains' share of the mean gradient, G V_k, with the fluid's force of this step
+  coup_->drive_share(*this, a);
+}
+
+// the grains' share of the mean gradient, G V_k, with the fluid's force of this step (couple)
+void FluidSolver::drive_grain_share(int a) {
   const double G = state.drive_gradient;
   for (int k = 0; k < pts.nlocal; ++k)
     if (is_grain(k)) {
       const double r = pts.radius[k];
-      grain_force_[3 * static_cast<std::size_t>(k) + a] += G * (4.0 / 3.0) * kPi * r * r * r;
+      coup_->grain_force[3 * static_cast<std::size_t>(k) + a] += G * (4.0 / 3.0) * kPi * r * r * r;
     }
 }
 

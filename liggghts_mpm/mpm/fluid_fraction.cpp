@@ -65,10 +65,7 @@ double FluidSolver::solid_node_volume(int i, int j, int k) const {
   return v;
 }
 
-void FluidSolver::setup_coupling() {
-  if (!opt.coupled) return;
-  if (!state.theta_initialized) init_theta();
-}
+void FluidSolver::setup_coupling() { coup_->setup(*this); }
 
 // At the first run with grains: the fluid present in a point's volume is theta of it, so its
 // mass is reduced once to theta rho0 V (8-3): otherwise the grains' volume would be counted as
@@ -111,24 +108,24 @@ void FluidSolver::fluid_fraction() {
   const int nlocal = pts.nlocal;
   double **x = pts.x;
   const double *radius = pts.radius;
-  if (static_cast<int>(grain_shapes_.size()) < nlocal) grain_shapes_.resize(nlocal);
+  if (static_cast<int>(coup_->grain_shapes.size()) < nlocal) coup_->grain_shapes.resize(nlocal);
   std::fill(g_.sol.begin(), g_.sol.end(), 0.0);
   std::fill(g_.need.begin(), g_.need.end(), 0.0);
   for (int d = 0; d < 3; ++d) {
-    grain_base_lo_[d] = INT_MAX;
-    grain_base_hi_[d] = INT_MIN;
+    coup_->base_lo[d] = INT_MAX;
+    coup_->base_hi[d] = INT_MIN;
   }
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k)) continue;
     check_grain(k);
-    Stencil &ps = grain_shapes_[k];
+    Stencil &ps = coup_->grain_shapes[k];
     if (!shape_of(x[k], ps)) {
       ps.base[0] = INT_MIN;  // outside the grid: no fluid there
       continue;
     }
     for (int d = 0; d < 3; ++d) {
-      grain_base_lo_[d] = std::min(grain_base_lo_[d], ps.base[d]);
-      grain_base_hi_[d] = std::max(grain_base_hi_[d], ps.base[d]);
+      coup_->base_lo[d] = std::min(coup_->base_lo[d], ps.base[d]);
+      coup_->base_hi[d] = std::max(coup_->base_hi[d], ps.base[d]);
     }
     const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
     for_nodes(ps, [&](std::size_t n, double w) {
@@ -170,9 +167,9 @@ void FluidSolver::fluid_fraction() {
   }
   grid_.forward({{g_.th.data(), 1}, {g_.need.data(), 1}});
   const double *const gth = g_.th.data();
-  for (const int i : plist_) {
+  for (const int i : pw_.plist) {
     double th = 0.0;
-    for_nodes(shapes_[i], [&](std::size_t n, double w) { th += w * gth[n]; });
+    for_nodes(pw_.shapes[i], [&](std::size_t n, double w) { th += w * gth[n]; });
     pts.state[i][C_THETA] = th;
   }
 }

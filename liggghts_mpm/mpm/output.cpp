@@ -11,16 +11,20 @@
 
 namespace mpm {
 
+OutputState::OutputState() = default;
+OutputState::~OutputState() = default;
+
 void FluidSolver::global_vector(double *out, int walls) {
   const GridSpec &gs = opt.grid;
   double **x = pts.x, **v = pts.v;
   const double *rmass = pts.rmass;
   const double *spacing = state.spacing;
+  const Projection *proj = pressure_->solve();
   double sum[4] = {0, 0, 0, state.n_clamped};  // mass, kinetic energy, points, clamped
   // |v|max, front, height, p max, wall time of the fluid, of the coupling and of the pressure solver
   // (slowest rank), largest averaged nodal pressure (f_ID[19])
-  double mx[8] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, time_fluid, time_couple, time_pressure_solver(),
-                  proj_ ? proj_->largest_average_pressure() : -HUGE_VAL};
+  double mx[8] = {0.0, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, io_.time_fluid, io_.time_couple, time_pressure_solver(),
+                  proj ? proj->largest_average_pressure() : -HUGE_VAL};
   std::vector<long long> cell;  // the grid cell of each point and its pressure (f_ID[10])
   std::vector<double> pcell;
   for (int i = 0; i < pts.nlocal; ++i) {
@@ -55,21 +59,21 @@ void FluidSolver::global_vector(double *out, int walls) {
   out[3] = std::isfinite(gmx[1]) ? gmx[1] : 0.0;
   out[4] = std::isfinite(gmx[2]) ? gmx[2] - gs.origin[opt.height_axis] : 0.0;
   out[5] = state.nsub;
-  out[6] = std::min(dt_stable_, dt_couple_);
+  out[6] = std::min(lim_.dt_stable, lim_.dt_couple);
   out[7] = gsum[3];
   out[8] = gsum[2];
   out[9] = std::isfinite(gmx[3]) ? gmx[3] : 0.0;
   out[13] = gmx[4];
   out[14] = gmx[5];
-  out[15] = proj_ ? proj_->iterations() : 0.0;
-  out[16] = proj_ ? proj_->residual() : 0.0;
+  out[15] = proj ? proj->iterations() : 0.0;
+  out[16] = proj ? proj->residual() : 0.0;
   out[17] = gmx[6];
   out[18] = std::isfinite(gmx[7]) ? gmx[7] : 0.0;
   // the mesh walls' loads and the probes (wall_loads.cpp): 0 before the first fluid step
   for (int c = 0; c < 6 * walls; ++c)
-    out[kGlobalSize + c] = c < static_cast<int>(wall_mean_.size()) ? wall_mean_[c] : 0.0;
+    out[kGlobalSize + c] = c < static_cast<int>(io_.wall_mean.size()) ? io_.wall_mean[c] : 0.0;
   for (std::size_t j = 0; j < opt.probes.size(); ++j)
-    out[kGlobalSize + 6 * walls + j] = j < probe_mean_.size() ? probe_mean_[j] : 0.0;
+    out[kGlobalSize + 6 * walls + j] = j < io_.probe_mean.size() ? io_.probe_mean[j] : 0.0;
   const std::size_t next = kGlobalSize + 6 * walls + opt.probes.size() + (opt.drive.active ? 1 : 0);
   if (opt.drive.active) out[next - 1] = state.drive_gradient;
   if (opt.flow_faces()) {
@@ -83,27 +87,28 @@ void FluidSolver::global_vector(double *out, int walls) {
   }
 }
 
-// since the fix was created: the Projection of each grid patch (a new one at every re-cut) adds
-// to what the ones before it counted
-double FluidSolver::time_pressure_solver() const {
-  return proj_seconds_before_ + (proj_ ? proj_->solver_seconds() : 0.0);
-}
-long FluidSolver::pressure_solves() const { return proj_solves_before_ + (proj_ ? proj_->solves() : 0); }
-long FluidSolver::pressure_iterations_summed() const {
-  return proj_iterations_before_ + (proj_ ? proj_->iterations_summed() : 0);
-}
+// since the solver was made (PressureModel's counters; 0 with eos)
+double FluidSolver::time_pressure_solver() const { return pressure_->solver_seconds(); }
+long FluidSolver::pressure_solves() const { return pressure_->solves(); }
+long FluidSolver::pressure_iterations_summed() const { return pressure_->iterations_summed(); }
 
-long FluidSolver::pressure_sealed_nodes() const { return proj_ ? proj_->sealed_nodes() : 0; }
-long FluidSolver::pressure_sealed_sets() const { return proj_ ? proj_->sealed_sets() : 0; }
+long FluidSolver::pressure_sealed_nodes() const {
+  const Projection *proj = pressure_->solve();
+  return proj ? proj->sealed_nodes() : 0;
+}
+long FluidSolver::pressure_sealed_sets() const {
+  const Projection *proj = pressure_->solve();
+  return proj ? proj->sealed_sets() : 0;
+}
 
 namespace {
 int point_field_size(const std::string &f) { return f == "v" ? 3 : f == "tau" ? 6 : f == "affine" ? 9 : 1; }
 }  // namespace
 
 void FluidSolver::write_output() {
-  if (last_output_step_ == clock.step) return;
-  last_output_step_ = clock.step;
-  // the ranks meet first (they would at the first collective call anyway), so that time_output is
+  if (io_.last_step == clock.step) return;
+  io_.last_step = clock.step;
+  // the ranks meet first (they would at the first collective call anyway), so that io_.time_output is
   // the output's own and not the wait for a rank still in the preceding step
   MPI_Barrier(comm_);
   const double t0 = MPI_Wtime();
@@ -163,13 +168,13 @@ void FluidSolver::write_output() {
   }
 
   try {  // collective: a failure on any rank throws the same message on every rank
-    if (!series_) series_.reset(new Hdf5Series(opt.out_prefix, comm_));
-    series_->write_step(clock.step, clock.time, pb, want_grid ? &gb : nullptr);
+    if (!io_.series) io_.series.reset(new Hdf5Series(opt.out_prefix, comm_));
+    io_.series->write_step(clock.step, clock.time, pb, want_grid ? &gb : nullptr);
   } catch (const std::exception &e) {
     throw Error(std::string("Fix mpm/fluid: keyword 'output': ") + e.what());
   }
-  time_output += MPI_Wtime() - t0;
-  ++n_outputs;
+  io_.time_output += MPI_Wtime() - t0;
+  ++io_.n_outputs;
 }
 
 }  // namespace mpm

@@ -8,22 +8,11 @@
 #include <sstream>
 
 #include "mpm/error.h"
-#include "mpm/hdf5_series.h"
 #include "mpm/projection.h"
 
 namespace mpm {
 
-namespace {
-// wall time of a phase, added to acc (f_ID[14], f_ID[15])
-template <class Fn>
-inline void timed(double &acc, Fn &&fn) {
-  const double t0 = MPI_Wtime();
-  fn();
-  acc += MPI_Wtime() - t0;
-}
-}  // namespace
-
-FluidSolver::FluidSolver(const Options &o, MPI_Comm comm) : opt(o), comm_(comm) {
+FluidSolver::FluidSolver(const Options &o, MPI_Comm comm) : opt(o), comm_(comm), pressure_(PressureModel::make(opt)), coup_(CouplingModel::make(opt)) {
   MPI_Comm_rank(comm_, &me_);
   MPI_Comm_size(comm_, &nprocs_);
   bc.setup(&opt, &grid_);
@@ -64,7 +53,7 @@ double FluidSolver::init_point(const double x[3], double vol, double *s) const {
   double rho = eos.rho0, p = 0.0;
   if (opt.hydrostatic) {
     p = std::max(0.0, eos.rho0 * opt.hydro_g * (opt.hydro_surface - x[opt.hydro_axis]));
-    rho = opt.projection ? eos.rho0 : eos.density(p);  // projection: incompressible
+    rho = pressure_->density(eos, p);  // projection: incompressible
   }
   // The point keeps the reference mass; a pre-compressed point is smaller.
   const double m = eos.rho0 * vol;
@@ -87,19 +76,10 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
   stencil_reach(opt.shape, skin / opt.grid.dx, reach);
   const int beyond = mesh_walls ? 1 : 0;
   const int halo[2] = {reach[0] + beyond, reach[1] + beyond};
-  halo_skin_ = skin;
-  for (int d = 0; d < 3; ++d) sub_lo_[d] = sublo[d], sub_hi_[d] = subhi[d];
-  // projection: the last solve goes on into the new patch (the warm start, the grains' pressure
-  // gradient, the d(theta)/dt source), so that run N; run M equals run N+M: from the old
-  // Projection (its owned box, or the whole grid if a rank's box changed), else from a
-  // restart file
-  ProjectionState last;
-  if (opt.projection && proj_) {
-    proj_->save(last);
-    proj_seconds_before_ += proj_->solver_seconds();
-    proj_solves_before_ += proj_->solves();
-    proj_iterations_before_ += proj_->iterations_summed();
-  }
+  shape_ctx_.skin = skin;
+  for (int d = 0; d < 3; ++d) shape_ctx_.sub_lo[d] = sublo[d], shape_ctx_.sub_hi[d] = subhi[d];
+  // projection: the last solve goes on into the new patch (ProjectionPressure::enter_patch)
+  pressure_->leave_patch();
   grid_.setup(opt.grid, comm_, sublo, subhi, halo);
   {
     const GridSpec &gs = opt.grid;
@@ -118,7 +98,7 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
       c.hi[d] = pb.hi[d] - (hi_face ? 0 : beyond);
     }
   }
-  g_.assign(grid_.size(), opt.musl, !opt.projection, opt.coupled, opt.grad_p == GradP::Fit);
+  g_.assign(grid_.size(), opt.musl, !pressure_->incompressible(), opt.coupled, opt.grad_p == GradP::Fit);
   bc.walls_moved();  // the nodes' mesh-wall constraints are indexed by the patch
   // the sparse grid covers the fluid's own phases, also with couple and with the projection: the
   // coupling reads the fluid's arrays (zero outside the active blocks, as on the dense grid) and
@@ -128,52 +108,17 @@ void FluidSolver::setup_grid(const double sublo[3], const double subhi[3], doubl
   // "Sparse grid")
   sparse_ = opt.sparse;
   if (sparse_) blocks_.setup(grid_);
-  if (opt.projection) {
-    proj_.reset(new Projection(grid_, comm_, opt));
-    if (last.valid) {
-      const IndexBox &ob = grid_.owned();
-      int same = 1, all = 0;
-      for (int d = 0; d < 3; ++d)
-        if (ob.lo[d] != last.box.lo[d] || ob.hi[d] != last.box.hi[d]) same = 0;
-      MPI_Allreduce(&same, &all, 1, MPI_INT, MPI_MIN, comm_);
-      if (!all) last = gather_global(last, opt.grid, comm_);
-      proj_->load(last);
-    } else if (state.projection.valid) {
-      proj_->load(state.projection);
-    }
-    state.projection = ProjectionState();  // read once
-  }
+  pressure_->enter_patch(grid_, comm_, opt, state);
   grid_ready_ = true;
 }
 
-ProjectionState FluidSolver::projection_state() {
-  if (!opt.projection) return ProjectionState();
-  if (!proj_) return state.projection;
-  ProjectionState local;
-  proj_->save(local);
-  return gather_global(local, opt.grid, comm_);
-}
+ProjectionState FluidSolver::projection_state() { return pressure_->restart_state(opt, comm_, state); }
 
 void FluidSolver::step() {
   const double h = opt.fluid_every * clock.dt / state.nsub;
-  if (opt.coupled) grain_force_.assign(3 * static_cast<std::size_t>(pts.nlocal), 0.0);
-  // the volume correction runs on every M-th fluid step (its first sub-step), removing the share
-  // min(k M hf, 1) of the volume error each time (Projection::volume_correction_every)
-  double vc_time = 0.0;
-  if (opt.projection && opt.volume_correction > 0.0) {
-    const double hf = opt.fluid_every * clock.dt;
-    const long every = Projection::volume_correction_every(opt.volume_correction, hf);
-    if (!opt.every_auto) {
-      if ((clock.step / opt.fluid_every) % every == 0) vc_time = every * hf;
-    } else {
-      // N varies: the correction's period every * hf is counted down in time
-      if (state.vc_due <= 0.5 * hf) {
-        vc_time = every * hf;
-        state.vc_due = vc_time;
-      }
-      state.vc_due -= hf;
-    }
-  }
+  coup_->begin_step(*this);
+  // the volume correction (projection) of this fluid step, due on its first sub-step
+  const double vc_time = pressure_->volume_correction_due(opt, clock, state);
   if (opt.every_auto) state.grain_tau = HUGE_VAL;  // this step's, for the next choice of N (couple_kernel)
   const bool samples = samples_on();
   if (walls_with_loads()) bc.record_loads(h);
@@ -183,30 +128,28 @@ void FluidSolver::step() {
   if (samples) end_samples();
   if (opt.drive.active) drive_correct(opt.fluid_every * clock.dt);
   inflow_advance(opt.fluid_every * clock.dt);
-  if (!opt.coupled) return;
-  // fluid force on the grains (mean over the sub-steps): kept in the state rows, from which the host
-  // adds it to the grains' forces on each of the N DEM steps this fluid step covers (with every N;
-  // FixMpmFluid::add_grain_force), so that the grains receive the impulse N dt F the fluid gave up
+  coup_->end_step(*this);
+}
+
+// GrainCoupling::end_step: the fluid force on the grains (mean over the sub-steps) kept in the
+// state rows
+void FluidSolver::store_grain_force() {
   for (int k = 0; k < pts.nlocal; ++k) {
     if (!is_grain(k)) continue;
-    for (int d = 0; d < 3; ++d) pts.state[k][C_FGRAIN + d] = grain_force_[3 * k + d];
+    for (int d = 0; d < 3; ++d) pts.state[k][C_FGRAIN + d] = coup_->grain_force[3 * k + d];
   }
 }
 
 // One sub-step of chapter 8, phase by phase.
 void FluidSolver::substep(double h, double vc_time) {
-  timed(time_fluid, [&] { compute_shapes(); });
-  if (opt.coupled)
-    timed(time_couple, [&] {
-      fluid_fraction();
-      if (state.theta_initialized) refresh_pressure();
-    });
-  timed(time_fluid, [&] { particles_to_grid(); });
-  if (opt.coupled) timed(time_couple, [&] { couple_fluid_grains(h); });
-  timed(time_fluid, [&] {
+  timed(io_.time_fluid, [&] { compute_shapes(); });
+  coup_->fraction(*this, io_.time_couple);
+  timed(io_.time_fluid, [&] { particles_to_grid(); });
+  coup_->exchange(*this, h, io_.time_couple);
+  timed(io_.time_fluid, [&] {
     update_grid(h, vc_time);
     if (samples_on()) sample_pressure(h);
-    if (opt.projection) interpolate_pressure();
+    point_pressure();
     grid_to_particles();
     if (opt.musl) remap_velocity_musl(h);
     update_stress(h);
@@ -216,17 +159,17 @@ void FluidSolver::substep(double h, double vc_time) {
 
 void FluidSolver::compute_shapes() {
   const int nlocal = pts.nlocal;
-  if (static_cast<int>(shapes_.size()) < nlocal) {
-    shapes_.resize(nlocal);
-    vpic_.resize(3 * static_cast<std::size_t>(nlocal));
-    velgrad_.resize(9 * static_cast<std::size_t>(nlocal));
+  if (static_cast<int>(pw_.shapes.size()) < nlocal) {
+    pw_.shapes.resize(nlocal);
+    pw_.vpic.resize(3 * static_cast<std::size_t>(nlocal));
+    pw_.velgrad.resize(9 * static_cast<std::size_t>(nlocal));
   }
-  plist_.clear();
+  pw_.plist.clear();
   double **x = pts.x;
   const GridSpec &gs = opt.grid;
   for (int d = 0; d < 3; ++d) {
-    base_lo_[d] = INT_MAX;
-    base_hi_[d] = INT_MIN;
+    pw_.base_lo[d] = INT_MAX;
+    pw_.base_hi[d] = INT_MIN;
   }
   // sparse grid: the blocks are marked here, in the pass that computes the stencils
   // (mark_active_blocks)
@@ -238,13 +181,13 @@ void FluidSolver::compute_shapes() {
   const bool quad = opt.shape == ShapeKind::QuadraticBSpline;
   for (int i = 0; i < nlocal; ++i) {
     if (!is_point(i)) continue;
-    plist_.push_back(i);
+    pw_.plist.push_back(i);
     check_point(i);
-    if (quad ? shape_at<true>(x[i], shapes_[i]) : shape_at<false>(x[i], shapes_[i])) {
-      const int *b = shapes_[i].base;
+    if (quad ? shape_at<true>(x[i], pw_.shapes[i]) : shape_at<false>(x[i], pw_.shapes[i])) {
+      const int *b = pw_.shapes[i].base;
       for (int d = 0; d < 3; ++d) {
-        base_lo_[d] = std::min(base_lo_[d], b[d]);
-        base_hi_[d] = std::max(base_hi_[d], b[d]);
+        pw_.base_lo[d] = std::min(pw_.base_lo[d], b[d]);
+        pw_.base_hi[d] = std::max(pw_.base_hi[d], b[d]);
       }
       if (sparse) blocks_.mark_from(std::max(b[0] - 1, lo0), std::max(b[1] - 1, lo1), std::max(b[2] - 1, lo2));
     } else {
@@ -354,8 +297,8 @@ void FluidSolver::outside_patch(const double *x) const {
   const ShapeCtx &c = shape_ctx_;
   std::ostringstream os;
   os << "Fix mpm/fluid: atom at (" << x[0] << ", " << x[1] << ", " << x[2] << ") is farther than the neighbor skin ("
-     << halo_skin_ << ") outside the subdomain [" << sub_lo_[0] << ", " << sub_hi_[0] << "] x [" << sub_lo_[1] << ", "
-     << sub_hi_[1] << "] x [" << sub_lo_[2] << ", " << sub_hi_[2] << "] of rank " << me_
+     << shape_ctx_.skin << ") outside the subdomain [" << shape_ctx_.sub_lo[0] << ", " << shape_ctx_.sub_hi[0] << "] x [" << shape_ctx_.sub_lo[1] << ", "
+     << shape_ctx_.sub_hi[1] << "] x [" << shape_ctx_.sub_lo[2] << ", " << shape_ctx_.sub_hi[2] << "] of rank " << me_
      << ": its stencil leaves the rank's grid patch (stencil nodes " << c.lo[0] << ".." << c.hi[0] << " x " << c.lo[1]
      << ".." << c.hi[1] << " x " << c.lo[2] << ".." << c.hi[2]
      << "); it moved too far between re-neighbourings (use neigh_modify every 1 check yes, or a larger "
@@ -363,9 +306,18 @@ void FluidSolver::outside_patch(const double *x) const {
   throw LocalError(os.str());
 }
 
-/* grid momentum update (8-35), velocity (8-36), boundary conditions */
+/* grid momentum update (8-35), velocity (8-36), boundary conditions: the pressure model's
+   (EosPressure: the nodes' conditions; ProjectionPressure: u*, then the projection) */
 void FluidSolver::update_grid(double h, double vc_time) {
+  pressure_->update_grid(*this, h, vc_time);
+  grid_.forward(g_.vel.data(), VelRec::N);
+}
+
+// update_grid's sweep over the nodes; node_bc: the boundary conditions at each node (eos; the
+// projection's u* has none, its wall conditions come with the projection, Projection::project)
+void FluidSolver::grid_velocity(double h, bool node_bc) {
   const double mmin = mass_min();
+  const double *rx = coup_->fluid_force(g_);  // the drag exchange's force on the fluid (couple)
   for_owned_nodes([&](int i, int j, int k, std::size_t n) {
     const double *g = &g_.p2g[P2gRec::N * n];
     double *gv = &g_.vel[VelRec::N * n];
@@ -377,24 +329,25 @@ void FluidSolver::update_grid(double h, double vc_time) {
     double vnew[3];
     for (int d = 0; d < 3; ++d) {
       gv[VelRec::V_OLD + d] = g[P2gRec::MV + d] * inv;
-      const double f = g[P2gRec::F + d] + (opt.coupled ? g_.rx[3 * n + d] : 0.0);
+      const double f = g[P2gRec::F + d] + (rx ? rx[3 * n + d] : 0.0);
       // damping is implicit in time so that any rate is stable
       vnew[d] = (gv[VelRec::V_OLD + d] + h * f * inv) / (1.0 + h * opt.damping);
     }
-    // projection: u* here; the wall conditions come with the projection (Projection::project)
-    if (!opt.projection) bc.apply(vnew, i, j, k, h, g[P2gRec::M]);
+    if (node_bc) bc.apply(vnew, i, j, k, h, g[P2gRec::M]);
     for (int d = 0; d < 3; ++d) gv[VelRec::V_NEW + d] = vnew[d];
   });
-  if (opt.projection) {
-    const bool vc = vc_time > 0.0;
-    if (vc) point_volume_to_grid();
-    IndexBox work;
-    const bool sparse_proj = sparse_ && !opt.coupled && !bc.walls();
-    if (sparse_proj) work = projection_work_box();
-    proj_->project(g_.vel.data(), g_.p2g.data(), mmin, opt.coupled ? g_.th.data() : nullptr, h,
-                   bc, clock.step, vc ? pvol_.data() : nullptr, sparse_proj ? &work : nullptr, vc_time);
-  }
-  grid_.forward(g_.vel.data(), VelRec::N);
+}
+
+// ProjectionPressure::update_grid: the projection of u* (its volume correction when due)
+void FluidSolver::project_velocity(Projection &proj, std::vector<double> &pvol, double h, double vc_time) {
+  const bool vc = vc_time > 0.0;
+  if (vc) point_volume_to_grid(pvol);
+  IndexBox work;
+  const double *theta = coup_->node_theta(g_);
+  const bool sparse_proj = sparse_ && !theta && !bc.walls();
+  if (sparse_proj) work = projection_work_box();
+  proj.project(g_.vel.data(), g_.p2g.data(), mass_min(), theta, h, bc, clock.step,
+               vc ? pvol.data() : nullptr, sparse_proj ? &work : nullptr, vc_time);
 }
 
 /* The projection's work box (sparse grid, pure fluid without mesh walls): the bounding box of the
@@ -404,9 +357,9 @@ void FluidSolver::update_grid(double h, double vc_time) {
 IndexBox FluidSolver::projection_work_box() {
   int loc[6], glob[6];
   for (int d = 0; d < 3; ++d) {
-    loc[d] = base_lo_[d];
-    loc[3 + d] = -base_hi_[d] - (support(opt.shape) - 1);  // the stencil's top node, negated
-    if (base_hi_[d] == INT_MIN) loc[3 + d] = INT_MAX;      // no points here
+    loc[d] = pw_.base_lo[d];
+    loc[3 + d] = -pw_.base_hi[d] - (support(opt.shape) - 1);  // the stencil's top node, negated
+    if (pw_.base_hi[d] == INT_MIN) loc[3 + d] = INT_MAX;      // no points here
   }
   MPI_Allreduce(loc, glob, 6, MPI_INT, MPI_MIN, comm_);
   const IndexBox &pb = grid_.patch();
@@ -426,32 +379,33 @@ IndexBox FluidSolver::projection_work_box() {
 
 /* projection with couple: the grains feel the nodal pressure gradient of the last solve, the
    discrete gradient the fluid felt (grad_p weak's array, read by couple_kernel) */
-void FluidSolver::projection_gradient_to_grains() { g_.gw = proj_->gradient(); }
+void FluidSolver::projection_gradient_to_grains() { g_.gw = pressure_->solve()->gradient(); }
 
 /* projection + volume_correction: the points' volume on the grid, sum S V with V = m / (theta
    rho0) (the volume a point holds, with this sub-step's theta), owned nodes after the reverse sum */
-void FluidSolver::point_volume_to_grid() {
-  pvol_.assign(grid_.size(), 0.0);
+void FluidSolver::point_volume_to_grid(std::vector<double> &pvol) {
+  pvol.assign(grid_.size(), 0.0);
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   with_stencil(opt.shape, [&](auto ns) {
-    for (const int i : plist_) {
+    for (const int i : pw_.plist) {
       const double V = pts.rmass[i] / (pts.state[i][C_THETA] * opt.rho0);
-      for_stencil<decltype(ns)::value>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double,
-                                                               double, double) { pvol_[n] += w * V; });
+      for_stencil<decltype(ns)::value>(pw_.shapes[i], sy, sz, [&](std::size_t n, int, int, int, double w, double,
+                                                               double, double) { pvol[n] += w * V; });
     }
   });
-  grid_.reverse_sum(pvol_.data(), 1);
+  grid_.reverse_sum(pvol.data(), 1);
 }
 
+void FluidSolver::point_pressure() { pressure_->point_pressure(*this); }
+
 /* projection: the points' pressure (state column C_P, for output and f_ID[10]) interpolated
-   from the nodal pressure of the solve */
-void FluidSolver::interpolate_pressure() {
-  const std::vector<double> &p = proj_->pressure();
+   from the nodal pressure p of the solve */
+void FluidSolver::interpolate_pressure(const std::vector<double> &p) {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   with_stencil(opt.shape, [&](auto ns) {
-    for (const int i : plist_) {
+    for (const int i : pw_.plist) {
       double sum = 0.0;
-      for_stencil<decltype(ns)::value>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double w, double,
+      for_stencil<decltype(ns)::value>(pw_.shapes[i], sy, sz, [&](std::size_t n, int, int, int, double w, double,
                                                                double, double) { sum += w * p[n]; });
       pts.state[i][C_P] = sum;
     }
@@ -462,34 +416,38 @@ void FluidSolver::interpolate_pressure() {
    Anti-locking: the dilatation rate is averaged over each grid cell and the cell's pressure
    follows from the cell's mean density, so all points of a cell carry one pressure (Mast et al.
    2012). theta_only: the fluid fraction changed, the volume did not (refresh_pressure). */
-void FluidSolver::update_stress(double h, bool theta_only) {
-  if (opt.projection) {
-    // incompressible: density rho0 and the volume m / (theta rho0) held (the points' number per
-    // cell measures the volume drift, docs/theory/projection.md); the pressure is the solve's
-    for (const int i : plist_) {
-      double *s = pts.state[i];
-      s[C_RHO] = opt.rho0;
-      s[C_VOL] = pts.rmass[i] / (s[C_THETA] * opt.rho0);
-      if (theta_only) continue;
-      const double *L = velgrad(i);
-      const double Lm[3][3] = {{L[0], L[1], L[2]}, {L[3], L[4], L[5]}, {L[6], L[7], L[8]}};
-      newtonian_deviatoric_stress(opt.viscosity, Lm, s + C_TAU);
-    }
-    return;
+void FluidSolver::update_stress(double h, bool theta_only) { pressure_->update_stress(*this, h, theta_only); }
+
+// incompressible (ProjectionPressure): density rho0 and the volume m / (theta rho0) held (the
+// points' number per cell measures the volume drift, docs/theory/projection.md); the pressure is
+// the solve's
+void FluidSolver::incompressible_stress(bool theta_only) {
+  for (const int i : pw_.plist) {
+    double *s = pts.state[i];
+    s[C_RHO] = opt.rho0;
+    s[C_VOL] = pts.rmass[i] / (s[C_THETA] * opt.rho0);
+    if (theta_only) continue;
+    const double *L = velgrad(i);
+    const double Lm[3][3] = {{L[0], L[1], L[2]}, {L[3], L[4], L[5]}, {L[6], L[7], L[8]}};
+    newtonian_deviatoric_stress(opt.viscosity, Lm, s + C_TAU);
   }
+}
+
+// EosPressure: the equation of state's pressure of each point, from its cell's density
+void FluidSolver::eos_stress(double h, bool theta_only) {
   const int nlocal = pts.nlocal;
   const double *rmass = pts.rmass;
   // anti-locking: the cell sums, after MUSL already taken in its gradient pass (musl_gradient),
   // else here
-  if (theta_only || !cells_summed_) {
-    if (pcell_.size() < static_cast<std::size_t>(nlocal)) pcell_.resize(nlocal);
+  if (theta_only || !pw_.cells_summed) {
+    if (pw_.pcell.size() < static_cast<std::size_t>(nlocal)) pw_.pcell.resize(nlocal);
     clear_nodes(g_.cell, CellRec::N);
     for (int i = 0; i < nlocal; ++i) {
       if (!is_point(i)) continue;
       sum_cell(i, theta_only ? nullptr : velgrad(i));
     }
   }
-  cells_summed_ = false;
+  pw_.cells_summed = false;
   grid_.reverse_sum(g_.cell.data(), CellRec::N);
   grid_.forward(g_.cell.data(), CellRec::N);
   for (int i = 0; i < nlocal; ++i) {
@@ -499,7 +457,7 @@ void FluidSolver::update_stress(double h, bool theta_only) {
     const double *L = theta_only ? nullptr : velgrad(i);
     // the cell's mean dilatation and density (anti-locking): the point's own J and volume follow
     // the cell's, its pressure is the cell's
-    const double *c = &g_.cell[CellRec::N * pcell_[i]];
+    const double *c = &g_.cell[CellRec::N * pw_.pcell[i]];
     const double div = c[CellRec::VDIV] / c[CellRec::V];
     const double rho_cell = c[CellRec::M] / (c[CellRec::THV] * (1.0 + h * div));
     double p = opt.eos.pressure(rho_cell);
@@ -536,13 +494,14 @@ void FluidSolver::advance_positions(double h) {
     hi[d] = gs.periodic[d] ? HUGE_VAL : gs.upper(d);
   }
   // the volume correction's drift (Projection::volume_drift): positions only
-  if (proj_ && !proj_->volume_drift().empty()) {
-    const double *w = proj_->volume_drift().data();
+  const std::vector<double> *drift = pressure_->volume_drift();
+  if (drift && !drift->empty()) {
+    const double *w = drift->data();
     const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
     with_stencil(opt.shape, [&](auto ns) {
-      for (const int i : plist_)
-        for_stencil<decltype(ns)::value>(shapes_[i], sy, sz, [&](std::size_t n, int, int, int, double s, double, double, double) {
-          for (int d = 0; d < 3; ++d) vpic_[3 * i + d] += s * w[3 * n + d];
+      for (const int i : pw_.plist)
+        for_stencil<decltype(ns)::value>(pw_.shapes[i], sy, sz, [&](std::size_t n, int, int, int, double s, double, double, double) {
+          for (int d = 0; d < 3; ++d) pw_.vpic[3 * i + d] += s * w[3 * n + d];
         });
     });
   }
@@ -550,7 +509,7 @@ void FluidSolver::advance_positions(double h) {
     if (!is_point(i)) continue;
     double *xi = x[i];
     const double xold[3] = {xi[0], xi[1], xi[2]};
-    for (int d = 0; d < 3; ++d) xi[d] += h * vpic_[3 * i + d];
+    for (int d = 0; d < 3; ++d) xi[d] += h * pw_.vpic[3 * i + d];
     if (box_only && xi[0] >= lo[0] && xi[0] <= hi[0] && xi[1] >= lo[1] && xi[1] <= hi[1] && xi[2] >= lo[2] &&
         xi[2] <= hi[2])
       continue;
@@ -560,14 +519,14 @@ void FluidSolver::advance_positions(double h) {
       // left through an outflow face: no longer fluid (is_point), removed by the host
       pts.state[i][C_FLAG] = kPointGone;
       for (int d = 0; d < 3; ++d) v[i][d] = 0.0;
-      ++gone_;
+      ++pw_.gone;
     }
   }
 }
 
 std::size_t FluidSolver::memory_bytes() const {
   std::size_t bytes = (g_.p2g.size() + g_.vel.size() + g_.cell.size() + g_.aux.size()) * sizeof(double);
-  bytes += shapes_.size() * sizeof(Stencil) + (vpic_.size() + velgrad_.size()) * sizeof(double);
+  bytes += pw_.shapes.size() * sizeof(Stencil) + (pw_.vpic.size() + pw_.velgrad.size()) * sizeof(double);
   return bytes;
 }
 

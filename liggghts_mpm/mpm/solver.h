@@ -13,15 +13,17 @@
 #include <vector>
 
 #include "mpm/boundaries.h"
+#include "mpm/coupling_model.h"
 #include "mpm/grid.h"
 #include "mpm/grid_fields.h"
 #include "mpm/options.h"
+#include "mpm/pressure_model.h"
 #include "mpm/projection_state.h"
+#include "mpm/solver_axes.h"
 #include "mpm/stencil.h"
 
 namespace mpm {
 
-class Hdf5Series;
 class Projection;
 
 // Views of the host's per-atom arrays (valid until the host reallocates them).
@@ -110,7 +112,7 @@ class FluidSolver {
   // the grains (mean over the sub-steps) goes to their state rows (C_FGRAIN) and grain_force(): the
   // host adds it to the grains' forces on each DEM step until the next fluid step.
   void step();
-  const std::vector<double> &grain_force() const { return grain_force_; }
+  const std::vector<double> &grain_force() const { return coup_->grain_force; }
 
   // f_ID[1..18] (collective): mass, kinetic energy, |v|max, front, height, sub-steps, stable dt,
   // clamped, points, p max, fluid force on the grains (3), wall time of the fluid and coupling,
@@ -135,13 +137,14 @@ class FluidSolver {
   // HDF5 + XDMF output of the points (and grid) fields of keyword output (collective).
   void write_output();
   // wall time in write_output on this rank (s, cumulative) and the step files written
-  double time_output = 0.0;
-  long n_outputs = 0;
+  double time_output() const { return io_.time_output; }
+  long n_outputs() const { return io_.n_outputs; }
   // wall time of the fluid's own work and of the coupling on this rank (s, cumulative)
-  double time_fluid = 0.0, time_couple = 0.0;
+  double time_fluid() const { return io_.time_fluid; }
+  double time_couple() const { return io_.time_couple; }
   // the wall time of the fluid and the coupling less the waits for the halo exchanges, since
   // construction: this rank's work (fix balance/mpm measured)
-  double busy_seconds() const { return time_fluid + time_couple - grid_.wait_seconds(); }
+  double busy_seconds() const { return io_.time_fluid + io_.time_couple - grid_.wait_seconds(); }
   // pressure projection, this rank, cumulative: wall time in the pressure solver (hypre assembly,
   // setup, PCG; part of time_fluid), solves and their PCG iterations (0 with eos)
   double time_pressure_solver() const;
@@ -163,8 +166,7 @@ class FluidSolver {
   // (8-35), (8-36), boundary conditions (projection: u*, solve, correction); vc_time > 0: the
   // volume correction is due and stands for that time (Projection::volume_correction_every)
   void update_grid(double h, double vc_time = 0.0);
-  void interpolate_pressure();      // projection: the points' pressure from the nodes
-  void point_volume_to_grid();      // projection + volume_correction: sum S V of the points
+  void point_pressure();            // the points' pressure from the nodes (projection; eos: none)
   void projection_gradient_to_grains();  // projection + couple: grad p for the grains
   void grid_to_particles();         // G2P (8-37)-(8-40)
   void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
@@ -184,8 +186,8 @@ class FluidSolver {
   // after the host created the layers due: inflow_depth less them
   void inflow_created(int f, int n);
   // points of this rank that left through an outflow face in the last fluid step (kPointGone)
-  long points_gone() const { return gone_; }
-  void clear_gone() { gone_ = 0; }
+  long points_gone() const { return pw_.gone; }
+  void clear_gone() { pw_.gone = 0; }
   void substep(double h, double vc_time = 0.0);  // all of them
   GridFields &fields() { return g_; }
   const LocalGrid &grid() const { return grid_; }
@@ -198,8 +200,24 @@ class FluidSolver {
   long nonzero_outside_active() const;
 
  private:
+  // the pressure models' work on the points and the grid (pressure_model.cpp)
+  friend class PressureModel;
+  friend class EosPressure;
+  friend class ProjectionPressure;
+  friend class GrainCoupling;
+  void store_grain_force();     // the grains' force of the fluid step to their state rows
+  void drive_grain_share(int a);  // superficial_velocity: the grains' share of the gradient
+  // the phases' bodies per pressure model: eos / node_bc true for the equation of state (the
+  // points' pressure in the internal force, the walls' traction, the nodes' boundary conditions)
+  void p2g(bool eos);
+  void grid_velocity(double h, bool node_bc);
+  void project_velocity(Projection &proj, std::vector<double> &pvol, double h, double vc_time);
+  void point_volume_to_grid(std::vector<double> &pvol);  // volume_correction: sum S V of the points
+  void interpolate_pressure(const std::vector<double> &p);
+  void eos_stress(double h, bool theta_only);
+  void incompressible_stress(bool theta_only);
   // kernels (transfer.cpp, coupling.cpp), instantiated per stencil size and transfer policy
-  template <int NS, class P, class Fn> void p2g_kernel(Fn &&after_point);
+  template <int NS, class P, class Fn> void p2g_kernel(Fn &&after_point, bool eos);
   template <int NS, class P> void g2p_kernel();
   template <int NS, class P> void musl_scatter();
   template <int NS> void musl_gradient();
@@ -236,16 +254,7 @@ class FluidSolver {
   // constants taken once per grid set-up (shape_ctx_)
   template <bool QUAD> bool shape_at(const double *x, Stencil &ps) const;
   [[noreturn]] void outside_patch(const double *x) const;
-  struct ShapeCtx {
-    double inv = 0.0;         // 1 / dx
-    double origin[3] = {0, 0, 0};
-    double ncell[3] = {0, 0, 0};
-    bool periodic[3] = {false, false, false};
-    // the nodes a stencil may use: the patch less the layers read beyond a stencil (mesh walls)
-    // where the patch does not end at a grid face; a stencil's last node within hi
-    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-  } shape_ctx_;
-  double halo_skin_ = 0.0, sub_lo_[3] = {0, 0, 0}, sub_hi_[3] = {0, 0, 0};  // setup_grid's (outside_patch)
+  ShapeCtx shape_ctx_;
   // anti-locking: the node index of the cell that holds point i (clamped at non-periodic faces)
   std::size_t cell_node(int i) const;
   // anti-locking: point i's share of its cell's sums (CellRec) for the stress update, velocity
@@ -263,7 +272,6 @@ class FluidSolver {
   std::string projection_limit(double dt, double dt_sub, const char *what, bool at_setup);  // check_timestep
   // a material point of the fluid (not one that left through an outflow face)
   bool is_point(int i) const { return (pts.mask[i] & pts.point_bit) != 0 && pts.state[i][C_FLAG] != kPointGone; }
-  long gone_ = 0;
   bool is_grain(int i) const { return opt.coupled && (pts.mask[i] & pts.grain_bit) != 0; }
   double mass_min() const { return opt.mass_threshold * state.point_mass_ref; }
 
@@ -273,36 +281,17 @@ class FluidSolver {
   GridFields g_;
   ActiveBlocks blocks_;
   bool sparse_ = false;
-  // compute_shapes: the smallest and largest stencil base of this rank's points (INT_MAX / INT_MIN
-  // without any), for the projection's work box
-  int base_lo_[3] = {0, 0, 0}, base_hi_[3] = {-1, -1, -1};
-  // fluid_fraction: the same for the stencils of this rank's grains inside the grid (couple_kernel's
-  // box of the grains' nodes)
-  int grain_base_lo_[3] = {0, 0, 0}, grain_base_hi_[3] = {-1, -1, -1};
-  IndexBox projection_work_box();
   bool grid_ready_ = false;
-  std::vector<Stencil> shapes_, grain_shapes_;
-  std::vector<int> plist_;          // local indices of the material points (this sub-step)
-  std::vector<double> vpic_;        // grid (PIC) velocity at the points, for the position update
-  std::vector<double> velgrad_;     // velocity gradient at the points, for the stress update
-  // the velocity gradient of the last transfer sits in the points' affine record (FLIP/PIC with
-  // MUSL store it there anyway), not in velgrad_: one stream of 9 doubles per point less
-  bool grad_in_state_ = false;
+  IndexBox projection_work_box();
+  // the state of each axis (solver_axes.h, pressure_model.h)
+  PointWork pw_;                            // core: the points of this sub-step
+  std::unique_ptr<PressureModel> pressure_; // pressure: eos or projection, chosen at construction
+  std::unique_ptr<CouplingModel> coup_;    // coupling: none or grains, chosen at construction
+  StepLimits lim_;                          // time step
+  OutputState io_;                          // io
   const double *velgrad(int i) const {
-    return grad_in_state_ ? pts.state[i] + C_AFF : &velgrad_[9 * static_cast<std::size_t>(i)];
+    return pw_.grad_in_state ? pts.state[i] + C_AFF : &pw_.velgrad[9 * static_cast<std::size_t>(i)];
   }
-  // anti-locking (eos): the node index of each point's cell, and whether the MUSL gradient pass
-  // has already summed the cells of this sub-step's stress update (sum_cell)
-  std::vector<std::size_t> pcell_;
-  bool cells_summed_ = false;
-  std::vector<double> grain_force_; // per local grain: fluid force averaged over sub-steps (3)
-  // time-step diagnostics of the last check
-  double dt_stable_ = 0.0, c_max_ = 0.0;
-  double dt_couple_ = HUGE_VAL, dt_grain_ = HUGE_VAL, c_couple_ = 0.0, c_grain_ = 0.0;
-  double couple_theta_min_ = 1.0, couple_rho_grain_ = 0.0;
-  double rho_range_[2] = {0.0, 0.0};  // lowest and highest density of the points at the last check
-  bool range_warned_ = false;         // range_warning() given in this run
-  double p_max_ = 0.0, p_scale_ = 0.0;  // pressure eos: largest point pressure, rho0 (|a| H + |v|^2)
   std::string range_warning();
   // finite position, velocity, mass (compute_shapes): q - q is 0 for a finite q and NaN for an
   // infinite or NaN one, one test for the usual case (the build does not assume finite math);
@@ -318,19 +307,6 @@ class FluidSolver {
   // the first of position, velocity, radius (when given) and mass that is not finite, or (radius,
   // mass) not positive; nullptr if none (bad_point, check_grain)
   static const char *first_bad(const double *x, const double *v, const double *radius, double mass);
-  std::unique_ptr<Hdf5Series> series_;
-  std::unique_ptr<Projection> proj_;  // pressure projection (opt.projection)
-  // the pressure solver's time, solves and PCG iterations of the Projections of earlier patches
-  double proj_seconds_before_ = 0.0;
-  long proj_solves_before_ = 0, proj_iterations_before_ = 0;
-  // wall_loads.cpp: per node the fluid mass and (pressure eos) mass times the points' pressure,
-  // of this sub-step (owned and halos); the mesh walls' loads (6 per wall) and the probes' sums
-  // (p h, h) summed over this fluid step's sub-steps on this rank, and their time
-  std::vector<double> wmp_;
-  std::vector<double> wall_sum_, wall_mean_;
-  double wall_time_ = 0.0;
-  std::vector<double> probe_sum_, probe_mean_;  // 2 per probe: sum p h (local), sum h
-  double probe_time_ = 0.0;
   // a mesh wall with 'loads yes' or a probe: the sub-steps sample the pressure (else nothing is spent)
   bool samples_on() const { return walls_with_loads() || !opt.probes.empty(); }
   bool walls_with_loads() const {
@@ -342,29 +318,15 @@ class FluidSolver {
   }
   void node_mass_pressure();
   void surface_pressure();
-  double p_surface_ = 0.0;  // pressure projection: the solve's pressure at the free surface (this sub-step)
   bool pressure_at(const double *x, double &p, double *vel);
   bool owns_sample(const double *x) const;
   void wall_pressure_loads();
   void probe_sums(double h);
   void begin_samples();
   void end_samples();
-  std::vector<double> pvol_;          // volume_correction: sum S V of the points per node
-  double vmax_ = 0.0;                 // |v|max of the points at the last time-step check
-  // every auto (timestep.cpp): the limits of the last check besides the fluid's own, and the one
-  // that set N
-  struct EveryAuto {
-    double grain_speed = 0.0;   // |v|max of the coupled grains
-    double accel = 0.0;         // |f/m|max of the points' external forces (gravity)
-    double wall_speed = 0.0;    // |w|max of the mesh walls' triangles near this rank
-    double grain_tau = HUGE_VAL;  // shortest drag response time m/K of a moving grain, all ranks
-    double limit = HUGE_VAL;    // the step N dt must not exceed
-    const char *which = "";
-  } auto_;
   void choose_every();
   double wall_speed2() const;
   void auto_limits(const double *glob);
-  long last_output_step_ = -1;
 };
 
 // The kernels' one dispatch on the stencil size: fn(std::integral_constant<int, NS>) with NS = 3
@@ -393,7 +355,7 @@ inline std::size_t FluidSolver::cell_node(int i) const {
 inline void FluidSolver::sum_cell(int i, const double *L) {
   const double *s = pts.state[i];
   const std::size_t n = cell_node(i);
-  pcell_[i] = n;
+  pw_.pcell[i] = n;
   double *c = &g_.cell[CellRec::N * n];
   const double V = s[C_VOL];
   c[CellRec::V] += V;

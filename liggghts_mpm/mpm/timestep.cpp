@@ -26,7 +26,7 @@ double FluidSolver::stable_dt() {
   double vg2max = 0.0;  // every auto: the coupled grains' largest |v|^2
   const int n = pts.nlocal, *mask = pts.mask, point_bit = pts.point_bit;
   double *const *vel = pts.v, *const *state = pts.state;
-  const bool coupled = opt.coupled, eos_scale = !opt.projection && !range_warned_, every_auto = opt.every_auto;
+  const bool coupled = opt.coupled, eos_scale = !pressure_->incompressible() && !lim_.range_warned, every_auto = opt.every_auto;
   for (int i = 0; i < n; ++i) {
     if (mask[i] & point_bit) {
       const double *v = vel[i], *s = state[i];
@@ -74,17 +74,17 @@ double FluidSolver::stable_dt() {
     // rho0 (|a|max H + |v|max^2), H the points' largest extent: hydrostatic plus dynamic pressure
     double extent = 0.0;
     for (int d = 0; d < 3; ++d) extent = std::max(extent, glob[8 + 2 * d] + glob[9 + 2 * d]);
-    p_max_ = glob[6];
-    p_scale_ = eos.rho0 * (std::sqrt(glob[7]) * std::max(extent, 0.0) + glob[0] * glob[0]);
+    lim_.p_max = glob[6];
+    lim_.p_scale = eos.rho0 * (std::sqrt(glob[7]) * std::max(extent, 0.0) + glob[0] * glob[0]);
   }
   // Sound speed: largest over the density range (Tait stiffens under compression, the linear
-  // law under tension).
-  // Projection: incompressible, no sound speed; the advective and viscous limits remain.
-  c_max_ = opt.projection ? 0.0 : std::sqrt(std::max(eos.sound_speed_sq(glob[1]), eos.sound_speed_sq(-glob[2])));
-  vmax_ = glob[0];
-  rho_range_[0] = -glob[2];
-  rho_range_[1] = glob[1];
-  const double c = c_max_, dx = opt.grid.dx;
+  // law under tension). Projection: incompressible, no sound speed; the advective and viscous
+  // limits remain.
+  lim_.c_max = pressure_->sound_speed(eos, -glob[2], glob[1]);
+  lim_.vmax = glob[0];
+  lim_.rho_range[0] = -glob[2];
+  lim_.rho_range[1] = glob[1];
+  const double c = lim_.c_max, dx = opt.grid.dx;
   const double dt_ac = acoustic_dt_limit(opt.cfl, dx, c, glob[0]);
   const double dt_visc = viscous_dt_limit(dx, eos.rho0, opt.viscosity, opt.dimension);
   coupled_limits(glob);
@@ -103,10 +103,10 @@ double FluidSolver::wall_speed2() const {
 // every auto: the reduced maxima of stable_dt (|a|^2 at 7, grains' |v|^2 at 14, walls' at 15, minus
 // the grains' shortest response time at 16)
 void FluidSolver::auto_limits(const double *glob) {
-  auto_.accel = std::sqrt(glob[7]);
-  auto_.grain_speed = std::sqrt(glob[14]);
-  auto_.wall_speed = std::sqrt(glob[15]);
-  auto_.grain_tau = -glob[16];  // of the last fluid step (HUGE_VAL before the first)
+  lim_.every.accel = std::sqrt(glob[7]);
+  lim_.every.grain_speed = std::sqrt(glob[14]);
+  lim_.every.wall_speed = std::sqrt(glob[15]);
+  lim_.every.grain_tau = -glob[16];  // of the last fluid step (HUGE_VAL before the first)
 }
 
 // Grains an integrator moves: the pore-pressure waves (fluid_laws.h). The coupled wave limits the
@@ -114,17 +114,17 @@ void FluidSolver::auto_limits(const double *glob) {
 // grains' step. Largest rho_f (1 - theta) / theta over the points against the lightest moving
 // grain. glob: stable_dt's reduced maxima (|v|max, ..., ratio, -theta min, -grain density min).
 void FluidSolver::coupled_limits(const double *glob) {
-  const double c = c_max_, dx = opt.grid.dx;
-  couple_theta_min_ = glob[4] < 0.0 ? -glob[4] : 1.0;
-  couple_rho_grain_ = glob[5] > -HUGE_VAL ? -glob[5] : 0.0;
-  c_couple_ = c_grain_ = 0.0;
-  dt_couple_ = dt_grain_ = HUGE_VAL;
-  if (couple_rho_grain_ > 0.0) {
-    const double r = glob[3] / couple_rho_grain_;
-    c_couple_ = coupled_wave_speed(c, r);
-    c_grain_ = grain_wave_speed(c, r);
-    dt_couple_ = acoustic_dt_limit(opt.cfl, dx, c_couple_, glob[0]);
-    dt_grain_ = c_grain_ > 0.0 ? acoustic_dt_limit(opt.cfl, dx, c_grain_, glob[0]) : HUGE_VAL;
+  const double c = lim_.c_max, dx = opt.grid.dx;
+  lim_.couple_theta_min = glob[4] < 0.0 ? -glob[4] : 1.0;
+  lim_.couple_rho_grain = glob[5] > -HUGE_VAL ? -glob[5] : 0.0;
+  lim_.c_couple = lim_.c_grain = 0.0;
+  lim_.dt_couple = lim_.dt_grain = HUGE_VAL;
+  if (lim_.couple_rho_grain > 0.0) {
+    const double r = glob[3] / lim_.couple_rho_grain;
+    lim_.c_couple = coupled_wave_speed(c, r);
+    lim_.c_grain = grain_wave_speed(c, r);
+    lim_.dt_couple = acoustic_dt_limit(opt.cfl, dx, lim_.c_couple, glob[0]);
+    lim_.dt_grain = lim_.c_grain > 0.0 ? acoustic_dt_limit(opt.cfl, dx, lim_.c_grain, glob[0]) : HUGE_VAL;
   }
 }
 
@@ -135,12 +135,12 @@ void FluidSolver::coupled_limits(const double *glob) {
 // in a dense bed), and its pressures and densities are not those of water.
 std::string FluidSolver::range_warning() {
   constexpr double kDensityDeviation = 0.03, kPressureFactor = 5.0;
-  if (opt.projection || range_warned_) return "";
-  const double r0 = opt.eos.rho0, lo = rho_range_[0] / r0, hi = rho_range_[1] / r0;
+  if (pressure_->incompressible() || lim_.range_warned) return "";
+  const double r0 = opt.eos.rho0, lo = lim_.rho_range[0] / r0, hi = lim_.rho_range[1] / r0;
   const bool density = lo < 1.0 - kDensityDeviation || hi > 1.0 + kDensityDeviation;
-  const bool pressure = p_max_ > kPressureFactor * p_scale_ && p_scale_ > 0.0;
+  const bool pressure = lim_.p_max > kPressureFactor * lim_.p_scale && lim_.p_scale > 0.0;
   if (!density && !pressure) return "";
-  range_warned_ = true;
+  lim_.range_warned = true;
   std::ostringstream os;
   os.precision(4);
   os << "WARNING: fix mpm/fluid (pressure eos): at step " << clock.step;
@@ -148,8 +148,8 @@ std::string FluidSolver::range_warning() {
     os << " the points' density left rho0 by more than " << 100 * kDensityDeviation << " % (rho/rho0 from " << lo << " to "
        << hi << ")" << (pressure ? " and" : "");
   if (pressure)
-    os << " the largest point pressure " << p_max_ << " exceeds " << kPressureFactor
-       << " times the scene's scale rho0 (|a| H + |v|max^2) = " << p_scale_;
+    os << " the largest point pressure " << lim_.p_max << " exceeds " << kPressureFactor
+       << " times the scene's scale rho0 (|a| H + |v|max^2) = " << lim_.p_scale;
   os << ": the weakly compressible fluid is outside its range. Remedies: a stiffer 'bulk' (" << opt.eos.K
      << ") with a smaller timestep or 'subcycle yes', or the incompressible default 'pressure projection' "
      << "(warned once per run)\n";
@@ -171,44 +171,44 @@ std::string FluidSolver::range_warning() {
 void FluidSolver::choose_every() {
   constexpr double kTauShare = 0.1;  // of the shortest drag response time
   const double cfl = opt.cfl, dx = opt.grid.dx;
-  auto_.limit = HUGE_VAL;
-  auto_.which = "none applies";
+  lim_.every.limit = HUGE_VAL;
+  lim_.every.which = "none applies";
   auto take = [&](double lim, const char *which) {
-    if (lim < auto_.limit) {
-      auto_.limit = lim;
-      auto_.which = which;
+    if (lim < lim_.every.limit) {
+      lim_.every.limit = lim;
+      lim_.every.which = which;
     }
   };
   if (opt.subcycle) {
-    take(dt_grain_, "the grains' pore-pressure wave (the fluid sub-cycled)");
+    take(lim_.dt_grain, "the grains' pore-pressure wave (the fluid sub-cycled)");
   } else {
-    take(dt_stable_, "the fluid's stable step");
-    take(dt_couple_, "the coupled pore-pressure wave");
-    if (auto_.accel > 0.0) take(cfl * std::sqrt(dx / auto_.accel), "the free-surface limit cfl sqrt(dx/|a|max)");
+    take(lim_.dt_stable, "the fluid's stable step");
+    take(lim_.dt_couple, "the coupled pore-pressure wave");
+    if (lim_.every.accel > 0.0) take(cfl * std::sqrt(dx / lim_.every.accel), "the free-surface limit cfl sqrt(dx/|a|max)");
   }
-  if (auto_.grain_speed > 0.0) take(cfl * dx / auto_.grain_speed, "the grains' advective limit cfl dx/|v_grain|max");
-  take(kTauShare * auto_.grain_tau, "the grains' drag response 0.1 min(m/K)");
-  if (auto_.wall_speed > 0.0) take(cfl * dx / auto_.wall_speed, "the mesh walls' advective limit cfl dx/|w|max");
-  const double nmax = std::floor(auto_.limit / clock.dt);  // inf or NaN: none of the limits applies
+  if (lim_.every.grain_speed > 0.0) take(cfl * dx / lim_.every.grain_speed, "the grains' advective limit cfl dx/|v_grain|max");
+  take(kTauShare * lim_.every.grain_tau, "the grains' drag response 0.1 min(m/K)");
+  if (lim_.every.wall_speed > 0.0) take(cfl * dx / lim_.every.wall_speed, "the mesh walls' advective limit cfl dx/|w|max");
+  const double nmax = std::floor(lim_.every.limit / clock.dt);  // inf or NaN: none of the limits applies
   opt.fluid_every = nmax >= kMaxEvery || std::isnan(nmax) ? kMaxEvery : nmax < 1.0 ? 1 : static_cast<int>(nmax);
 }
 
 std::string FluidSolver::every_auto_limit() const {
   std::ostringstream os;
   os.precision(6);
-  os << "limit: " << auto_.which;
-  if (std::isfinite(auto_.limit)) os << " = " << auto_.limit;
+  os << "limit: " << lim_.every.which;
+  if (std::isfinite(lim_.every.limit)) os << " = " << lim_.every.limit;
   return os.str();
 }
 
 std::string FluidSolver::check_timestep(bool at_setup) {
-  if (at_setup) range_warned_ = false;
-  dt_stable_ = stable_dt();
-  if (opt.every_auto && !std::isnan(dt_stable_)) choose_every();
+  if (at_setup) lim_.range_warned = false;
+  lim_.dt_stable = stable_dt();
+  if (opt.every_auto && !std::isnan(lim_.dt_stable)) choose_every();
   const int every = opt.fluid_every;
   const double dt = every * clock.dt, cfl = opt.cfl, dx = opt.grid.dx;
-  // (projection at rest without viscosity: no limit at all, dt_stable_ = inf)
-  if (std::isnan(dt_stable_) || (!opt.projection && std::isinf(dt_stable_)) || dt_stable_ <= 0.0 || std::isnan(dt_couple_) || std::isnan(dt_grain_))
+  // (projection at rest without viscosity: no limit at all, lim_.dt_stable = inf)
+  if (std::isnan(lim_.dt_stable) || (!pressure_->incompressible() && std::isinf(lim_.dt_stable)) || lim_.dt_stable <= 0.0 || std::isnan(lim_.dt_couple) || std::isnan(lim_.dt_grain))
     throw Error("Fix mpm/fluid: the fluid state is not finite (NaN velocity or density); "
                 "the run was unstable before this check");
   const char *what = every > 1 ? "fluid step (every x timestep) " : "timestep ";
@@ -219,26 +219,26 @@ std::string FluidSolver::check_timestep(bool at_setup) {
     os.precision(6);
     os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << limit << " of the "
        << whose << " (" << wave << ": cfl*dx/(" << csym << "+|v|max) with cfl = " << cfl << ", dx = " << dx
-       << ", " << csym << " = " << cformula << " = " << cval << ", fluid sound speed c_f = " << c_max_
-       << ", lowest fluid fraction theta = " << couple_theta_min_ << ", lightest moving grain rho_p = "
-       << couple_rho_grain_ << "); " << before << "reduce the timestep to " << limit / every << after
+       << ", " << csym << " = " << cformula << " = " << cval << ", fluid sound speed c_f = " << lim_.c_max
+       << ", lowest fluid fraction theta = " << lim_.couple_theta_min << ", lightest moving grain rho_p = "
+       << lim_.couple_rho_grain << "); " << before << "reduce the timestep to " << limit / every << after
        << " (docs/theory/coupled_stability.md)" << (at_setup ? "" : " (limit reached during the run)");
     throw Error(os.str());
   };
   // the grains' wave: sub-cycling the fluid does not help, the grains move once per step
-  if (opt.subcycle && dt > dt_grain_)
-    coupled_error(dt_grain_, "grains coupled with the fluid", "pore-pressure wave of the grains with the fluid sub-cycled",
-                  "c_g", "c_f*sqrt(rho_f*(1-theta)/(theta*rho_p))", c_grain_,
+  if (opt.subcycle && dt > lim_.dt_grain)
+    coupled_error(lim_.dt_grain, "grains coupled with the fluid", "pore-pressure wave of the grains with the fluid sub-cycled",
+                  "c_g", "c_f*sqrt(rho_f*(1-theta)/(theta*rho_p))", lim_.c_grain,
                   "the grains move once per timestep, so 'subcycle yes' cannot help: ", "");
   // without sub-cycling, fluid and grains together: the coupled wave
-  if (!opt.subcycle && dt > dt_couple_)
-    coupled_error(dt_couple_, "fluid coupled with the grains", "pore-pressure wave of fluid and grains", "c",
-                  "c_f*sqrt(1 + rho_f*(1-theta)/(theta*rho_p))", c_couple_, "", " or use keyword 'subcycle yes'");
+  if (!opt.subcycle && dt > lim_.dt_couple)
+    coupled_error(lim_.dt_couple, "fluid coupled with the grains", "pore-pressure wave of fluid and grains", "c",
+                  "c_f*sqrt(1 + rho_f*(1-theta)/(theta*rho_p))", lim_.c_couple, "", " or use keyword 'subcycle yes'");
   // the fluid (sub-)step: its own limit and, so that a step that is not sub-cycled also
   // satisfies it, the coupled one
-  const double dt_sub = std::min(dt_stable_, dt_couple_);
+  const double dt_sub = std::min(lim_.dt_stable, lim_.dt_couple);
   std::string log = range_warning();
-  if (opt.projection && (dt > dt_sub ? !opt.subcycle : at_setup)) return projection_limit(dt, dt_sub, what, at_setup);
+  if (pressure_->incompressible() && (dt > dt_sub ? !opt.subcycle : at_setup)) return projection_limit(dt, dt_sub, what, at_setup);
   if (dt <= dt_sub) {
     state.nsub = 1;
     return log;
@@ -248,14 +248,14 @@ std::string FluidSolver::check_timestep(bool at_setup) {
     const double dt_visc = viscous_dt_limit(dx, opt.eos.rho0, opt.viscosity, opt.dimension);
     std::ostringstream os;
     os.precision(6);
-    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << dt_stable_;
-    if (dt_visc <= dt_stable_)
+    os << "Fix mpm/fluid: " << what << dt << " exceeds the largest stable time step " << lim_.dt_stable;
+    if (dt_visc <= lim_.dt_stable)
       os << " (viscous limit dx^2 rho/(2 dim eta) with dx = " << dx << ", rho = " << opt.eos.rho0
          << ", keyword 'viscosity' eta = " << opt.viscosity << ")";
     else
-      os << " (acoustic limit cfl*dx/(c+|v|max) with cfl = " << cfl << ", dx = " << dx << ", c = " << c_max_
+      os << " (acoustic limit cfl*dx/(c+|v|max) with cfl = " << cfl << ", dx = " << dx << ", c = " << lim_.c_max
          << " from keyword 'bulk' " << opt.eos.K << " and 'density' " << opt.eos.rho0 << ")";
-    os << "; reduce the timestep to " << dt_stable_ / every
+    os << "; reduce the timestep to " << lim_.dt_stable / every
        << " or use keyword 'subcycle yes'" << (at_setup ? "" : " (limit reached during the run)");
     throw Error(os.str());
   }
@@ -285,11 +285,11 @@ std::string FluidSolver::projection_limit(double dt, double dt_sub, const char *
   const int every = opt.fluid_every;
   const double cfl = opt.cfl, dx = opt.grid.dx;
   // the limit applied: advective cfl*dx/|v|max or viscous dx^2 rho/(2 dim eta)
-  const double dt_adv = acoustic_dt_limit(cfl, dx, 0.0, vmax_);
+  const double dt_adv = acoustic_dt_limit(cfl, dx, 0.0, lim_.vmax);
   const double dt_visc = viscous_dt_limit(dx, opt.rho0, opt.viscosity, opt.dimension);
   std::ostringstream os;
   os.precision(4);
-  os << "advective limit cfl*dx/|v|max = " << dt_adv << " (cfl = " << cfl << ", dx = " << dx << ", |v|max = " << vmax_
+  os << "advective limit cfl*dx/|v|max = " << dt_adv << " (cfl = " << cfl << ", dx = " << dx << ", |v|max = " << lim_.vmax
      << "), viscous limit dx^2 rho/(2 dim eta) = " << dt_visc << "; "
      << (dt_adv <= dt_visc ? "advective" : "viscous") << " limit applies";
   // six significant digits (std::to_string printed 0.000000 for a step below 1e-6)

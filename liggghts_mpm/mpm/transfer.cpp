@@ -10,30 +10,33 @@
 namespace mpm {
 
 /* particles to grid: mass (8-19), momentum (8-10), internal force (8-24),
-   external forces (gravity (8-18) and whatever the host's fixes add), wall traction (8-23) */
-void FluidSolver::particles_to_grid() {
+   external forces (gravity (8-18) and whatever the host's fixes add), wall traction (8-23); the
+   pressure model's (EOS: the points' pressure in the internal force and the traction) */
+void FluidSolver::particles_to_grid() { pressure_->particles_to_grid(*this); }
+
+void FluidSolver::p2g(bool eos) {
   clear_nodes(g_.p2g, P2gRec::N);
   // the boundary term of each point right after its own share, so that every node sums its
   // contributions in point order
   // (projection: the walls' reaction is the solve's pressure, not a traction of the points)
-  const bool traction = opt.shape == ShapeKind::QuadraticBSpline && !opt.projection;
+  const bool traction = opt.shape == ShapeKind::QuadraticBSpline && eos;
   double *const g = g_.p2g.data();
   auto boundary_term = [&](int i, const Stencil &ps) {
     if (traction) bc.add_traction(ps, pts.x[i], pts.state[i][C_VOL], pts.state[i][C_P], g);
   };
-  with_policy(opt, [&](auto pol) { p2g_kernel<decltype(pol)::NS, decltype(pol)>(boundary_term); });
+  with_policy(opt, [&](auto pol) { p2g_kernel<decltype(pol)::NS, decltype(pol)>(boundary_term, eos); });
   grid_.reverse_sum(g_.p2g.data(), P2gRec::N);
 }
 
 template <int NS, class P, class Fn>
-void FluidSolver::p2g_kernel(Fn &&after_point) {
+void FluidSolver::p2g_kernel(Fn &&after_point, bool eos) {
   double **x = pts.x, **v = pts.v, **f = pts.f;
   const double *rmass = pts.rmass;
   double *const g = g_.p2g.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  const bool eos_p = !opt.projection;  // projection: no pressure in the internal force (u*)
-  for (const int i : plist_) {
-    const Stencil &ps = shapes_[i];
+  const bool eos_p = eos;  // projection: no pressure in the internal force (u*)
+  for (const int i : pw_.plist) {
+    const Stencil &ps = pw_.shapes[i];
     const double *s = pts.state[i];
     const double m = rmass[i], V = s[C_VOL], p = eos_p ? s[C_P] : 0.0;
     const double *t = s + C_TAU;
@@ -77,9 +80,9 @@ void FluidSolver::g2p_kernel() {
   const double dinv = apic_dinv_bspline2() / (opt.grid.dx * opt.grid.dx);
   const bool flip = opt.transfer == Transfer::Flip;
   const double alpha = opt.flip_alpha;
-  if (P::need_L) grad_in_state_ = false;  // velgrad_ holds this transfer's gradient
-  for (const int i : plist_) {
-    const Stencil &ps = shapes_[i];
+  if (P::need_L) pw_.grad_in_state = false;  // pw_.velgrad holds this transfer's gradient
+  for (const int i : pw_.plist) {
+    const Stencil &ps = pw_.shapes[i];
     double *s = pts.state[i];
     // 4-wide accumulators of the velocity record; L and B by columns: Lc[e][d] = sum v_d dS/dx_e
     Row4 vp = {0, 0, 0, 0}, dv = {0, 0, 0, 0};
@@ -108,7 +111,7 @@ void FluidSolver::g2p_kernel() {
         L[3 * d + e] = Lc[e][d];
         B[3 * d + e] = Bc[e][d];
       }
-    for (int d = 0; d < 3; ++d) vpic_[3 * i + d] = vp[d];
+    for (int d = 0; d < 3; ++d) pw_.vpic[3 * i + d] = vp[d];
     if (flip) {
       for (int d = 0; d < 3; ++d) v[i][d] = alpha * (v[i][d] + dv[d]) + (1.0 - alpha) * vp[d];
     } else {
@@ -128,7 +131,7 @@ void FluidSolver::g2p_kernel() {
       throw LocalError(os.str());
     }
     // velocity gradient for the stress update (USL; MUSL recomputes it)
-    if (P::need_L) std::copy(L, L + 9, &velgrad_[9 * static_cast<std::size_t>(i)]);
+    if (P::need_L) std::copy(L, L + 9, &pw_.velgrad[9 * static_cast<std::size_t>(i)]);
   }
 }
 
@@ -164,8 +167,8 @@ void FluidSolver::musl_scatter() {
   const double *rmass = pts.rmass;
   double *const ga = g_.aux.data();
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
-  for (const int i : plist_) {
-    const Stencil &ps = shapes_[i];
+  for (const int i : pw_.plist) {
+    const Stencil &ps = pw_.shapes[i];
     const double *s = pts.state[i];
     const double m = rmass[i];
     const Row4 mv = {m * v[i][0], m * v[i][1], m * v[i][2], 0.0};
@@ -192,13 +195,13 @@ void FluidSolver::musl_gradient() {
   const bool store_affine = opt.transfer != Transfer::Apic;
   // anti-locking (eos): the cell sums of the stress update (update_stress) are taken here, in the
   // same point order, while the point's record is at hand (one pass over the points less)
-  const bool cells = !opt.projection;
+  const bool cells = !pressure_->incompressible();
   if (cells) {
-    if (pcell_.size() < static_cast<std::size_t>(pts.nlocal)) pcell_.resize(pts.nlocal);
+    if (pw_.pcell.size() < static_cast<std::size_t>(pts.nlocal)) pw_.pcell.resize(pts.nlocal);
     clear_nodes(g_.cell, CellRec::N);
   }
-  for (const int i : plist_) {
-    const Stencil &ps = shapes_[i];
+  for (const int i : pw_.plist) {
+    const Stencil &ps = pw_.shapes[i];
     Row4 Lc[3] = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}};  // Lc[e][d] = sum v_d dS/dx_e
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double, double gx, double gy, double gz) {
       const Row4 u = row4(ga + AuxRec::N * n + AuxRec::U);
@@ -212,11 +215,11 @@ void FluidSolver::musl_gradient() {
     if (store_affine)
       std::copy(L, L + 9, pts.state[i] + C_AFF);
     else
-      std::copy(L, L + 9, &velgrad_[9 * static_cast<std::size_t>(i)]);
+      std::copy(L, L + 9, &pw_.velgrad[9 * static_cast<std::size_t>(i)]);
     if (cells) sum_cell(i, L);
   }
-  cells_summed_ = cells;
-  grad_in_state_ = store_affine;
+  pw_.cells_summed = cells;
+  pw_.grad_in_state = store_affine;
 }
 
 }  // namespace mpm

@@ -30,7 +30,7 @@
 namespace mpm {
 
 namespace {
-// columns of wmp_, per node i, sums over the points p with weights S_ip, d = x_p - x_i: mass m,
+// columns of io_.wmp, per node i, sums over the points p with weights S_ip, d = x_p - x_i: mass m,
 // m p, momentum m v (3), m d (3), m p d (3), m d d^T (xx yy zz yz xz xy)
 enum { W_M = 0, W_MP = 1, W_MV = 2, W_MD = 5, W_MPD = 8, W_MDD = 11, kW = 17 };
 double fill_depth(ShapeKind k, double f);
@@ -63,18 +63,18 @@ double fill_depth(ShapeKind k, double f) {
 
 void FluidSolver::node_mass_pressure() {
   const std::size_t nodes = g_.p2g.size() / P2gRec::N;
-  wmp_.assign(kW * nodes, 0.0);
+  io_.wmp.assign(kW * nodes, 0.0);
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   const GridSpec &gs = opt.grid;
-  const bool fit = !proj_;
+  const bool fit = !pressure_->solve();
   with_stencil(opt.shape, [&](auto ns) {
-    for (const int i : plist_) {
+    for (const int i : pw_.plist) {
       const double m = pts.rmass[i], pp = pts.state[i][C_P], mp = m * pp;
       const double *v = pts.v[i], *x = pts.x[i];
-      const Stencil &st = shapes_[i];
+      const Stencil &st = pw_.shapes[i];
       for_stencil<decltype(ns)::value>(st, sy, sz, [&](std::size_t n, int a, int b, int c, double w, double, double,
                                                        double) {
-        double *r = &wmp_[kW * n];
+        double *r = &io_.wmp[kW * n];
         r[W_M] += w * m;
         r[W_MP] += w * mp;
         for (int d = 0; d < 3; ++d) r[W_MV + d] += w * m * v[d];
@@ -95,8 +95,8 @@ void FluidSolver::node_mass_pressure() {
       });
     }
   });
-  grid_.reverse_sum(wmp_.data(), kW);
-  grid_.forward(wmp_.data(), kW);
+  grid_.reverse_sum(io_.wmp.data(), kW);
+  grid_.forward(io_.wmp.data(), kW);
 }
 
 // The pressure at x (false: no fluid there, or x outside the grid); mass: sum S M at x; vel
@@ -110,14 +110,14 @@ bool FluidSolver::pressure_at(const double *x, double &p, double *vel) {
   }
   Stencil s;
   if (!shape_of(x, s)) return false;
-  const std::vector<double> *pn = proj_ ? &proj_->pressure() : nullptr;
+  const std::vector<double> *pn = pressure_->solve() ? &pressure_->solve()->pressure() : nullptr;
   // moments about x: M0, sum m p, momentum; eos also M1 = sum m (y - x), Mp1, M2
   double m = 0.0, q = 0.0, pp = 0.0, mv[3] = {0.0, 0.0, 0.0};
   double M1[3] = {0.0, 0.0, 0.0}, P1[3] = {0.0, 0.0, 0.0}, M2[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
   with_stencil(opt.shape, [&](auto ns) {
     for_stencil<decltype(ns)::value>(s, grid_.stride_y(), grid_.stride_z(), [&](std::size_t n, int a, int b, int c,
                                                                                 double w, double, double, double) {
-      const double *r = &wmp_[kW * n];
+      const double *r = &io_.wmp[kW * n];
       m += w * r[W_M];
       q += w * r[W_MP];
       for (int d = 0; d < 3; ++d) mv[d] += w * r[W_MV + d];
@@ -142,8 +142,8 @@ bool FluidSolver::pressure_at(const double *x, double &p, double *vel) {
   if (vel)
     for (int d = 0; d < 3; ++d) vel[d] = mv[d] / m;
   if (pn) {
-    p = pp - p_surface_;
-    // projection: above the surface level the field less p_surface_ turns negative (the solve's
+    p = pp - io_.p_surface;
+    // projection: above the surface level the field less io_.p_surface turns negative (the solve's
     // zero lies higher); where the fluid is thinner than half a full cell that is no suction but air
     if (p < 0.0 && m < 0.5 * opt.rho0 * gs.dx * gs.dx * gs.dx) p = 0.0;
     return true;
@@ -188,11 +188,11 @@ bool FluidSolver::owns_sample(const double *x) const {
 
 /* The probes' sums of this sub-step with weight h: a point probe, the pressure at its point (on
    the rank that owns the point, where fluid is); a box probe, the nodal pressure of every owned
-   node inside the box that holds fluid (each node counts once). probe_sum_[2 j] += h sum p,
-   probe_sum_[2 j + 1] += h (number of values). */
+   node inside the box that holds fluid (each node counts once). io_.probe_sum[2 j] += h sum p,
+   io_.probe_sum[2 j + 1] += h (number of values). */
 void FluidSolver::probe_sums(double h) {
   const GridSpec &gs = opt.grid;
-  const std::vector<double> *pn = proj_ ? &proj_->pressure() : nullptr;
+  const std::vector<double> *pn = pressure_->solve() ? &pressure_->solve()->pressure() : nullptr;
   const double mmin = mass_min();
   for (std::size_t j = 0; j < opt.probes.size(); ++j) {
     const Probe &pr = opt.probes[j];
@@ -214,14 +214,14 @@ void FluidSolver::probe_sums(double h) {
         for (int jj = lo[1]; jj <= hi[1]; ++jj)
           for (int i = lo[0]; i <= hi[0]; ++i) {
             const std::size_t n = grid_.index(i, jj, k);
-            const double m = wmp_[kW * n + W_M];
+            const double m = io_.wmp[kW * n + W_M];
             if (!(m > mmin) || m <= 0.0) continue;
-            sp += pn ? (*pn)[n] - p_surface_ : wmp_[kW * n + W_MP] / m;
+            sp += pn ? (*pn)[n] - io_.p_surface : io_.wmp[kW * n + W_MP] / m;
             cnt += 1.0;
           }
     }
-    probe_sum_[2 * j] += h * sp;
-    probe_sum_[2 * j + 1] += h * cnt;
+    io_.probe_sum[2 * j] += h * sp;
+    io_.probe_sum[2 * j + 1] += h * cnt;
   }
 }
 
@@ -234,20 +234,20 @@ void FluidSolver::probe_sums(double h) {
    fastest (largest component of -grad p, central differences) has less, the level follows from
    the fill of the one of the two nodes whose fill is nearer 1/2 (fill_depth: the fill of a node
    below a plane surface), and the pressure there linearly between the two nodes. The mean over these
-   nodes (all ranks) is p_surface_, taken off every sample of the walls and probes. Nodes within
+   nodes (all ranks) is io_.p_surface, taken off every sample of the walls and probes. Nodes within
    two cells of a mesh wall, and pairs that reach the padding, take no part (there the nodal mass
    lacks what lies behind the wall). */
 void FluidSolver::surface_pressure() {
-  p_surface_ = 0.0;
-  if (!proj_) return;
+  io_.p_surface = 0.0;
+  if (!pressure_->solve()) return;
   const GridSpec &gs = opt.grid;
-  const std::vector<double> &p = proj_->pressure();
+  const std::vector<double> &p = pressure_->solve()->pressure();
   const double full = opt.rho0 * gs.dx * gs.dx * gs.dx, half = 0.5 * full;
   const WallGeometry *wg = bc.walls();
   const std::size_t st[3] = {1, grid_.stride_y(), grid_.stride_z()};
   double loc[2] = {0.0, 0.0}, glob[2];
   grid_.for_owned_all([&](int i, int j, int k, std::size_t n) {
-    const double ma = wmp_[kW * n + W_M];
+    const double ma = io_.wmp[kW * n + W_M];
     if (ma < half) return;
     const int c[3] = {i, j, k};
     double g[3];
@@ -260,7 +260,7 @@ void FluidSolver::surface_pressure() {
       if (std::fabs(g[d]) > std::fabs(g[dd])) dd = d;
     if (g[dd] == 0.0) return;
     const std::size_t nb = g[dd] < 0.0 ? n + st[dd] : n - st[dd];
-    const double mb = wmp_[kW * nb + W_M];
+    const double mb = io_.wmp[kW * nb + W_M];
     if (mb >= half) return;
     if (wg && wg->walls() > 0) {
       double x[3], dist;
@@ -276,28 +276,28 @@ void FluidSolver::surface_pressure() {
     loc[1] += 1.0;
   });
   MPI_Allreduce(loc, glob, 2, MPI_DOUBLE, MPI_SUM, comm_);
-  p_surface_ = glob[1] > 0.0 ? glob[0] / glob[1] : 0.0;
+  io_.p_surface = glob[1] > 0.0 ? glob[0] / glob[1] : 0.0;
 }
 
 /* pressure projection: the pressure correction's momentum of this sub-step as nodal terms
-   (Projection::load_coefficients), b_n = (p_n - p_surface_) c_n + r_n (the shift by a constant
+   (Projection::load_coefficients), b_n = (p_n - io_.p_surface) c_n + r_n (the shift by a constant
    changes no sum: the c_n sum to 0), each direction d of each node's to the boundary that its grid
    line along d meets first (Boundaries::line_wall; a node behind a mesh casts from its mirror
    image in front): a mesh wall takes it, a grid face takes none. */
 void FluidSolver::wall_pressure_loads() {
-  const std::vector<double> &c = proj_->load_coefficients(), &r = proj_->load_rest();
+  const std::vector<double> &c = pressure_->solve()->load_coefficients(), &r = pressure_->solve()->load_rest();
   if (c.empty()) return;
-  const double ps = opt.pressure_acceleration ? 0.0 : p_surface_;
+  const double ps = opt.pressure_acceleration ? 0.0 : io_.p_surface;
   const GridSpec &gs = opt.grid;
   grid_.for_owned_all([&](int i, int j, int k, std::size_t n) {
-    const double p = proj_->load_pressure(n) - ps;
+    const double p = pressure_->solve()->load_pressure(n) - ps;
     double b[3];
     for (int d = 0; d < 3; ++d) b[d] = p * c[3 * n + d] + r[3 * n + d];
     if (b[0] == 0.0 && b[1] == 0.0 && b[2] == 0.0) return;
     const double x[3] = {gs.origin[0] + i * gs.dx, gs.origin[1] + j * gs.dx, gs.origin[2] + k * gs.dx};
     // a node behind a mesh: its lines are those of its mirror image in front of the wall
     double y[3] = {x[0], x[1], x[2]};
-    if (proj_->load_behind(i, j, k, n)) {
+    if (pressure_->solve()->load_behind(i, j, k, n)) {
       double nrm[3], dist = 0.0;
       if (bc.node_normal(i, j, k, nrm) && bc.walls()->nearest_wall(x, 3.0 * gs.dx, &dist) >= 0)
         for (int e = 0; e < 3; ++e) y[e] = x[e] + 2.0 * dist * nrm[e];
@@ -314,30 +314,30 @@ void FluidSolver::wall_pressure_loads() {
 }
 
 void FluidSolver::sample_pressure(double h) {
-  if (probe_sum_.size() != 2 * opt.probes.size()) {
-    probe_sum_.assign(2 * opt.probes.size(), 0.0);
-    probe_mean_.assign(opt.probes.size(), 0.0);
-    probe_time_ = 0.0;
+  if (io_.probe_sum.size() != 2 * opt.probes.size()) {
+    io_.probe_sum.assign(2 * opt.probes.size(), 0.0);
+    io_.probe_mean.assign(opt.probes.size(), 0.0);
+    io_.probe_time = 0.0;
   }
-  const bool pressure_loads = bc.recording() && proj_;
+  const bool pressure_loads = bc.recording() && pressure_->solve();
   if (pressure_loads || !opt.probes.empty()) {
     node_mass_pressure();
     surface_pressure();
   }
   if (pressure_loads) wall_pressure_loads();
   if (!opt.probes.empty()) probe_sums(h);
-  wall_time_ += h;
-  probe_time_ += h;
+  io_.wall_time += h;
+  io_.probe_time += h;
 }
 
 // Start of a fluid step: the walls' sums restart (their output is the mean over this step).
 void FluidSolver::begin_samples() {
-  std::fill(wall_sum_.begin(), wall_sum_.end(), 0.0);
-  wall_time_ = 0.0;
-  if (probe_sum_.size() != 2 * opt.probes.size()) {
-    probe_sum_.assign(2 * opt.probes.size(), 0.0);
-    probe_mean_.assign(opt.probes.size(), 0.0);
-    probe_time_ = 0.0;
+  std::fill(io_.wall_sum.begin(), io_.wall_sum.end(), 0.0);
+  io_.wall_time = 0.0;
+  if (io_.probe_sum.size() != 2 * opt.probes.size()) {
+    io_.probe_sum.assign(2 * opt.probes.size(), 0.0);
+    io_.probe_mean.assign(opt.probes.size(), 0.0);
+    io_.probe_time = 0.0;
   }
 }
 
@@ -345,29 +345,29 @@ void FluidSolver::begin_samples() {
 // the probes' means when their window is complete (every fluid step with probe_window 0).
 void FluidSolver::end_samples() {
   const int nw = bc.walls() ? bc.walls()->walls() : 0;
-  if (static_cast<int>(wall_sum_.size()) != 6 * nw) wall_sum_.assign(6 * static_cast<std::size_t>(nw), 0.0);
+  if (static_cast<int>(io_.wall_sum.size()) != 6 * nw) io_.wall_sum.assign(6 * static_cast<std::size_t>(nw), 0.0);
   // the walls' momentum given to the fluid over this step (Boundaries::record_loads): the fluid's
   // force on them is its opposite
   if (bc.recording()) {
-    std::vector<double> J(wall_sum_.size(), 0.0);
+    std::vector<double> J(io_.wall_sum.size(), 0.0);
     bc.take_loads(J);
-    for (std::size_t c = 0; c < wall_sum_.size(); ++c) wall_sum_[c] -= J[c];
+    for (std::size_t c = 0; c < io_.wall_sum.size(); ++c) io_.wall_sum[c] -= J[c];
   }
-  const bool window_done = !opt.probes.empty() && probe_time_ >= opt.probe_window * (1.0 - 1e-9);
-  std::vector<double> loc(wall_sum_);
-  if (window_done) loc.insert(loc.end(), probe_sum_.begin(), probe_sum_.end());
+  const bool window_done = !opt.probes.empty() && io_.probe_time >= opt.probe_window * (1.0 - 1e-9);
+  std::vector<double> loc(io_.wall_sum);
+  if (window_done) loc.insert(loc.end(), io_.probe_sum.begin(), io_.probe_sum.end());
   if (loc.empty()) return;
   std::vector<double> glob(loc.size());
   MPI_Allreduce(loc.data(), glob.data(), static_cast<int>(loc.size()), MPI_DOUBLE, MPI_SUM, comm_);
-  wall_mean_.assign(6 * static_cast<std::size_t>(nw), 0.0);
-  for (int c = 0; c < 6 * nw; ++c) wall_mean_[c] = wall_time_ > 0.0 ? glob[c] / wall_time_ : 0.0;
+  io_.wall_mean.assign(6 * static_cast<std::size_t>(nw), 0.0);
+  for (int c = 0; c < 6 * nw; ++c) io_.wall_mean[c] = io_.wall_time > 0.0 ? glob[c] / io_.wall_time : 0.0;
   if (window_done) {
     for (std::size_t j = 0; j < opt.probes.size(); ++j) {
       const double s = glob[6 * nw + 2 * j], w = glob[6 * nw + 2 * j + 1];
-      probe_mean_[j] = w > 0.0 ? s / w : 0.0;
+      io_.probe_mean[j] = w > 0.0 ? s / w : 0.0;
     }
-    std::fill(probe_sum_.begin(), probe_sum_.end(), 0.0);
-    probe_time_ = 0.0;
+    std::fill(io_.probe_sum.begin(), io_.probe_sum.end(), 0.0);
+    io_.probe_time = 0.0;
   }
 }
 
