@@ -283,7 +283,7 @@ class FluidSolver {
   bool sparse_ = false;
   bool grid_ready_ = false;
   IndexBox projection_work_box();
-  // the state of each axis (solver_axes.h, pressure_model.h)
+  // the state of each axis (solver_axes.h, pressure_model.h, coupling_model.h)
   PointWork pw_;                            // core: the points of this sub-step
   std::unique_ptr<PressureModel> pressure_; // pressure: eos or projection, chosen at construction
   std::unique_ptr<CouplingModel> coup_;    // coupling: none or grains, chosen at construction
