@@ -268,9 +268,9 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
   // out, a fluid at rest in hydrostatic balance looked to the exchange as if it fell freely over
   // the step: the drag then pulled a held bed down by about K g h / 2 per grain (Archimedes on a
   // held random bed 0.92 with h = 8.6 ms; proportional to h and to the viscosity).
-  const double *pgrad = pressure_->incompressible() && g_.gw.size() == 3 * grid_.size() ? g_.gw.data() : nullptr;
+  const double *pgrad = pressure_->reaction_in_solve() && g_.gw.size() == 3 * grid_.size() ? g_.gw.data() : nullptr;
   const double inv_rho = 1.0 / opt.eos.rho0;
-  const bool proj = pressure_->incompressible();
+  const bool proj = pressure_->reaction_in_solve();
   // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned
   // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
@@ -332,7 +332,7 @@ void FluidSolver::couple_kernel(double h) {
   // projection: the grains feel the nodal gradient of the last solve (grain_pressure); the fluid
   // gets no pressure reaction as a force: the projection takes it along the periodic directions
   // (the exact exchange, set_grain_reaction) and elsewhere its share -theta grad p is its correction
-  const bool proj = pressure_->incompressible();
+  const bool proj = pressure_->reaction_in_solve();
   const bool weak = opt.grad_p == GradP::Weak || proj;
   grain_pressure_inputs<NS>(proj, weak);
 

@@ -32,6 +32,13 @@ class PressureModel {
   // stress of the internal force, the walls take no traction of the points, the grid faces'
   // conditions and the grains' pressure reaction come with the solve (the kernels' switches)
   bool incompressible() const { return incompressible_; }
+  // what the coupling and the MUSL pass take from the model (constant for the model's life):
+  // the points' pressure is a stress of the internal force (eos: its anti-locking cell sums are
+  // taken in the MUSL pass, its grains' pressure reaction is a force on the fluid)
+  bool pressure_is_stress() const { return !incompressible_; }
+  // the grains' pressure reaction goes to the solve, and the fluid's acceleration held over the
+  // drag exchange includes the last solve's gradient (projection)
+  bool reaction_in_solve() const { return incompressible_; }
   // the density of a point pre-compressed to pressure p (hydrostatic set-up)
   virtual double density(const Eos &eos, double p) const = 0;
   // the sound speed over the points' density range (0: no sound waves, no acoustic limit)

@@ -195,7 +195,7 @@ void FluidSolver::musl_gradient() {
   const bool store_affine = opt.transfer != Transfer::Apic;
   // anti-locking (eos): the cell sums of the stress update (update_stress) are taken here, in the
   // same point order, while the point's record is at hand (one pass over the points less)
-  const bool cells = !pressure_->incompressible();
+  const bool cells = pressure_->pressure_is_stress();
   if (cells) {
     if (pw_.pcell.size() < static_cast<std::size_t>(pts.nlocal)) pw_.pcell.resize(pts.nlocal);
     clear_nodes(g_.cell, CellRec::N);
