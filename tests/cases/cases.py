@@ -32,6 +32,22 @@ units si
 """
 
 
+def water_box_script(lx, ly, lz, cell, dt):
+    """An input template of a box periodic along x and y ({zb}: its z boundary, f or p) filled with
+    water by fix f (2 x 2 x 2 points per cell of size cell), run for two steps of dt: {pre} the lines
+    before the fix, {args} the fix's further keywords, {post} the lines after the run (the
+    bad-input cases)."""
+    return PREAMBLE.replace("boundary f f f", "boundary p p {zb}") + f"""region box block 0 {lx:g} 0 {ly:g} 0 {lz:g} units box
+create_box 1 box
+neighbor {cell / 5:g} bin
+{{pre}}
+fix f all mpm/fluid cell {cell:g} density 1000 viscosity 1e-3 fill box 2 2 2 type 1 {{args}}
+timestep {dt:g}
+run 2
+{{post}}
+"""
+
+
 def check(cond, what):
     print(("ok    " if cond else "FAIL  ") + what)
     if not cond:

@@ -28,7 +28,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from cases import DATA, PREAMBLE, check, driver_main, read_csv  # noqa: E402
+from cases import DATA, check, driver_main, read_csv, water_box_script  # noqa: E402
 
 INP = os.path.join(DATA, "in.flow_drive")
 RHO, H = 1000.0, 0.25 * 2.0e-3 / 2.0  # the input's water and time step
@@ -105,16 +105,7 @@ def case_restart(r):
             check(rel < 1e-10, f"{pressure}: {k} of the resumed run = uninterrupted run (rel. diff {rel:.1e})")
 
 
-# the cases' preamble, periodic along x and y
-BAD = PREAMBLE.replace("boundary f f f", "boundary p p {zb}") + """region box block 0 0.008 0 0.008 0 0.008 units box
-create_box 1 box
-neighbor 0.0004 bin
-{pre}
-fix f all mpm/fluid cell 0.002 density 1000 viscosity 1e-3 fill box 2 2 2 type 1 {args}
-timestep 2.5e-4
-run 2
-{post}
-"""
+BAD = water_box_script(0.008, 0.008, 0.008, 0.002, 2.5e-4)
 
 
 def case_bad_input(r):

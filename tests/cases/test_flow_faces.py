@@ -28,7 +28,7 @@ import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from cases import DATA, PREAMBLE, check, driver_main, read_csv  # noqa: E402
+from cases import DATA, check, driver_main, read_csv, water_box_script  # noqa: E402
 
 INP = os.path.join(DATA, "in.flow_faces")
 RHO, CELL, G, DT = 1000.0, 0.01, 9.81, 5e-4  # the input's water, cell, gravity and time step
@@ -111,15 +111,7 @@ def case_restart(r):
     check(rel < 1e-10, "the resumed run = the uninterrupted run at every step")
 
 
-# the cases' preamble, periodic along x and y
-BAD = PREAMBLE.replace("boundary f f f", "boundary p p {zb}") + """region box block 0 0.04 0 0.04 0 0.08 units box
-create_box 1 box
-neighbor 0.002 bin
-fix f all mpm/fluid cell 0.01 density 1000 viscosity 1e-3 fill box 2 2 2 type 1 {args}
-timestep 5e-4
-run 2
-{post}
-"""
+BAD = water_box_script(0.04, 0.04, 0.08, 0.01, 5e-4)
 
 
 def case_bad_input(r):
@@ -148,16 +140,16 @@ def case_bad_input(r):
          ("fix_modify boundary cannot make face zhi an inflow or outflow face",)),
     ]
     for i, (zb, args, post, needles) in enumerate(cases):
-        r.expect_error(f"flow_faces/bad_input/{i}", BAD.format(zb=zb, args=args, post=post), needles,
+        r.expect_error(f"flow_faces/bad_input/{i}", BAD.format(zb=zb, pre="", args=args, post=post), needles,
                        f"'{args} {post}' refused")
     # the inflow's speed enters the step limit at the setup (before a step, not once the fluid moves)
-    p, msg = r.run_script("flow_faces/bad_input/fast", BAD.format(zb="f", args="boundary zlo inflow 20", post=""))
+    p, msg = r.run_script("flow_faces/bad_input/fast", BAD.format(zb="f", pre="", args="boundary zlo inflow 20", post=""))
     check(p.returncode != 0 and "|v|max = 20)" in msg and "reduce the timestep to 0.00025" in msg
           and "during the run" not in msg and "Loop time" not in p.stdout,
           f"an inflow of 20 m/s refused at the setup by the advective step limit (got: {msg.strip()[:160]})")
     # accepted: fix_modify of an inflow's velocity between runs
     p, msg = r.run_script("flow_faces/bad_input/ok", BAD.format(
-        zb="f", args="boundary zlo inflow 0.05 boundary zhi outflow",
+        zb="f", pre="", args="boundary zlo inflow 0.05 boundary zhi outflow",
         post="fix_modify f boundary zlo inflow 0.02\nrun 2"))
     check(p.returncode == 0, f"fix_modify of an inflow's velocity accepted ({msg.strip()[:120]})")
 
