@@ -110,6 +110,8 @@ struct Result {
   double vaporization_cut = 0;   // m3, recession cut to the melt available (conservative flow)
   double melt_balance = 0;       // (melted - vaporized - expelled - molten) / melted
   long flow_substeps_max = 0;    // most flux sub-steps in one step (conservative flow)
+  long heat_substeps_max = 0;    // most heat Courant sub-steps in one step (--melt-heat flux)
+  long heat_substeps_extra = 0;  // steps added by the heat Courant limit over the run
   double removal_rate = 0;
   double T_peak = 0, p_peak = 0, u_peak_max = 0, A_last = 0;
   double T_center = 0;     // K, centre surface temperature at the end

@@ -490,6 +490,8 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
                        {"vaporization_cut_m3", num(r.vaporization_cut)},
                        {"relative_residual", num(r.melt_balance)},
                        {"flow_substeps_max", r.flow_substeps_max}};
+  j["heat_courant_substeps_max"] = r.heat_substeps_max;
+  j["heat_courant_steps_added"] = r.heat_substeps_extra;
   j["u_peak_max_m_per_s"] = num(r.u_peak_max);
   j["A_last"] = num(r.A_last);
   j["xi_melt_edge"] = num(r.xi_melt_edge);
