@@ -13,6 +13,7 @@
 
 #include "laser_model.h"
 #include "laser_params.h"
+#include "laser_timestep.h"
 
 using namespace laser;
 
@@ -73,4 +74,37 @@ TEST(LaserCourant, Prandtl1420GridLadderConvergesWithoutLimiter) {
   EXPECT_GT(od, 0.7);
   EXPECT_GT(ov, 0.7);
   EXPECT_GT(os, 0.7);
+}
+
+// The automatic step at Pr = 1420 with the heat Courant limit (50 us, d(xi) 0.025): the b2
+// limiter never acts, no column takes more than its energy bound, the melt volume balance
+// closes, the step control accepts its three-level estimate (the only cause the run may name
+// is the grid estimate: d(xi) 0.025 against 0.05 is not converged at this Prandtl number), and
+// a run at a quarter of the reported step moves centre depth and removed volume by less than
+// the step's estimate.
+TEST(LaserCourant, Prandtl1420StaysWithinItsEstimate) {
+  Config c;
+  read_config_file(c, std::string(LASER_INPUTS_DIR) + "/prandtl142.toml");
+  c.mat.Pr = 1420;
+  c.heat_courant = 0.5;
+  c.tp = 50e-6;
+  c.dxi = 0.025;
+  c.quiet = true;
+  validate(c);
+  const Result r = TimeStepPolicy(c).run(c, nullptr);
+  ASSERT_TRUE(r.status == "ok" || r.status == "inaccurate") << r.status << ": " << r.message;
+  for (const auto& cause : r.causes) EXPECT_EQ(cause, "grid error estimate above --tol") << r.message;
+  EXPECT_EQ(r.b2_clamps, 0);
+  EXPECT_LT(r.check.worst_node_ratio, 1.0);
+  EXPECT_LT(std::fabs(r.melt_balance), 1e-6);
+  Config q = c;
+  q.dt = 0.25 * r.dt;
+  const Result rq = run_simulation(q);
+  const double dd = std::fabs(rq.depth_center / r.depth_center - 1.0);
+  const double dv = std::fabs(rq.volume_removed / r.volume_removed - 1.0);
+  std::printf("[ PR1420 ] automatic: %s, dt %.4g s, runs %d; at dt/4 depth %.3e (estimate %.3e), volume %.3e "
+              "(estimate %.3e); melt balance %.2e, column %.3f\n", r.status.c_str(), r.dt, r.step.runs, dd,
+              r.step.depth_error, dv, r.step.volume_error, r.melt_balance, r.check.worst_node_ratio);
+  EXPECT_LT(dd, r.step.depth_error);
+  EXPECT_LT(dv, r.step.volume_error);
 }
