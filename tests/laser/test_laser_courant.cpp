@@ -1,4 +1,4 @@
-// The heat Courant limit of the face heat fluxes (docs/theory/laser_model.md 2.9): at
+// The heat Courant limit of the face heat fluxes (--heat-courant 0.5, docs/theory/laser_model.md 2.11): at
 // Pr = 1420 (the shipped Pr = 142 config with a ten times larger Prandtl number, 200 us)
 // the b2 limiter of (4-25) does not act at any step of a dt ladder or any grid of a d(xi)
 // ladder, no column takes more than its energy bound, and centre depth, removed volume and
