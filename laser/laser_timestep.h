@@ -68,7 +68,8 @@ class TimeStepPolicy {
   void deliver_frames(const Config& cfg, Result& r, const SinkFactory& make_sink, long& steps) const;
   bool buffered(const Config& cfg, double dt) const;
   struct Estimate {
-    double dt = 0, companion = 0, ed = 0, ev = 0;  // reported step, coarse companion's step, relative depth/volume error estimates
+    // reported step, coarse companion's step, relative depth/volume error estimates
+    double dt = 0, companion = 0, ed = 0, ev = 0;
     int runs = 0;
     long steps = 0;
     bool stalled = false;
