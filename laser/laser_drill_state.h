@@ -40,6 +40,8 @@ inline Config absorbed(Config c) {
   return c;
 }
 constexpr long kMaxFlowSubsteps = 100000;
+// the most parts one step is split into by the heat Courant limit (Config::heat_courant)
+constexpr int kMaxHeatSubsteps = 1000;
 constexpr double kTcWarnFraction = 0.8;
 // rho (h_m V_melted + h_v V_vaporized) above this multiple of the beam energy is
 // not a solution at all (diverged); between 1 and this it is a failed check
@@ -84,6 +86,7 @@ class Drill {
   void physical_check();
   bool state_admissible(double tb);
   bool step(long step, double ta, double tb, double& tau);
+  int heat_substeps(double dtau) const;
   void finish(double tau);
   void assess();
   void note_content_hits();
@@ -110,6 +113,7 @@ class Drill {
   std::string first_clamp_;
   std::string first_b2_, first_bl_, first_content_;
   long flow_substeps_ = 0;
+  long heat_substeps_max_ = 0, heat_substeps_total_ = 0;
   std::vector<double> face_c_;  // conservative flow: face volume-rate coefficients c_k (rate c_k g_up^2)
   int first_c_ = 0;             // first node of the integral profiles
   int idx_x1_ = 0;

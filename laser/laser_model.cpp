@@ -119,6 +119,30 @@ bool Drill::state_admissible(double tb) {
   return true;
 }
 
+// Heat Courant number of the face heat fluxes: the share of a column's melt that the flow
+// sends out of it in one step, C = dtau sum|c_k| g / a (c_k: the last flow solve's face
+// rates, g: the column's thickness now). Beyond C = 1 the column's layer is asked to give
+// more heat than it holds and the limit of (4-25) acts; the step is split into the fewest
+// equal parts with C <= heat_courant (at most kMaxHeatSubsteps; 0: not split).
+int Drill::heat_substeps(double dtau) const {
+  if (!(cfg_.heat_courant > 0.0) || !cfg_.flux_heat() || face_c_.empty()) return 1;
+  const int N = static_cast<int>(nodes_.size());
+  const double R2 = cfg_.R * cfg_.R;
+  double rate = 0.0;  // max over columns of sum|c_k| g / a
+  for (int i = std::max(first_c_, 0); i < N; ++i) {
+    const Node& n = nodes_[i];
+    if (!n.molten || !(n.g > 0.0) || !(n.area > 0.0)) continue;
+    double out = 0.0;
+    for (int f : {i - 1, i}) {
+      if (f < first_c_ || f < 0 || f >= N) continue;
+      if ((face_c_[f] >= 0.0 ? f : f + 1) == i) out += std::fabs(face_c_[f]);
+    }
+    rate = std::max(rate, out * n.g * R2 / n.area);
+  }
+  const double parts = std::ceil(dtau * rate / cfg_.heat_courant - 1e-12);
+  return static_cast<int>(std::clamp(parts, 1.0, static_cast<double>(kMaxHeatSubsteps)));
+}
+
 // One time step [ta, tb]: the phases of the text in order (laser_model.h).
 // Returns false when the run stops (status and message set); tau is moved to
 // tb once the fronts have moved.
@@ -186,7 +210,15 @@ Result Drill::run() {
   for (long step_no = 0; step_no < nsteps; ++step_no) {
     const double ta = tau;
     const double tb = (step_no == nsteps - 1) ? tau_p : std::min(tau_p, (step_no + 1) * dtau_);
-    if (!step(step_no, ta, tb, tau)) break;
+    // the face heat fluxes of a column are advanced with the step's flow: keep each step's
+    // heat Courant number (docs/theory/laser_model.md 2.10) at most Config::heat_courant
+    const int m = heat_substeps(tb - ta);
+    heat_substeps_max_ = std::max<long>(heat_substeps_max_, m);
+    heat_substeps_total_ += m - 1;
+    bool going = true;
+    for (int k = 1; k <= m && going; ++k)
+      going = step(step_no, ta + (tb - ta) * (k - 1) / m, k == m ? tb : ta + (tb - ta) * k / m, tau);
+    if (!going) break;
     const bool frame = tb >= tau_p * next_frame / (nframes - 1) - 1e-12 * tau_p;
     if (frame) ++next_frame;
     if (frame || step_no % centre_every == 0 || step_no == nsteps - 1) record(tb, frame);
@@ -233,6 +265,8 @@ void Drill::finish(double tau) {
     res_.volume_molten += n.g * R * n.area;
   }
   res_.flow_substeps_max = flow_substeps_;
+  res_.heat_substeps_max = heat_substeps_max_;
+  res_.heat_substeps_extra = heat_substeps_total_;
   if (res_.volume_melted > 0.0)
     res_.melt_balance = (res_.volume_melted - res_.volume_vaporized - res_.volume_expelled - res_.volume_molten) /
                         res_.volume_melted;

@@ -81,7 +81,9 @@ struct PhysicalCheck {
 // How the time step was chosen and checked (laser_timestep.h).
 struct StepReport {
   bool automatic = false;
-  double companion_dt = 0;   // s, step of the run the estimate compares with
+  double companion_dt = 0;   // s, step of the coarse run of the three-level estimate (2 dt; dt/2 without one)
+  double fine_companion_dt = 0;  // s, step of its fine run (dt/2; dt/4 without a coarse one)
+  double depth_ratio = 0, volume_ratio = 0;  // ratio of successive differences of the three runs
   double depth_error = 0;    // relative, estimated error of the reported run
   double volume_error = 0;
   double grid_companion_dxi = 0;  // d(xi) of the grid companion run (0: none)
@@ -110,6 +112,8 @@ struct Result {
   double vaporization_cut = 0;   // m3, recession cut to the melt available (conservative flow)
   double melt_balance = 0;       // (melted - vaporized - expelled - molten) / melted
   long flow_substeps_max = 0;    // most flux sub-steps in one step (conservative flow)
+  long heat_substeps_max = 0;    // most heat Courant sub-steps in one step (--melt-heat flux)
+  long heat_substeps_extra = 0;  // steps added by the heat Courant limit over the run
   double removal_rate = 0;
   double T_peak = 0, p_peak = 0, u_peak_max = 0, A_last = 0;
   double T_center = 0;     // K, centre surface temperature at the end

@@ -466,6 +466,9 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
   j["time_step"] = {{"dt_s", num(r.dt)},
                     {"automatic", r.step.automatic},
                     {"companion_dt_s", num(r.step.companion_dt)},
+                    {"fine_companion_dt_s", num(r.step.fine_companion_dt)},
+                    {"depth_difference_ratio", num(r.step.depth_ratio)},
+                    {"volume_difference_ratio", num(r.step.volume_ratio)},
                     {"depth_error_estimate", num(r.step.depth_error)},
                     {"volume_error_estimate", num(r.step.volume_error)},
                     {"grid_companion_dxi", num(r.step.grid_companion_dxi)},
@@ -490,6 +493,8 @@ std::string summary_json(const Config& cfg, const Result& r, double wall) {
                        {"vaporization_cut_m3", num(r.vaporization_cut)},
                        {"relative_residual", num(r.melt_balance)},
                        {"flow_substeps_max", r.flow_substeps_max}};
+  j["heat_courant_substeps_max"] = r.heat_substeps_max;
+  j["heat_courant_steps_added"] = r.heat_substeps_extra;
   j["u_peak_max_m_per_s"] = num(r.u_peak_max);
   j["A_last"] = num(r.A_last);
   j["xi_melt_edge"] = num(r.xi_melt_edge);

@@ -360,6 +360,10 @@ void add_numerics_params(std::vector<Param>& t) {
                    &Config::dtau));
   t.push_back(real("tol", "numerics", "-", 1e-6, 0.5, false,
                    "relative depth/volume error allowed by the step-doubling estimate", &Config::tol));
+  t.push_back(real("heat-courant", "numerics", "-", 0, 10, false,
+                   "heat Courant number C = dtau sum|c_k| g / a of the face heat fluxes (--melt-heat flux) kept in "
+                   "each step by splitting it into the fewest equal sub-steps with C <= this (at most 1000); 0: "
+                   "no splitting (beyond C = 1 the b2 limit of (4-25) acts)", &Config::heat_courant));
   // [output]
   {
     Param p{"frames", "output", Kind::Int, "-", 2, 1e5, false, {}, "number of profile frames in profiles.h5 "

@@ -90,6 +90,9 @@ struct Config {
   double dt = 0.0;         // s; 0: chosen by the time-step policy (laser_timestep.h)
   double dtau = 0.0;       // nondimensional; overrides dt when > 0
   double tol = 1e-3;       // relative depth/volume error the time-step policy aims at
+  // heat Courant number kept per step by --melt-heat flux by splitting the step
+  // (docs/theory/laser_model.md 2.10); 0: no splitting
+  double heat_courant = 0.0;
   int frames = 200;        // HDF5 frames
   std::string out = "laser_out";
   bool overwrite = false;

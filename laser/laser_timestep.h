@@ -39,21 +39,50 @@ class TimeStepPolicy {
   // about 15-20 minutes of CPU at the 4e5 node steps per second measured for
   // Table 5.1; a case that needs more is refused before anything is computed.
   static constexpr double kMaxNodeSteps = 4e8;
+  // At most this many halvings of an automatic step for a safeguard alone (error within --tol).
+  static constexpr int kSafeguardHalvings = 3;
+  // The three-level estimate is accepted where successive differences keep their sign and
+  // contract by at most this ratio (observed order 1/2), or where both are below
+  // kNoiseFraction of --tol; a run whose steps the heat Courant limit split in more than
+  // kMaxSubstepShare of them is refined as a safeguarded one is.
+  static constexpr double kMaxRatio = 0.7071067811865476;
+  static constexpr double kNoiseFraction = 0.1;
+  static constexpr double kMaxSubstepShare = 0.1;
+  // Frames of a candidate run are kept in memory up to this size (fields per node and frame).
+  static constexpr double kMaxFrameBytes = 256.0 * 1024 * 1024;
+  static constexpr double kFrameFields = 11;
 
  private:
+  struct Level3 {
+    double est = 0, moves = 0, ratio = 0;
+    bool asymptotic = true;
+    bool accepted(double tol) const;
+  };
+  struct Levels {
+    Result coarse, mid, fine, finest;
+    bool has_coarse = false;
+  };
+  static Level3 three_level(double Dc, double Dm, double Df);
+  static void estimate(const Levels& L, Level3& qd, Level3& qv);
+  bool first_levels(const Config& cfg, Levels& L, long& steps, int& runs, const SinkFactory& make_sink) const;
+  void deliver_frames(const Config& cfg, Result& r, const SinkFactory& make_sink, long& steps) const;
+  bool buffered(const Config& cfg, double dt) const;
   struct Estimate {
-    double dt, companion, ed, ev;  // reported step, companion step, relative depth/volume error estimates
-    int runs;
-    long steps;
-    bool stalled;
+    // reported step, coarse companion's step, relative depth/volume error estimates
+    double dt = 0, companion = 0, ed = 0, ev = 0;
+    int runs = 0;
+    long steps = 0;
+    bool stalled = false;
     std::string history;
     double grid_dxi = 0, grid_dt = 0, grid_ed = 0, grid_ev = 0;  // grid companion's d(xi), step, error estimates
+    double fine_companion = 0;
+    Level3 depth, volume;  // grid companion at the reported step (not the coarse companion's)
   };
   void grid_estimate(Result& fine, const Result& coarse, const Config& cfg, Estimate& est) const;
   void report(Result& fine, const Config& cfg, const Estimate& est) const;
-  Result run_at(Config cfg, double dt, const SinkFactory& make_sink, bool reported, long& steps) const;
-  void check_work(const Config& cfg) const;
-  double dt_ = 0, dt_stable_ = 0;
+  Result run_at(Config cfg, double dt, bool reported, long& steps, const SinkFactory& make_sink = nullptr) const;
+  void check_work(const Config& cfg);
+  double dt_ = 0, dt_stable_ = 0, nodes_ = 3;
   bool automatic_ = false;
   std::string reason_;
 };
