@@ -120,7 +120,7 @@ template <int NS>
 void FluidSolver::grain_pressure_inputs(bool proj, bool weak) {
   if (!proj && weak) point_sums<NS>();
   if (proj) {
-    projection_gradient_to_grains();
+    // the last solve's gradient, read in place (grain_gradient)
   } else if (weak) {
     weak_pressure_gradient();
     smooth_weak_gradient<NS>();
@@ -200,7 +200,7 @@ template <int NS>
     if (weak) {
       // the gradient the fluid itself feels at the nodes (weak_pressure_gradient), interpolated, in
       // the same pass (the fitted and the nodal gradients below are not read then)
-      const double *const gw = g_.gw.data();
+      const double *const gw = grain_gradient();
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
         const double *st = gst + StRec::N * n;
         uw += w * row4(st + StRec::U);
@@ -268,7 +268,7 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
   // out, a fluid at rest in hydrostatic balance looked to the exchange as if it fell freely over
   // the step: the drag then pulled a held bed down by about K g h / 2 per grain (Archimedes on a
   // held random bed 0.92 with h = 8.6 ms; proportional to h and to the viscosity).
-  const double *pgrad = pressure_->reaction_in_solve() && g_.gw.size() == 3 * grid_.size() ? g_.gw.data() : nullptr;
+  const double *pgrad = pressure_->reaction_in_solve() ? grain_gradient() : nullptr;
   const double inv_rho = 1.0 / opt.eos.rho0;
   const bool proj = pressure_->reaction_in_solve();
   // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned

@@ -104,13 +104,18 @@ void FluidSolver::check_grain(int k) const {
   throw LocalError(os.str());
 }
 
+bool FluidSolver::grains_need_nodes() const { return opt.grad_p != GradP::Weak && !pressure_->reaction_in_solve(); }
+
 void FluidSolver::fluid_fraction() {
   const int nlocal = pts.nlocal;
   double **x = pts.x;
   const double *radius = pts.radius;
   if (static_cast<int>(coup_->grain_shapes.size()) < nlocal) coup_->grain_shapes.resize(nlocal);
+  // the nodes some grain reads are needed only by the pressure moments of grad_p nodal and fit
+  // (pressure_moments, grain_node_state); grad_p weak and the projection never read them
+  double *const need = grains_need_nodes() ? g_.need.data() : nullptr;
   std::fill(g_.sol.begin(), g_.sol.end(), 0.0);
-  std::fill(g_.need.begin(), g_.need.end(), 0.0);
+  if (need) std::fill(g_.need.begin(), g_.need.end(), 0.0);
   for (int d = 0; d < 3; ++d) {
     coup_->base_lo[d] = INT_MAX;
     coup_->base_hi[d] = INT_MIN;
@@ -128,10 +133,13 @@ void FluidSolver::fluid_fraction() {
       coup_->base_hi[d] = std::max(coup_->base_hi[d], ps.base[d]);
     }
     const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
-    for_nodes(ps, [&](std::size_t n, double w) {
-      g_.sol[n] += w * Vk;
-      g_.need[n] = 1.0;
-    });
+    if (need)
+      for_nodes(ps, [&](std::size_t n, double w) {
+        g_.sol[n] += w * Vk;
+        need[n] = 1.0;
+      });
+    else
+      for_nodes(ps, [&](std::size_t n, double w) { g_.sol[n] += w * Vk; });
   }
   // Walls: the solid volume mapped to a node outside a grid face is folded onto its mirror node
   // inside (reflected shape functions), so that no node has the sliver volume that (8-13) gives
@@ -144,7 +152,7 @@ void FluidSolver::fluid_fraction() {
   // one exchange; need goes back to the halo copies with theta below: a point of this rank must
   // add its pressure moments to a node that only another rank's grain reads (else np 2 differs
   // from np 1 with 'grad_p fit')
-  grid_.reverse_sum({{g_.need.data(), 1}, {g_.sol.data(), 1}});
+  grid_.reverse_sum({{need, 1}, {g_.sol.data(), 1}});
   if (opt.theta_smooth > 0.0) smooth_solid_volume();
   // the mirror node and its volume of every owned node depend on the patch only: found once
   if (g_.th_src.size() != grid_.size()) {
@@ -165,7 +173,7 @@ void FluidSolver::fluid_fraction() {
       th[n] = std::min(1.0, std::max(tmin, 1.0 - sol[src[n]] / Vj[n]));  // (8-11), (8-14)
     });
   }
-  grid_.forward({{g_.th.data(), 1}, {g_.need.data(), 1}});
+  grid_.forward({{g_.th.data(), 1}, {need, 1}});
   const double *const gth = g_.th.data();
   for (const int i : pw_.plist) {
     double th = 0.0;
