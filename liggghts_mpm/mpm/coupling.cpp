@@ -2,6 +2,9 @@
 // and pressure exchange with the grains and its reaction on the fluid (solver.h, coupling.h); the
 // fluid fraction and its smoothing are in fluid_fraction.cpp.
 #include <Eigen/Dense>
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 #include <algorithm>
 #include <climits>
@@ -52,6 +55,24 @@ static IndexBox stencil_box(const int lo[3], const int hi[3], int ns, const Inde
     b.hi[d] = hi[d] == INT_MIN ? INT_MIN : hi[d] + ns - 1;
   }
   return b.cut(patch);
+}
+
+// fn(n) for the nodes of box a outside box b (up to six slabs of a).
+template <class Fn>
+static void for_box_minus(const LocalGrid &grid, IndexBox a, const IndexBox &b, Fn &&fn) {
+  if (b.empty()) {
+    if (!a.empty()) grid.for_box(a, [&](int, int, int, std::size_t n) { fn(n); });
+    return;
+  }
+  for (int d = 0; d < 3 && !a.empty(); ++d) {
+    IndexBox lo = a, hi = a;
+    lo.hi[d] = std::min(a.hi[d], b.lo[d] - 1);
+    hi.lo[d] = std::max(a.lo[d], b.hi[d] + 1);
+    for (const IndexBox &s : {lo, hi})
+      if (!s.empty()) grid.for_box(s, [&](int, int, int, std::size_t n) { fn(n); });
+    a.lo[d] = std::max(a.lo[d], b.lo[d]);
+    a.hi[d] = std::min(a.hi[d], b.hi[d]);
+  }
 }
 
 // The smallest box holding b and the boxes of more.
@@ -271,14 +292,23 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
   const double *pgrad = pressure_->reaction_in_solve() ? grain_gradient() : nullptr;
   const double inv_rho = 1.0 / opt.eos.rho0;
   const bool proj = pressure_->reaction_in_solve();
-  // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned
-  // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+  // node-wise exchange; the fluid's share of it stays on the owner (rx is read only there, by
+  // update_grid; the other nodes keep the 0 of the allocation). At the owned nodes outside dbox
+  // (no grain: K = 0, J = 0, the record keeps its zeros) rx is 0 - 0 / h = 0: only the nodes the
+  // last call may have left nonzero (g_.xbox) are cleared, and only dbox's are visited, not the
+  // whole patch (projection: rp, written by couple_kernel at the same nodes, alike)
+  const IndexBox vis = grid_.restricted() ? grid_.owned().cut(grid_.work()) : grid_.owned();
+  const IndexBox wbox = vis.cut(dbox);
+  for_box_minus(grid_, vis.cut(g_.xbox), wbox, [&](std::size_t n) {
+    for (int d = 0; d < 3; ++d) g_.rx[3 * n + d] = 0.0;
+    if (proj)
+      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = 0.0;
+  });
+  // (with a work box the nodes outside it keep what they had, as before: the box only grows)
+  g_.xbox = grid_.restricted() ? g_.xbox.hull(wbox) : wbox;
+  if (wbox.empty()) return;
+  grid_.for_box(wbox, [&](int, int, int, std::size_t n) {
     double *rx = &g_.rx[3 * n];
-    if (!dbox.contains(i, j, k)) {  // no grain here: K = 0, J = 0, the record keeps its zeros
-      rx[0] = rx[1] = rx[2] = 0.0;  // 0 - 0 / h
-      return;
-    }
     double *q = &g_.dr[DrRec::N * n];
     const double *st = &g_.st[StRec::N * n];
     double J[3] = {0, 0, 0};
@@ -378,14 +408,19 @@ void FluidSolver::couple_kernel(double h) {
   grid_.reverse_sum({{g_.dr.data(), DrRec::N}, {opt.reaction_points && !proj ? g_.rp.data() : nullptr, 3}});
 
   drag_exchange(dbox, h);
-  if (opt.reaction_points && !proj) route_reaction<NS>();
+  if (opt.reaction_points && !proj) {
+    route_reaction<NS>();
+    g_.xbox = grid_.owned();  // route_reaction adds to rx at any owned node
+  }
   // projection: the reaction of the grains' pressure force at the owned nodes, for the projection's
-  // exact exchange along the periodic directions (Projection::exact_correction)
+  // exact exchange along the periodic directions (Projection::exact_correction); 0 outside dbox,
+  // where drag_exchange cleared it
   if (proj) {
-    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-      const bool in = dbox.contains(i, j, k);
-      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = in ? gdr[DrRec::N * n + DrRec::FP + d] : 0.0;
-    });
+    const IndexBox wbox = (grid_.restricted() ? grid_.owned().cut(grid_.work()) : grid_.owned()).cut(dbox);
+    if (!wbox.empty())
+      grid_.for_box(wbox, [&](int, int, int, std::size_t n) {
+        for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
+      });
     pressure_->solve()->set_grain_reaction(g_.rp.data());
   }
   grid_.forward(g_.dr.data(), DrRec::N);
@@ -547,6 +582,26 @@ void FluidSolver::route_reaction() {
   });
 }
 
+/* A node's 3 values as a Row4 (the 4th 0) and a Row4's first 3 added back: with AVX one masked
+   load or store (the 4th lane neither read nor written), else element by element; the sums per
+   element are the same operations in the same order either way. */
+#if defined(__AVX__)
+static inline Row4 load3(const double *p) {
+  return (Row4)_mm256_maskload_pd(p, _mm256_set_epi64x(0, -1, -1, -1));
+}
+static inline void add3(double *p, double w, const Row4 &v) {
+  const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
+  Row4 cur = (Row4)_mm256_maskload_pd(p, m);
+  cur += w * v;
+  _mm256_maskstore_pd(p, m, (__m256d)cur);
+}
+#else
+static inline Row4 load3(const double *p) { return Row4{p[0], p[1], p[2], 0.0}; }
+static inline void add3(double *p, double w, const Row4 &v) {
+  for (int d = 0; d < 3; ++d) p[d] += w * v[d];
+}
+#endif
+
 template <int NS>
 void FluidSolver::through_points(const double *q, std::vector<double> &out) {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
@@ -556,11 +611,11 @@ void FluidSolver::through_points(const double *q, std::vector<double> &out) {
     const Stencil &ps = pw_.shapes[i];
     Row4 qp = {0, 0, 0, 0};
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-      qp += w * Row4{q[3 * n], q[3 * n + 1], q[3 * n + 2], 0.0};
+      qp += w * load3(q + 3 * n);
     });
     const Row4 vq = pts.state[i][C_VOL] * qp;
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-      for (int d = 0; d < 3; ++d) o[3 * n + d] += w * vq[d];
+      add3(o + 3 * n, w, vq);
     });
   }
   grid_.reverse_sum(out.data(), 3);
