@@ -116,10 +116,10 @@ void FluidSolver::fluid_fraction() {
   double *const need = grains_need_nodes() ? g_.need.data() : nullptr;
   std::fill(g_.sol.begin(), g_.sol.end(), 0.0);
   if (need) std::fill(g_.need.begin(), g_.need.end(), 0.0);
-  for (int d = 0; d < 3; ++d) {
-    coup_->base_lo[d] = INT_MAX;
-    coup_->base_hi[d] = INT_MIN;
-  }
+  // (the box of the stencil bases in locals, written back after the loop: stores to the members
+  // inside it could alias the sums and were made for every grain)
+  int blo[3] = {INT_MAX, INT_MAX, INT_MAX}, bhi[3] = {INT_MIN, INT_MIN, INT_MIN};
+  double *const sol = g_.sol.data();
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k)) continue;
     check_grain(k);
@@ -129,17 +129,18 @@ void FluidSolver::fluid_fraction() {
       continue;
     }
     for (int d = 0; d < 3; ++d) {
-      coup_->base_lo[d] = std::min(coup_->base_lo[d], ps.base[d]);
-      coup_->base_hi[d] = std::max(coup_->base_hi[d], ps.base[d]);
+      blo[d] = std::min(blo[d], ps.base[d]);
+      bhi[d] = std::max(bhi[d], ps.base[d]);
     }
     const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
-    if (need)
-      for_nodes(ps, [&](std::size_t n, double w) {
-        g_.sol[n] += w * Vk;
-        need[n] = 1.0;
-      });
-    else
-      for_nodes(ps, [&](std::size_t n, double w) { g_.sol[n] += w * Vk; });
+    for_nodes(ps, [&](std::size_t n, double w) {
+      sol[n] += w * Vk;
+      if (need) need[n] = 1.0;
+    });
+  }
+  for (int d = 0; d < 3; ++d) {
+    coup_->base_lo[d] = blo[d];
+    coup_->base_hi[d] = bhi[d];
   }
   // Walls: the solid volume mapped to a node outside a grid face is folded onto its mirror node
   // inside (reflected shape functions), so that no node has the sliver volume that (8-13) gives
