@@ -1,6 +1,7 @@
 // The coupling phases of the solver (chapter 7.2, 8.2): the pressure fit at the nodes, the drag
 // and pressure exchange with the grains and its reaction on the fluid (solver.h, coupling.h); the
-// fluid fraction and its smoothing are in fluid_fraction.cpp.
+// fluid fraction and its smoothing are in fluid_fraction.cpp, grad_p weak's nodal gradient in
+// coupling_weak.cpp.
 #include <Eigen/Dense>
 #if defined(__AVX__)
 #include <immintrin.h>
@@ -296,7 +297,7 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
   // update_grid; the other nodes keep the 0 of the allocation). At the owned nodes outside dbox
   // (no grain: K = 0, J = 0, the record keeps its zeros) rx is 0 - 0 / h = 0: only the nodes the
   // last call may have left nonzero (g_.xbox) are cleared, and only dbox's are visited, not the
-  // whole patch (projection: rp, written by couple_kernel at the same nodes, alike)
+  // whole patch (projection: rp, the grains' pressure reaction, written at the same nodes, alike)
   const IndexBox vis = grid_.restricted() ? grid_.owned().cut(grid_.work()) : grid_.owned();
   const IndexBox wbox = vis.cut(dbox);
   for_box_minus(grid_, vis.cut(g_.xbox), wbox, [&](std::size_t n) {
@@ -330,6 +331,10 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
       rx[d] = (opt.reaction_points || proj ? 0.0 : q[DrRec::FP + d]) - J[d] / h;  // force on the fluid
       q[DrRec::J + d] = q[DrRec::K] > 0.0 ? J[d] / q[DrRec::K] : 0.0;  // impulse per unit K, to the grains
     }
+    // projection: the reaction of the grains' pressure force at the owned nodes, for the
+    // projection's exact exchange along the periodic directions (Projection::exact_correction)
+    if (proj)
+      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = q[DrRec::FP + d];
   });
 }
 
@@ -412,17 +417,8 @@ void FluidSolver::couple_kernel(double h) {
     route_reaction<NS>();
     g_.xbox = grid_.owned();  // route_reaction adds to rx at any owned node
   }
-  // projection: the reaction of the grains' pressure force at the owned nodes, for the projection's
-  // exact exchange along the periodic directions (Projection::exact_correction); 0 outside dbox,
-  // where drag_exchange cleared it
-  if (proj) {
-    const IndexBox wbox = (grid_.restricted() ? grid_.owned().cut(grid_.work()) : grid_.owned()).cut(dbox);
-    if (!wbox.empty())
-      grid_.for_box(wbox, [&](int, int, int, std::size_t n) {
-        for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = gdr[DrRec::N * n + DrRec::FP + d];
-      });
-    pressure_->solve()->set_grain_reaction(g_.rp.data());
-  }
+  // projection: the grains' pressure reaction for the solve (rp, written by drag_exchange)
+  if (proj) pressure_->solve()->set_grain_reaction(g_.rp.data());
   grid_.forward(g_.dr.data(), DrRec::N);
   grain_drag_forces<NS>(Kgrain, h);
   // pfit and dr are 0 at the next call (they are allocated 0 and no other code writes them): only
@@ -461,57 +457,6 @@ void FluidSolver::point_sums() {
   }
   // (the volume folded at the faces with reaction points, summed in the same exchange)
   grid_.reverse_sum({{g_.wk.data(), WkRec::N}, {opt.reaction_points ? g_.rq.data() : nullptr, 3}});
-}
-
-/* grad_p weak: the pressure gradient the fluid itself feels at node i, -(internal force + wall
-   traction) / sum_p S_ip V_p: the P2G force less the points' external forces. At rest every free
-   node balances it with the weight of its fluid and the grains' reaction, so a grain reads
-   exactly rho g there, whatever the packing and next to a floor, where the anti-locked cell
-   pressure has its staircase (docs/theory/well_balanced.md). Nodes on a grid face and padding
-   nodes (their velocity is the wall's) take the value of the nearest node off the faces. */
-void FluidSolver::weak_pressure_gradient() {
-  const GridSpec &gs = opt.grid;
-  const double vmin = 1e-12 * gs.dx * gs.dx * gs.dx, vhalf = 0.5 * gs.dx * gs.dx * gs.dx;
-  std::fill(g_.gw.begin(), g_.gw.end(), 0.0);
-  grid_.for_owned([&](int, int, int, std::size_t n) {
-    const double *w = &g_.wk[WkRec::N * n];
-    if (!(w[WkRec::V] > vmin)) return;
-    const double *f = &g_.p2g[P2gRec::N * n + P2gRec::F];
-    // a node whose points fill less than half a cell (a free surface, a front) divides by half a
-    // cell: its force over its points' sliver of volume gave the grains there gradients of many
-    // rho g, and the collapsing bed of tank quick blew up at 0.026 s (it runs with the floor)
-    const double Vd = std::max(w[WkRec::V], vhalf);
-    for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = -(f[d] - w[WkRec::F + d]) / Vd;
-  });
-  grid_.forward(g_.gw.data(), 3);
-  weak_face_copy();
-}
-
-// grad_p weak: nodes on a grid face and padding nodes take the value of the nearest node off the faces
-// Only the nodes a copy writes are visited: the slabs of the patch at or beyond a face (index <= 0
-// or >= ncell along a dimension that is clamped). The node copied from lies in none of them (its
-// clamped indices are inside), so a node in two slabs gets the same copy twice.
-void FluidSolver::weak_face_copy() {
-  const GridSpec &gs = opt.grid;
-  const IndexBox &pb = grid_.patch();
-  auto copy = [&](int i, int j, int k, std::size_t n) {
-    int c[3] = {i, j, k};
-    for (int d = 0; d < 3; ++d) {
-      if (gs.periodic[d] || gs.ncell[d] < 2) continue;
-      c[d] = std::min(std::max(c[d], 1), gs.ncell[d] - 1);
-    }
-    if (!grid_.in_patch(c[0], c[1], c[2])) return;
-    const std::size_t m = grid_.index(c[0], c[1], c[2]);
-    for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = g_.gw[3 * m + d];
-  };
-  for (int d = 0; d < 3; ++d) {
-    if (gs.periodic[d] || gs.ncell[d] < 2) continue;
-    IndexBox lo = pb, hi = pb;
-    lo.hi[d] = std::min(pb.hi[d], 0);
-    hi.lo[d] = std::max(pb.lo[d], gs.ncell[d]);
-    if (!lo.empty()) grid_.for_box(lo, copy);
-    if (!hi.empty()) grid_.for_box(hi, copy);
-  }
 }
 
 /* grad_p weak, the points' view of the nodal gradient: g_p = sum_i S_ip g_i at the points, then
