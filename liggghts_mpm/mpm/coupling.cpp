@@ -527,25 +527,20 @@ void FluidSolver::route_reaction() {
   });
 }
 
-/* A node's 3 values as a Row4 (the 4th 0) and a Row4's first 3 added back: with AVX one masked
-   load or store (the 4th lane neither read nor written), else element by element; the sums per
-   element are the same operations in the same order either way. */
+/* A node's 3 values as a Row4 (the 4th 0): with AVX one masked load (the 4th lane not read), else
+   element by element; and a Row4's first 3 added back element by element (an AVX masked store
+   there took fewer instructions but the coupling ran slower, docs/validation/performance.md "The
+   coupling's sweeps"). The sums are the same operations in the same order either way. */
 #if defined(__AVX__)
 static inline Row4 load3(const double *p) {
   return (Row4)_mm256_maskload_pd(p, _mm256_set_epi64x(0, -1, -1, -1));
 }
-static inline void add3(double *p, double w, const Row4 &v) {
-  const __m256i m = _mm256_set_epi64x(0, -1, -1, -1);
-  Row4 cur = (Row4)_mm256_maskload_pd(p, m);
-  cur += w * v;
-  _mm256_maskstore_pd(p, m, (__m256d)cur);
-}
 #else
 static inline Row4 load3(const double *p) { return Row4{p[0], p[1], p[2], 0.0}; }
+#endif
 static inline void add3(double *p, double w, const Row4 &v) {
   for (int d = 0; d < 3; ++d) p[d] += w * v[d];
 }
-#endif
 
 template <int NS>
 void FluidSolver::through_points(const double *q, std::vector<double> &out) {
