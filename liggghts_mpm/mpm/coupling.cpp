@@ -1,7 +1,11 @@
 // The coupling phases of the solver (chapter 7.2, 8.2): the pressure fit at the nodes, the drag
 // and pressure exchange with the grains and its reaction on the fluid (solver.h, coupling.h); the
-// fluid fraction and its smoothing are in fluid_fraction.cpp.
+// fluid fraction and its smoothing are in fluid_fraction.cpp, grad_p weak's nodal gradient in
+// coupling_weak.cpp.
 #include <Eigen/Dense>
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 #include <algorithm>
 #include <climits>
@@ -52,6 +56,24 @@ static IndexBox stencil_box(const int lo[3], const int hi[3], int ns, const Inde
     b.hi[d] = hi[d] == INT_MIN ? INT_MIN : hi[d] + ns - 1;
   }
   return b.cut(patch);
+}
+
+// fn(n) for the nodes of box a outside box b (up to six slabs of a).
+template <class Fn>
+static void for_box_minus(const LocalGrid &grid, IndexBox a, const IndexBox &b, Fn &&fn) {
+  if (b.empty()) {
+    if (!a.empty()) grid.for_box(a, [&](int, int, int, std::size_t n) { fn(n); });
+    return;
+  }
+  for (int d = 0; d < 3 && !a.empty(); ++d) {
+    IndexBox lo = a, hi = a;
+    lo.hi[d] = std::min(a.hi[d], b.lo[d] - 1);
+    hi.lo[d] = std::max(a.lo[d], b.hi[d] + 1);
+    for (const IndexBox &s : {lo, hi})
+      if (!s.empty()) grid.for_box(s, [&](int, int, int, std::size_t n) { fn(n); });
+    a.lo[d] = std::max(a.lo[d], b.lo[d]);
+    a.hi[d] = std::min(a.hi[d], b.hi[d]);
+  }
 }
 
 // The smallest box holding b and the boxes of more.
@@ -120,7 +142,7 @@ template <int NS>
 void FluidSolver::grain_pressure_inputs(bool proj, bool weak) {
   if (!proj && weak) point_sums<NS>();
   if (proj) {
-    projection_gradient_to_grains();
+    // the last solve's gradient, read in place (grain_gradient)
   } else if (weak) {
     weak_pressure_gradient();
     smooth_weak_gradient<NS>();
@@ -200,7 +222,7 @@ template <int NS>
     if (weak) {
       // the gradient the fluid itself feels at the nodes (weak_pressure_gradient), interpolated, in
       // the same pass (the fitted and the nodal gradients below are not read then)
-      const double *const gw = g_.gw.data();
+      const double *const gw = grain_gradient();
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
         const double *st = gst + StRec::N * n;
         uw += w * row4(st + StRec::U);
@@ -268,17 +290,26 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
   // out, a fluid at rest in hydrostatic balance looked to the exchange as if it fell freely over
   // the step: the drag then pulled a held bed down by about K g h / 2 per grain (Archimedes on a
   // held random bed 0.92 with h = 8.6 ms; proportional to h and to the viscosity).
-  const double *pgrad = pressure_->reaction_in_solve() && g_.gw.size() == 3 * grid_.size() ? g_.gw.data() : nullptr;
+  const double *pgrad = pressure_->reaction_in_solve() ? grain_gradient() : nullptr;
   const double inv_rho = 1.0 / opt.eos.rho0;
   const bool proj = pressure_->reaction_in_solve();
-  // node-wise exchange; the fluid's share of it stays on the owner (rx is written at every owned
-  // node here and read only there, by update_grid; the other nodes keep the 0 of the allocation)
-  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+  // node-wise exchange; the fluid's share of it stays on the owner (rx is read only there, by
+  // update_grid; the other nodes keep the 0 of the allocation). At the owned nodes outside dbox
+  // (no grain: K = 0, J = 0, the record keeps its zeros) rx is 0 - 0 / h = 0: only the nodes the
+  // last call may have left nonzero (g_.xbox) are cleared, and only dbox's are visited, not the
+  // whole patch (projection: rp, the grains' pressure reaction, written at the same nodes, alike)
+  const IndexBox vis = grid_.restricted() ? grid_.owned().cut(grid_.work()) : grid_.owned();
+  const IndexBox wbox = vis.cut(dbox);
+  for_box_minus(grid_, vis.cut(g_.xbox), wbox, [&](std::size_t n) {
+    for (int d = 0; d < 3; ++d) g_.rx[3 * n + d] = 0.0;
+    if (proj)
+      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = 0.0;
+  });
+  // (with a work box the nodes outside it keep what they had, as before: the box only grows)
+  g_.xbox = grid_.restricted() ? g_.xbox.hull(wbox) : wbox;
+  if (wbox.empty()) return;
+  grid_.for_box(wbox, [&](int, int, int, std::size_t n) {
     double *rx = &g_.rx[3 * n];
-    if (!dbox.contains(i, j, k)) {  // no grain here: K = 0, J = 0, the record keeps its zeros
-      rx[0] = rx[1] = rx[2] = 0.0;  // 0 - 0 / h
-      return;
-    }
     double *q = &g_.dr[DrRec::N * n];
     const double *st = &g_.st[StRec::N * n];
     double J[3] = {0, 0, 0};
@@ -300,6 +331,10 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
       rx[d] = (opt.reaction_points || proj ? 0.0 : q[DrRec::FP + d]) - J[d] / h;  // force on the fluid
       q[DrRec::J + d] = q[DrRec::K] > 0.0 ? J[d] / q[DrRec::K] : 0.0;  // impulse per unit K, to the grains
     }
+    // projection: the reaction of the grains' pressure force at the owned nodes, for the
+    // projection's exact exchange along the periodic directions (Projection::exact_correction)
+    if (proj)
+      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = q[DrRec::FP + d];
   });
 }
 
@@ -378,16 +413,12 @@ void FluidSolver::couple_kernel(double h) {
   grid_.reverse_sum({{g_.dr.data(), DrRec::N}, {opt.reaction_points && !proj ? g_.rp.data() : nullptr, 3}});
 
   drag_exchange(dbox, h);
-  if (opt.reaction_points && !proj) route_reaction<NS>();
-  // projection: the reaction of the grains' pressure force at the owned nodes, for the projection's
-  // exact exchange along the periodic directions (Projection::exact_correction)
-  if (proj) {
-    grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-      const bool in = dbox.contains(i, j, k);
-      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = in ? gdr[DrRec::N * n + DrRec::FP + d] : 0.0;
-    });
-    pressure_->solve()->set_grain_reaction(g_.rp.data());
+  if (opt.reaction_points && !proj) {
+    route_reaction<NS>();
+    g_.xbox = grid_.owned();  // route_reaction adds to rx at any owned node
   }
+  // projection: the grains' pressure reaction for the solve (rp, written by drag_exchange)
+  if (proj) pressure_->solve()->set_grain_reaction(g_.rp.data());
   grid_.forward(g_.dr.data(), DrRec::N);
   grain_drag_forces<NS>(Kgrain, h);
   // pfit and dr are 0 at the next call (they are allocated 0 and no other code writes them): only
@@ -426,57 +457,6 @@ void FluidSolver::point_sums() {
   }
   // (the volume folded at the faces with reaction points, summed in the same exchange)
   grid_.reverse_sum({{g_.wk.data(), WkRec::N}, {opt.reaction_points ? g_.rq.data() : nullptr, 3}});
-}
-
-/* grad_p weak: the pressure gradient the fluid itself feels at node i, -(internal force + wall
-   traction) / sum_p S_ip V_p: the P2G force less the points' external forces. At rest every free
-   node balances it with the weight of its fluid and the grains' reaction, so a grain reads
-   exactly rho g there, whatever the packing and next to a floor, where the anti-locked cell
-   pressure has its staircase (docs/theory/well_balanced.md). Nodes on a grid face and padding
-   nodes (their velocity is the wall's) take the value of the nearest node off the faces. */
-void FluidSolver::weak_pressure_gradient() {
-  const GridSpec &gs = opt.grid;
-  const double vmin = 1e-12 * gs.dx * gs.dx * gs.dx, vhalf = 0.5 * gs.dx * gs.dx * gs.dx;
-  std::fill(g_.gw.begin(), g_.gw.end(), 0.0);
-  grid_.for_owned([&](int, int, int, std::size_t n) {
-    const double *w = &g_.wk[WkRec::N * n];
-    if (!(w[WkRec::V] > vmin)) return;
-    const double *f = &g_.p2g[P2gRec::N * n + P2gRec::F];
-    // a node whose points fill less than half a cell (a free surface, a front) divides by half a
-    // cell: its force over its points' sliver of volume gave the grains there gradients of many
-    // rho g, and the collapsing bed of tank quick blew up at 0.026 s (it runs with the floor)
-    const double Vd = std::max(w[WkRec::V], vhalf);
-    for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = -(f[d] - w[WkRec::F + d]) / Vd;
-  });
-  grid_.forward(g_.gw.data(), 3);
-  weak_face_copy();
-}
-
-// grad_p weak: nodes on a grid face and padding nodes take the value of the nearest node off the faces
-// Only the nodes a copy writes are visited: the slabs of the patch at or beyond a face (index <= 0
-// or >= ncell along a dimension that is clamped). The node copied from lies in none of them (its
-// clamped indices are inside), so a node in two slabs gets the same copy twice.
-void FluidSolver::weak_face_copy() {
-  const GridSpec &gs = opt.grid;
-  const IndexBox &pb = grid_.patch();
-  auto copy = [&](int i, int j, int k, std::size_t n) {
-    int c[3] = {i, j, k};
-    for (int d = 0; d < 3; ++d) {
-      if (gs.periodic[d] || gs.ncell[d] < 2) continue;
-      c[d] = std::min(std::max(c[d], 1), gs.ncell[d] - 1);
-    }
-    if (!grid_.in_patch(c[0], c[1], c[2])) return;
-    const std::size_t m = grid_.index(c[0], c[1], c[2]);
-    for (int d = 0; d < 3; ++d) g_.gw[3 * n + d] = g_.gw[3 * m + d];
-  };
-  for (int d = 0; d < 3; ++d) {
-    if (gs.periodic[d] || gs.ncell[d] < 2) continue;
-    IndexBox lo = pb, hi = pb;
-    lo.hi[d] = std::min(pb.hi[d], 0);
-    hi.lo[d] = std::max(pb.lo[d], gs.ncell[d]);
-    if (!lo.empty()) grid_.for_box(lo, copy);
-    if (!hi.empty()) grid_.for_box(hi, copy);
-  }
 }
 
 /* grad_p weak, the points' view of the nodal gradient: g_p = sum_i S_ip g_i at the points, then
@@ -547,6 +527,21 @@ void FluidSolver::route_reaction() {
   });
 }
 
+/* A node's 3 values as a Row4 (the 4th 0): with AVX one masked load (the 4th lane not read), else
+   element by element; and a Row4's first 3 added back element by element (an AVX masked store
+   there took fewer instructions but the coupling ran slower, docs/validation/performance.md "The
+   coupling's sweeps"). The sums are the same operations in the same order either way. */
+#if defined(__AVX__)
+static inline Row4 load3(const double *p) {
+  return (Row4)_mm256_maskload_pd(p, _mm256_set_epi64x(0, -1, -1, -1));
+}
+#else
+static inline Row4 load3(const double *p) { return Row4{p[0], p[1], p[2], 0.0}; }
+#endif
+static inline void add3(double *p, double w, const Row4 &v) {
+  for (int d = 0; d < 3; ++d) p[d] += w * v[d];
+}
+
 template <int NS>
 void FluidSolver::through_points(const double *q, std::vector<double> &out) {
   const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
@@ -556,11 +551,11 @@ void FluidSolver::through_points(const double *q, std::vector<double> &out) {
     const Stencil &ps = pw_.shapes[i];
     Row4 qp = {0, 0, 0, 0};
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-      qp += w * Row4{q[3 * n], q[3 * n + 1], q[3 * n + 2], 0.0};
+      qp += w * load3(q + 3 * n);
     });
     const Row4 vq = pts.state[i][C_VOL] * qp;
     for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
-      for (int d = 0; d < 3; ++d) o[3 * n + d] += w * vq[d];
+      add3(o + 3 * n, w, vq);
     });
   }
   grid_.reverse_sum(out.data(), 3);

@@ -104,17 +104,22 @@ void FluidSolver::check_grain(int k) const {
   throw LocalError(os.str());
 }
 
+bool FluidSolver::grains_need_nodes() const { return opt.grad_p != GradP::Weak && !pressure_->reaction_in_solve(); }
+
 void FluidSolver::fluid_fraction() {
   const int nlocal = pts.nlocal;
   double **x = pts.x;
   const double *radius = pts.radius;
   if (static_cast<int>(coup_->grain_shapes.size()) < nlocal) coup_->grain_shapes.resize(nlocal);
+  // the nodes some grain reads are needed only by the pressure moments of grad_p nodal and fit
+  // (pressure_moments, grain_node_state); grad_p weak and the projection never read them
+  double *const need = grains_need_nodes() ? g_.need.data() : nullptr;
   std::fill(g_.sol.begin(), g_.sol.end(), 0.0);
-  std::fill(g_.need.begin(), g_.need.end(), 0.0);
-  for (int d = 0; d < 3; ++d) {
-    coup_->base_lo[d] = INT_MAX;
-    coup_->base_hi[d] = INT_MIN;
-  }
+  if (need) std::fill(g_.need.begin(), g_.need.end(), 0.0);
+  // (the box of the stencil bases in locals, written back after the loop: stores to the members
+  // inside it could alias the sums and were made for every grain)
+  int blo[3] = {INT_MAX, INT_MAX, INT_MAX}, bhi[3] = {INT_MIN, INT_MIN, INT_MIN};
+  double *const sol = g_.sol.data();
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k)) continue;
     check_grain(k);
@@ -124,14 +129,18 @@ void FluidSolver::fluid_fraction() {
       continue;
     }
     for (int d = 0; d < 3; ++d) {
-      coup_->base_lo[d] = std::min(coup_->base_lo[d], ps.base[d]);
-      coup_->base_hi[d] = std::max(coup_->base_hi[d], ps.base[d]);
+      blo[d] = std::min(blo[d], ps.base[d]);
+      bhi[d] = std::max(bhi[d], ps.base[d]);
     }
     const double Vk = 4.0 / 3.0 * M_PI * radius[k] * radius[k] * radius[k];
     for_nodes(ps, [&](std::size_t n, double w) {
-      g_.sol[n] += w * Vk;
-      g_.need[n] = 1.0;
+      sol[n] += w * Vk;
+      if (need) need[n] = 1.0;
     });
+  }
+  for (int d = 0; d < 3; ++d) {
+    coup_->base_lo[d] = blo[d];
+    coup_->base_hi[d] = bhi[d];
   }
   // Walls: the solid volume mapped to a node outside a grid face is folded onto its mirror node
   // inside (reflected shape functions), so that no node has the sliver volume that (8-13) gives
@@ -144,7 +153,7 @@ void FluidSolver::fluid_fraction() {
   // one exchange; need goes back to the halo copies with theta below: a point of this rank must
   // add its pressure moments to a node that only another rank's grain reads (else np 2 differs
   // from np 1 with 'grad_p fit')
-  grid_.reverse_sum({{g_.need.data(), 1}, {g_.sol.data(), 1}});
+  grid_.reverse_sum({{need, 1}, {g_.sol.data(), 1}});
   if (opt.theta_smooth > 0.0) smooth_solid_volume();
   // the mirror node and its volume of every owned node depend on the patch only: found once
   if (g_.th_src.size() != grid_.size()) {
@@ -165,7 +174,7 @@ void FluidSolver::fluid_fraction() {
       th[n] = std::min(1.0, std::max(tmin, 1.0 - sol[src[n]] / Vj[n]));  // (8-11), (8-14)
     });
   }
-  grid_.forward({{g_.th.data(), 1}, {g_.need.data(), 1}});
+  grid_.forward({{g_.th.data(), 1}, {need, 1}});
   const double *const gth = g_.th.data();
   for (const int i : pw_.plist) {
     double th = 0.0;

@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "mpm/grid.h"
+
 namespace mpm {
 
 // Columns of a point's state row (also the fix's per-atom array, 1-based in f_ID[n]).
@@ -61,6 +63,8 @@ struct GridFields {
   std::vector<double> wk;       // grad_p weak: WkRec (reverse-summed)
   std::vector<double> gw;       // grad_p weak: the fluid's pressure gradient (3), every patch node
   std::vector<double> rp, rq;   // reaction points: the grains' pressure reaction, its density (3)
+  // the owned nodes outside which rx (and, with the projection, rp) are 0 (drag_exchange)
+  IndexBox xbox;
   // fluid_fraction: per owned node the node whose solid volume gives its fraction (its mirror inside
   // the box walls, or itself) and that node's volume; they depend on the patch only (filled on first use)
   std::vector<std::size_t> th_src;
@@ -85,6 +89,7 @@ struct GridFields {
       gw.assign(nodes * 3, 0.0);
       rp.assign(nodes * 3, 0.0);
       rq.assign(nodes * 3, 0.0);
+      xbox = IndexBox();
       vnode.clear();
       vnode_ready = false;
       th_src.clear();

@@ -377,9 +377,14 @@ IndexBox FluidSolver::projection_work_box() {
   return w.cut(pb);
 }
 
-/* projection with couple: the grains feel the nodal pressure gradient of the last solve, the
-   discrete gradient the fluid felt (grad_p weak's array, read by couple_kernel) */
-void FluidSolver::projection_gradient_to_grains() { g_.gw = pressure_->solve()->gradient(); }
+/* The nodal pressure gradient couple_kernel's grad_p weak path reads: with the projection the
+   discrete gradient of the last solve, the one the fluid felt, read where the solve keeps it (not
+   copied: the whole patch's array each sub-step); else grad_p weak's own array
+   (weak_pressure_gradient) */
+const double *FluidSolver::grain_gradient() const {
+  const std::vector<double> &g = pressure_->reaction_in_solve() ? pressure_->solve()->gradient() : g_.gw;
+  return g.size() == 3 * grid_.size() ? g.data() : nullptr;
+}
 
 /* projection + volume_correction: the points' volume on the grid, sum S V with V = m / (theta
    rho0) (the volume a point holds, with this sub-step's theta), owned nodes after the reverse sum */

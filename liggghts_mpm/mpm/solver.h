@@ -167,7 +167,9 @@ class FluidSolver {
   // volume correction is due and stands for that time (Projection::volume_correction_every)
   void update_grid(double h, double vc_time = 0.0);
   void point_pressure();            // the points' pressure from the nodes (projection; eos: none)
-  void projection_gradient_to_grains();  // projection + couple: grad p for the grains
+  // the nodal pressure gradient the grains feel (grad_p weak: gw; projection + couple: the last
+  // solve's, read in place); nullptr where it does not cover the patch
+  const double *grain_gradient() const;
   void grid_to_particles();         // G2P (8-37)-(8-40)
   void remap_velocity_musl(double h);  // MUSL remap of the updated point momentum
   void update_stress(double h, bool theta_only = false);  // (7-21)-(7-24)
@@ -303,6 +305,7 @@ class FluidSolver {
     if (!(z == 0.0 && m > 0.0)) bad_point(i);
   }
   void bad_point(int i) const;
+  bool grains_need_nodes() const;     // the pressure moments read need (grad_p nodal, fit; eos)
   void check_grain(int k) const;      // finite position, velocity, radius, mass (fluid_fraction)
   // the first of position, velocity, radius (when given) and mass that is not finite, or (radius,
   // mass) not positive; nullptr if none (bad_point, check_grain)
