@@ -369,6 +369,7 @@ void FluidSolver::couple_kernel(double h) {
   // (the exact exchange, set_grain_reaction) and elsewhere its share -theta grad p is its correction
   const bool proj = pressure_->reaction_in_solve();
   const bool weak = opt.grad_p == GradP::Weak || proj;
+  const bool moments = grains_need_nodes();  // grad_p nodal / fit: the points' pressure moments (pfit)
   grain_pressure_inputs<NS>(proj, weak);
 
   // the box of the grains' stencils (fluid_fraction found them for this sub-step)
@@ -384,7 +385,7 @@ void FluidSolver::couple_kernel(double h) {
   // pfit is 0 outside the points' stencils and the exchanged boxes (with grad_p weak and the
   // projection everywhere): there the node reads a record of zeros, not the array
   const IndexBox pbox = stencil_box(pw_.base_lo, pw_.base_hi, NS, grid_.patch());
-  const IndexBox rbox = !proj && !weak ? bounding_box(pbox, xboxes) : IndexBox();
+  const IndexBox rbox = moments ? bounding_box(pbox, xboxes) : IndexBox();
   if (!sbox.empty()) grain_node_state(sbox, rbox, weak);
   grid_.forward(g_.st.data(), StRec::N);
 
@@ -429,7 +430,7 @@ void FluidSolver::couple_kernel(double h) {
   std::vector<IndexBox> boxes = xboxes;
   boxes.push_back(gbox);
   grid_.zero_boxes(g_.dr, DrRec::N, boxes);
-  if (!proj && !weak) {
+  if (moments) {
     boxes.back() = pbox;
     grid_.zero_boxes(g_.pfit, PfitRec::N, boxes);
   }
