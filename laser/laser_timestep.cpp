@@ -296,8 +296,6 @@ Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) cons
   est.dt = L.mid.dt;
   est.companion = L.has_coarse ? L.coarse.dt : L.fine.dt;
   est.fine_companion = L.has_coarse ? L.fine.dt : L.finest.dt;
-  est.ed = qd.est;
-  est.ev = qv.est;
   est.runs = runs;
   est.steps = steps;
   est.stalled = stalled;
@@ -343,8 +341,8 @@ void TimeStepPolicy::report(Result& fine, const Config& cfg, const Estimate& est
   StepReport& s = fine.step;
   s.automatic = automatic_;
   s.companion_dt = est.companion;
-  s.depth_error = est.ed;
-  s.volume_error = est.ev;
+  s.depth_error = est.depth.est;
+  s.volume_error = est.volume.est;
   s.runs = est.runs;
   s.steps_total = est.steps;
   s.stable_limit = dt_stable_;
@@ -358,11 +356,11 @@ void TimeStepPolicy::report(Result& fine, const Config& cfg, const Estimate& est
   s.volume_ratio = est.volume.ratio;
   s.reason = reason_ + (est.dt < dt_ ? ", refined to meet --tol" : "");
   const bool within = est.depth.accepted(cfg.tol) && est.volume.accepted(cfg.tol);
-  if (!within && (fine.status == "ok" || fine.status == "inaccurate")) {
-    const bool high = std::max(est.ed, est.ev) > cfg.tol;
+  if (!within && finished(fine)) {
+    const bool high = std::max(est.depth.est, est.volume.est) > cfg.tol;
     const std::string m =
         std::string(high ? "estimated error of the time step" : "time-step differences not contracting") +
-        ": depth " + fmt(est.ed, 4) + ", volume " + fmt(est.ev, 4) + " (three levels: dt = " + fmt(est.dt, 4) +
+        ": depth " + fmt(est.depth.est, 4) + ", volume " + fmt(est.volume.est, 4) + " (three levels: dt = " + fmt(est.dt, 4) +
         " s against " + fmt(est.companion, 4) + " s and " + fmt(est.fine_companion, 4) +
         " s; ratios of successive differences " + fmt(est.depth.ratio, 3) + ", " + fmt(est.volume.ratio, 3) + ")" +
         (high ? " above --tol " + fmt(cfg.tol, 4)
@@ -381,7 +379,7 @@ void TimeStepPolicy::report(Result& fine, const Config& cfg, const Estimate& est
                                       : (high ? "time-step error estimate above --tol"
                                               : "time-step differences not contracting"));
   }
-  if (std::max(est.grid_ed, est.grid_ev) > cfg.tol && (fine.status == "ok" || fine.status == "inaccurate")) {
+  if (std::max(est.grid_ed, est.grid_ev) > cfg.tol && finished(fine)) {
     const std::string m = "grid error estimate above --tol: depth " + fmt(est.grid_ed, 4) + ", volume " +
                           fmt(est.grid_ev, 4) + " (d(xi) = " + fmt(cfg.dxi, 4) + " against " + fmt(est.grid_dxi, 4) +
                           ", dt = " + fmt(est.grid_dt, 4) + " s) above --tol " + fmt(cfg.tol, 4) +
@@ -400,11 +398,11 @@ void TimeStepPolicy::report(Result& fine, const Config& cfg, const Estimate& est
 // 2 d(xi) it costs a quarter of the reported run. A companion that does not
 // finish gives no estimate (NaN, null in summary.json) and a note.
 void TimeStepPolicy::grid_estimate(Result& fine, const Result& coarse, const Config& cfg, Estimate& est) const {
-  if (fine.status != "ok" && fine.status != "inaccurate") return;
+  if (!finished(fine)) return;
   // the grid companion runs at the coarse companion's step unless a safeguard acted there or
   // the estimate is taken again after a halving for it
   const bool use_coarse =
-      est.companion > est.dt && (coarse.status == "ok" || coarse.status == "inaccurate") &&
+      est.companion > est.dt && finished(coarse) &&
       !safeguarded(coarse);
   const Result& base = use_coarse ? coarse : fine;
   Config gc = cfg;
@@ -413,7 +411,7 @@ void TimeStepPolicy::grid_estimate(Result& fine, const Result& coarse, const Con
   est.grid_dt = use_coarse ? est.companion : est.dt;
   const Result grid = run_at(gc, est.grid_dt, false, est.steps);
   ++est.runs;
-  if (grid.status != "ok" && grid.status != "inaccurate") {
+  if (!finished(grid)) {
     est.grid_ed = est.grid_ev = std::numeric_limits<double>::quiet_NaN();
     fine.notes.push_back("no grid error estimate: the companion run at d(xi) = " + fmt(gc.dxi, 4) + ", dt = " +
                          fmt(est.grid_dt, 4) + " s ended " + grid.status +

@@ -68,15 +68,14 @@ class TimeStepPolicy {
   void deliver_frames(const Config& cfg, Result& r, const SinkFactory& make_sink, long& steps) const;
   bool buffered(const Config& cfg, double dt) const;
   struct Estimate {
-    // reported step, coarse companion's step, relative depth/volume error estimates
-    double dt = 0, companion = 0, ed = 0, ev = 0;
+    double dt = 0, companion = 0;  // reported step, coarse companion's step
     int runs = 0;
     long steps = 0;
     bool stalled = false;
     std::string history;
     double grid_dxi = 0, grid_dt = 0, grid_ed = 0, grid_ev = 0;  // grid companion's d(xi), step, error estimates
     double fine_companion = 0;
-    Level3 depth, volume;  // grid companion at the reported step (not the coarse companion's)
+    Level3 depth, volume;  // three-level estimates of the relative depth and volume errors (est)
   };
   void grid_estimate(Result& fine, const Result& coarse, const Config& cfg, Estimate& est) const;
   void report(Result& fine, const Config& cfg, const Estimate& est) const;
