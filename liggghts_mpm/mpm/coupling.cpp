@@ -58,24 +58,6 @@ static IndexBox stencil_box(const int lo[3], const int hi[3], int ns, const Inde
   return b.cut(patch);
 }
 
-// fn(n) for the nodes of box a outside box b (up to six slabs of a).
-template <class Fn>
-static void for_box_minus(const LocalGrid &grid, IndexBox a, const IndexBox &b, Fn &&fn) {
-  if (b.empty()) {
-    if (!a.empty()) grid.for_box(a, [&](int, int, int, std::size_t n) { fn(n); });
-    return;
-  }
-  for (int d = 0; d < 3 && !a.empty(); ++d) {
-    IndexBox lo = a, hi = a;
-    lo.hi[d] = std::min(a.hi[d], b.lo[d] - 1);
-    hi.lo[d] = std::max(a.lo[d], b.hi[d] + 1);
-    for (const IndexBox &s : {lo, hi})
-      if (!s.empty()) grid.for_box(s, [&](int, int, int, std::size_t n) { fn(n); });
-    a.lo[d] = std::max(a.lo[d], b.lo[d]);
-    a.hi[d] = std::min(a.hi[d], b.hi[d]);
-  }
-}
-
 // The smallest box holding b and the boxes of more.
 static IndexBox bounding_box(IndexBox b, const std::vector<IndexBox> &more) {
   for (const IndexBox &m : more) b = b.hull(m);
@@ -300,11 +282,9 @@ void FluidSolver::drag_exchange(const IndexBox &dbox, double h) {
   // whole patch (projection: rp, the grains' pressure reaction, written at the same nodes, alike)
   const IndexBox vis = grid_.restricted() ? grid_.owned().cut(grid_.work()) : grid_.owned();
   const IndexBox wbox = vis.cut(dbox);
-  for_box_minus(grid_, vis.cut(g_.xbox), wbox, [&](std::size_t n) {
-    for (int d = 0; d < 3; ++d) g_.rx[3 * n + d] = 0.0;
-    if (proj)
-      for (int d = 0; d < 3; ++d) g_.rp[3 * n + d] = 0.0;
-  });
+  const std::vector<IndexBox> gone = vis.cut(g_.xbox).minus(wbox);
+  grid_.zero_boxes(g_.rx, 3, gone);
+  if (proj) grid_.zero_boxes(g_.rp, 3, gone);
   // (with a work box the nodes outside it keep what they had, as before: the box only grows)
   g_.xbox = grid_.restricted() ? g_.xbox.hull(wbox) : wbox;
   if (wbox.empty()) return;

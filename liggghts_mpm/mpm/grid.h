@@ -44,6 +44,24 @@ struct IndexBox {
   bool contains(int i, int j, int k) const {
     return i >= lo[0] && i <= hi[0] && j >= lo[1] && j <= hi[1] && k >= lo[2] && k <= hi[2];
   }
+  // the nodes of this box outside b, as up to six disjoint slabs
+  std::vector<IndexBox> minus(const IndexBox &b) const {
+    std::vector<IndexBox> out;
+    if (empty()) return out;
+    const IndexBox c = cut(b);
+    if (c.empty()) return {*this};
+    IndexBox rest = *this;
+    for (int d = 2; d >= 0; --d) {
+      IndexBox l = rest, h = rest;
+      l.hi[d] = c.lo[d] - 1;
+      h.lo[d] = c.hi[d] + 1;
+      if (!l.empty()) out.push_back(l);
+      if (!h.empty()) out.push_back(h);
+      rest.lo[d] = c.lo[d];
+      rest.hi[d] = c.hi[d];
+    }
+    return out;
+  }
 };
 
 struct GridSpec {

@@ -37,31 +37,13 @@ Projection::Projection(LocalGrid &grid, MPI_Comm comm, const Options &opt)
   if (opt.grain_pressure_acceleration) grad_acc_ext_.assign(3 * n, 0.0);
 }
 
-static std::vector<IndexBox> box_minus(const IndexBox &a, const IndexBox &b) {
-  std::vector<IndexBox> out;
-  if (a.empty()) return out;
-  const IndexBox c = a.cut(b);
-  if (c.empty()) return {a};
-  IndexBox rest = a;
-  for (int d = 2; d >= 0; --d) {
-    IndexBox lo = rest, hi = rest;
-    lo.hi[d] = c.lo[d] - 1;
-    hi.lo[d] = c.hi[d] + 1;
-    if (!lo.empty()) out.push_back(lo);
-    if (!hi.empty()) out.push_back(hi);
-    rest.lo[d] = c.lo[d];
-    rest.hi[d] = c.hi[d];
-  }
-  return out;
-}
-
 void Projection::retire(const IndexBox &work) {
   if (!have_prev_) return;
   const std::pair<std::vector<double> *, int> arrays[] = {
       {&u_, 3}, {&grad_, 3}, {&grad_ext_, 3}, {&rhs_, 1}, {&p_, 1}, {&p_ext_, 1},
       {&acc_, 3}, {&p_acc_, 1}, {&p_acc_ext_, 1}, {&grad_acc_, 3}, {&grad_acc_ext_, 3},
       {&fold_mass_, 1}, {&gk_, 1}, {&pk_, 1}};
-  const std::vector<IndexBox> gone = box_minus(work_prev_.cut(grid_.patch()), work);
+  const std::vector<IndexBox> gone = work_prev_.cut(grid_.patch()).minus(work);
   for (const auto &a : arrays) grid_.zero_boxes(*a.first, a.second, gone);  // (unused arrays are empty)
 }
 
