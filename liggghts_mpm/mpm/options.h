@@ -105,6 +105,9 @@ struct Options {
   bool grain_pressure_acceleration = true;   // grain_pressure acceleration (couple only): grains feel its gradient
   double pressure_average = 0.0;     // time: time constant of the averaged nodal pressure f_ID[19] (0: none)
   double volume_correction = 0.0;    // 1/time: rate at which compressed points are pushed apart (0: off)
+  // projection with the node surface (derived, no keyword): the rate at which the P2G velocity's
+  // divergence is removed at the film's front, sqrt(9.81 m/s^2 / cell) (0: removed within each step)
+  double front_rate = 0.0;
   // reports
   int front_axis = 0;
   int height_axis = 2, wall_axis = 0;

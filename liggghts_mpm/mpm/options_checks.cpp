@@ -299,6 +299,8 @@ void finish_options(Options &o, const std::vector<std::string> &seen, const bool
   // (g = 9.81 m/s^2, SI units; docs/theory/projection.md, "Volume over long runs")
   if (o.projection && std::find(seen.begin(), seen.end(), "volume_correction") == seen.end())
     o.volume_correction = std::sqrt(kVolumeCorrectionG / o.grid.dx);
+  // the node surface's film front: relaxed at the same rate (docs/theory/projection.md, "The step size")
+  o.front_rate = o.projection && !o.surface_ghost ? std::sqrt(kVolumeCorrectionG / o.grid.dx) : 0.0;
   o.eos.rho0 = o.rho0;
   o.eos.K = o.bulk;
   fit_grid(o, env);

@@ -125,11 +125,16 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   // pressure, and a wall node's velocity zeroed before it (normal or, no-slip, tangential) would
   // be moved again by the correction (measured: the F1 column at rest, docs/theory/projection.md).
   // Forwarded with the labels (one exchange), for solve_pressure.
+  const bool film = opt_.front_rate > 0.0;
+  if (film) u_old_.resize(3 * grid_.size(), 0.0);  // (outside a work box never read: EMPTY nodes)
   grid_.for_owned([&](int, int, int, std::size_t n) {
     const double *v = vel + VelRec::N * n + VelRec::V_NEW;
     for (int d = 0; d < 3; ++d) u_[3 * n + d] = v[d];
+    if (film)
+      for (int d = 0; d < 3; ++d) u_old_[3 * n + d] = v[VelRec::V_OLD - VelRec::V_NEW + d];
   });
-  make_labels(p2g, mmin, theta, bc.walls(), {u_.data(), 3});
+  make_labels(p2g, mmin, theta, bc.walls(), {u_.data(), 3}, {film ? u_old_.data() : nullptr, 3});
+  front_any_ = film && mark_front();
   const double hs = solve_pressure(vel, p2g, mmin, theta, h, step);
   correct_velocity(grid_, lab_, grad_.data(), inv_rho_.data(), hs, u_.data());
   if (exact_) exact_correction(vel, p2g, hs);
@@ -195,6 +200,12 @@ double Projection::solve_pressure(const double *vel, const double *p2g, double m
   exchange_weights(theta, p2g);
   if (exact_) add_grain_reaction(p2g, hs);
   pressure_rhs(grid_, lab_, geo_, u_.data(), th, theta_prev, h, rhs_.data());
+  // the film's front: the P2G velocity's divergence removed at the rate front_rate, not within the
+  // step (docs/theory/projection.md, "The step size"); u_old over s as u* has it
+  if (front_any_) {
+    const double f = std::min(h * opt_.front_rate, 1.0);
+    relax_front_source(grid_, lab_, geo_, front_.data(), u_old_.data(), th, (1.0 - f) / (s * h), rhs_.data());
+  }
   // grid damping c (update_grid): u* = (u_old + h f / m) / s, s = 1 + h c, and the step is
   // s u = u_old + h f / m - h grad p / rho, i.e. u = u* - (h / s) grad p / rho. The solve gives
   // that p (the source times s, the correction with h / s): the pressure of a damped fluid at

@@ -107,7 +107,14 @@ class Projection {
  private:
   // with: an array forwarded with the labels (NodeLabels::exchange)
   void make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls,
-                   LocalGrid::Field with = {nullptr, 0});
+                   LocalGrid::Field with = {nullptr, 0}, LocalGrid::Field with2 = {nullptr, 0});
+  // The film's front (node surface, Options::front_rate > 0): front_ set at the owned FLUID nodes
+  // that hold less than half a cell (make_labels) and have an open face to a dry EMPTY node; true if
+  // any. u_old_: the P2G velocity (owned nodes and halos, forwarded with the labels).
+  bool mark_front();
+  std::vector<std::uint8_t> front_;
+  std::vector<double> u_old_;
+  bool front_any_ = false;
   // project's steps. solve_pressure: u* from vel into u_, the solve into p_, its gradient grad_ and
   // the points' and grains' copies (p_ext_, grad_ext_); returns the step of the correction,
   // h / (1 + h damping). set_velocities: the projected velocity with the wall conditions into

@@ -98,6 +98,7 @@ void NodeLabels::reset(const LocalGrid &grid, const IndexBox *work) {
   if (work) grid.for_box(work->cut(pb), [&](int, int, int, std::size_t n) { kind[n] = kFluid; });
   closed.assign(grid.size(), 0);
   wet.clear();
+  dry.clear();
   wall_u.clear();
   if (!work) level.clear();  // with a work box the caller fills the level in the box (kept sized)
   // the padding: the slabs of the patch below node 0 and above node ncell of each non-periodic d
@@ -115,7 +116,7 @@ void NodeLabels::close_face(const LocalGrid &grid, int i, int j, int k, int d, d
   if (!wall_u.empty()) wall_u[3 * n + d] = wall_velocity;
 }
 
-void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm, LocalGrid::Field with) {
+void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm, LocalGrid::Field with, LocalGrid::Field with2) {
   // One forward of small integers packed in doubles (exact), with the wall velocities when some
   // rank has moving walls and the level set when there is one, all in one message per peer.
   // Only the nodes the forward reads or writes are packed and unpacked (a surface, not the patch).
@@ -125,14 +126,18 @@ void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm, LocalGrid::Field with)
   buf_.resize(grid.size());
   const std::vector<IndexBox> boxes = grid.exchanged_boxes();
   for (const IndexBox &b : boxes)
-    grid.for_box(b, [&](int, int, int, std::size_t n) { buf_[n] = kind[n] + 4.0 * closed[n] + (wet.empty() ? 0.0 : 256.0 * wet[n]); });
-  grid.forward({{buf_.data(), 1}, {any ? wall_u.data() : nullptr, 3}, {level.empty() ? nullptr : level.data(), 1}, with});
+    grid.for_box(b, [&](int, int, int, std::size_t n) {
+      buf_[n] = kind[n] + 4.0 * closed[n] + (wet.empty() ? 0.0 : 256.0 * wet[n]) + (dry.empty() ? 0.0 : 512.0 * dry[n]);
+    });
+  grid.forward({{buf_.data(), 1}, {any ? wall_u.data() : nullptr, 3}, {level.empty() ? nullptr : level.data(), 1}, with,
+                with2});
   for (const IndexBox &b : boxes)
     grid.for_box(b, [&](int, int, int, std::size_t n) {
       const int v = static_cast<int>(buf_[n]);
       kind[n] = std::uint8_t(v & 3);
       closed[n] = std::uint8_t((v >> 2) & 63);
-      if (!wet.empty()) wet[n] = std::uint8_t(v >> 8);
+      if (!wet.empty()) wet[n] = std::uint8_t((v >> 8) & 1);
+      if (!dry.empty()) dry[n] = std::uint8_t((v >> 9) & 1);
     });
 }
 
@@ -164,6 +169,16 @@ void pressure_rhs(const LocalGrid &grid, const NodeLabels &labels, const Project
     if (theta_prev) s += geo.volume(i, j, k) * (theta[n] - theta_prev[n]) / dt;
     rhs[n] = s / dt;
   });
+}
+
+void relax_front_source(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                        const std::uint8_t *front, const double *u_old, const double *theta, double c, double *rhs) {
+  const double s = c / grid.spec().dx;
+  for_faces_if(
+      grid, labels, geo, [&](int, int, int, std::size_t n) { return front[n] != 0; },
+      [&](std::size_t n, const Face &f, int d, int side) {
+        if (!f.wall) rhs[n] -= s * side * f.area * face_flux(labels, n, f, d, u_old, theta);
+      });
 }
 
 void acceleration_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,

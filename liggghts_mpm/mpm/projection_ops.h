@@ -39,6 +39,9 @@ struct NodeLabels {
   // mass up to 1.5 cells beyond the surface): their velocity takes part in the flux of their faces
   // to FLUID nodes (surface_weight). Empty: none (free_surface node, or set by the caller).
   std::vector<std::uint8_t> wet;
+  // Node surface (no level): 1 at the EMPTY nodes that hold no fluid (mass at most the threshold),
+  // for the film's front (Projection::mark_front). Empty: not kept (ghost surface).
+  std::vector<std::uint8_t> dry;
   std::vector<double> wall_u;
   // the velocity along +d through the grid face f = 2 d (low) or 2 d + 1 (high) of a face of a
   // node on it towards the padding or beyond the grid (keyword boundary ... inflow U; 0: at rest)
@@ -57,9 +60,10 @@ struct NodeLabels {
   // its size and values (the caller sets it in the box).
   void reset(const LocalGrid &grid, const IndexBox *work = nullptr);
   void close_face(const LocalGrid &grid, int i, int j, int k, int d, double wall_velocity = 0.0);
-  // Copies the owned nodes' labels into the halos (collective over the grid's comm); with: one
-  // more array forwarded in the same messages (none if its data is null).
-  void exchange(LocalGrid &grid, MPI_Comm comm, LocalGrid::Field with = {nullptr, 0});
+  // Copies the owned nodes' labels into the halos (collective over the grid's comm); with, with2:
+  // more arrays forwarded in the same messages (none if their data is null).
+  void exchange(LocalGrid &grid, MPI_Comm comm, LocalGrid::Field with = {nullptr, 0},
+                LocalGrid::Field with2 = {nullptr, 0});
 
  private:
   std::vector<double> buf_;  // exchange: kind and closed packed (only the exchanged nodes used)
@@ -207,6 +211,14 @@ void flux_divergence(const LocalGrid &grid, const NodeLabels &labels, const Proj
 // flux_divergence; theta_prev null: no d(theta)/dt term.
 void pressure_rhs(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
                   const double *u, const double *theta, const double *theta_prev, double dt, double *rhs);
+
+// The film's front (docs/theory/projection.md, "The step size"): at the owned nodes with front[n]
+// set, rhs_n -= c D'_n(u_old), D'_n the part of flux_divergence through the node's open faces (a
+// wall face's flux is the wall's and stays in full). With c = (1 - f) / (s h) the source there is
+// that of u* - (1 - f) u_old / s: the divergence of the step's increment removed in full, that of
+// the P2G velocity u_old the share f per step.
+void relax_front_source(const LocalGrid &grid, const NodeLabels &labels, const ProjectionGeometry &geo,
+                        const std::uint8_t *front, const double *u_old, const double *theta, double c, double *rhs);
 
 // Right-hand side of the pressure of an acceleration field a (keyword pressure_output
 // acceleration): rhs_n = D_n of flux_divergence with a for u, at the owned FLUID nodes (0

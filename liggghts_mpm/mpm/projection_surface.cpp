@@ -23,6 +23,9 @@ namespace {
 // leaves the column moving (0.07 m/s after 1 s) and the MPM16 dam-break front 0.39 a off; 0.25:
 // at rest to 1e-12 m/s, front 0.037 a (apic).
 constexpr double kSurfaceFill = 0.25;
+// The film's front (Projection::mark_front): a FLUID node holding less than this fraction of a full
+// cell next to a dry EMPTY node (docs/theory/projection.md, "The step size").
+constexpr double kFrontFill = 0.5;
 // Ghost surface: a node is FLUID when level_is_fluid(level) (projection_ops.h, kLevelTie). A fluid
 // filled up to a node plane gives its nodes a level of exactly 0 up to round-off; with 0 as the
 // bound they flipped between EMPTY and FLUID from step to step (F1 at rest: 2.6e-4 m/s after 1 s).
@@ -77,7 +80,7 @@ double surface_distance(double f, ShapeKind shape, int np) {
    wall at rest: the face between the last node on the fluid side and the next one (a gate through
    a node plane leaves that node on the fluid side, like a box wall through its nodes). */
 void Projection::make_labels(const double *p2g, double mmin, const double *theta, const WallGeometry *walls,
-                             LocalGrid::Field with) {
+                             LocalGrid::Field with, LocalGrid::Field with2) {
   const bool sparse = grid_.restricted();
   lab_.reset(grid_, sparse ? &work_ : nullptr);
   for (int f = 0; f < 6; ++f) lab_.grid_face_u[f] = opt_.face_velocity(f);
@@ -95,6 +98,12 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     grid_.for_owned([&](int, int, int, std::size_t n) { fold_mass_[n] = p2g[P2gRec::N * n + P2gRec::M]; });
     grid_.forward(fold_mass_.data(), 1);
   }
+  // the film's front: the candidates (under kFrontFill) and the dry nodes (outside a work box: dry)
+  const bool film = opt_.front_rate > 0.0;
+  if (film) {
+    front_.assign(grid_.size(), 0);
+    lab_.dry.assign(grid_.size(), 1);
+  }
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kSolid) return;
     const double m = p2g[P2gRec::N * n + P2gRec::M];
@@ -108,6 +117,10 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
       if (m <= mmin || m <= 0.0 || !level_is_fluid(lab_.level[n])) lab_.kind[n] = kEmpty;
     } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
       lab_.kind[n] = kEmpty;
+    }
+    if (film) {
+      lab_.dry[n] = m <= mmin || m <= 0.0;
+      front_[n] = fill < kFrontFill;
     }
     // the nodes on an outflow face hold p = 0 (a Dirichlet face: EMPTY, wet when they hold fluid);
     // those on an inflow face holding fluid are FLUID: the inflow's stream goes on behind the face,
@@ -139,7 +152,24 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     plane.hi[g.dim] = std::min(plane.hi[g.dim], lo);
     grid_.for_box(plane, [&](int i, int j, int k, std::size_t) { lab_.close_face(grid_, i, j, k, g.dim); });
   }
-  lab_.exchange(grid_, comm_, with);
+  lab_.exchange(grid_, comm_, with, with2);
+}
+
+bool Projection::mark_front() {
+  bool any = false;
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (!front_[n]) return;
+    bool edge = false;
+    if (lab_.kind[n] == kFluid)
+      for (int d = 0; d < 3 && !edge; ++d)
+        for (int side = -1; side <= 1 && !edge; side += 2) {
+          std::size_t m = n;
+          edge = open_face(grid_, lab_, i, j, k, d, side, &m) && lab_.kind[m] == kEmpty && lab_.dry[m];
+        }
+    front_[n] = edge;
+    any = any || edge;
+  });
+  return any;
 }
 
 /* The node mass with the mass of its mirror images behind the box walls added (the padding nodes

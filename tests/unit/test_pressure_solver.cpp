@@ -498,6 +498,58 @@ TEST(PressureSolver, MovingFloorLiftsTheColumn) {
   EXPECT_LT(dev, 1e-9 * w);
 }
 
+TEST(PressureSolver, FrontSourceIsThatOfTheRelaxedVelocity) {
+  // relax_front_source (the film's front, docs/theory/projection.md "The step size") against an
+  // independent form: the source of u* - (1 - f) u_old / s at the front nodes, that of u* elsewhere.
+  // Random u*, u_old and theta, an EMPTY region (the upper third), a moving floor (its flux is the
+  // wall's and stays in full) and a closed face inside the fluid.
+  mpm::GridSpec g = cube(8, 6, 9, 0.1);
+  Problem P(g, MPI_COMM_WORLD, 0.45);
+  const double dt = 2e-3, f = 0.3, s = 1.04, c = (1.0 - f) / (s * dt);
+  const std::size_t nn = P.grid.size();
+  std::vector<double> uo(3 * nn), mix(3 * nn);
+  std::vector<std::uint8_t> front(nn, 0);
+  P.each_patch([&](int i, int j, int k, std::size_t n) {
+    P.theta[n] = 0.5 + 0.5 * hash01(i, j, k, 7);
+    for (int d = 0; d < 3; ++d) {
+      P.u[3 * n + d] = hash01(i, j, k, 11 + d) - 0.5;
+      uo[3 * n + d] = hash01(i, j, k, 21 + d) - 0.5;
+      mix[3 * n + d] = P.u[3 * n + d] - (1.0 - f) * uo[3 * n + d] / s;
+    }
+    if (P.lab.kind[n] != kSolid && k >= 6) P.lab.kind[n] = kEmpty;
+  });
+  const mpm::IndexBox &pb = P.grid.patch();
+  if (pb.lo[2] <= -1)
+    for (int j = pb.lo[1]; j <= pb.hi[1]; ++j)
+      for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) P.lab.close_face(P.grid, i, j, -1, 2, 0.07);
+  P.grid.for_owned([&](int i, int j, int k, std::size_t) {
+    if (i == 3 && j == 2 && k == 1) P.lab.close_face(P.grid, i, j, k, 0);
+  });
+  P.lab.exchange(P.grid, MPI_COMM_WORLD);
+  // front: the top FLUID layer, every other node, and the nodes on the floor and beside the closed face
+  P.grid.for_owned([&](int i, int j, int k, std::size_t n) {
+    front[n] = P.lab.kind[n] == kFluid && ((k == 5 && (i + j) % 2 == 0) || k == 0 || (j == 2 && k == 1 && i >= 3));
+  });
+  std::vector<double> want(nn, 0.0);
+  mpm::pressure_rhs(P.grid, P.lab, P.geo, mix.data(), P.theta.data(), nullptr, dt, want.data());
+  std::vector<double> plain(nn, 0.0);
+  mpm::pressure_rhs(P.grid, P.lab, P.geo, P.u.data(), P.theta.data(), nullptr, dt, plain.data());
+  mpm::pressure_rhs(P.grid, P.lab, P.geo, P.u.data(), P.theta.data(), nullptr, dt, P.rhs.data());
+  mpm::relax_front_source(P.grid, P.lab, P.geo, front.data(), uo.data(), P.theta.data(), c, P.rhs.data());
+  long fronts = 0, moved = 0;
+  P.grid.for_owned([&](int, int, int, std::size_t n) {
+    fronts += front[n];
+    moved += std::fabs(P.rhs[n] - plain[n]) > 1e-9;
+  });
+  const double err = P.max_owned([&](int, int, int, std::size_t n) {
+    return std::fabs(P.rhs[n] - (front[n] ? want[n] : plain[n])) / (std::fabs(plain[n]) + 1.0);
+  });
+  if (root()) std::printf("[ front    ] relaxed source against that of the mixed velocity: %.2e\n", err);
+  EXPECT_LT(err, 1e-12);
+  EXPECT_GT(fronts, 0);
+  EXPECT_EQ(moved, fronts);  // (the front nodes only, each of them)
+}
+
 // ---- 3. Periodic dimension: an exact discrete eigenmode ------------------------------------
 
 // beta3 (per direction, the same at every node; null: beta in all three): the coefficients of the
