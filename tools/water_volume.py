@@ -1,0 +1,152 @@
+#!/usr/bin/env python3
+"""The water's volume over a run from the fix's HDF5 point files: the points' mass spread on the
+grid nodes by the quadratic B-spline (as the fix's P2G does), read where the water is deep (every
+node of the 3 x 3 x 3 block around the node holding at least `--deep` of a full cell, away from the
+walls). A point keeps its mass, so the water's volume is its mass over its density, and its density
+relative to rest is the mean fill of those nodes: the volume relative to the first file is the first
+file's mean fill over this file's. Also the occupied cells (cells holding a point) and the highest
+point, and with --rest AXIS C1 C2 R (a horizontal cylinder, z up: the jar) the volume the points'
+mean height gives when the water is at rest, a circular segment whose centroid is that height.
+
+    tools/python tools/water_volume.py RUNDIR --prefix jar --dx 0.005556 --ppc 1 \
+        [--origin 0 0 0] [--cylinder AXIS C1 C2 R] [--box LO HI LO HI LO HI] [--deep 0.9] [--rest AXIS C1 C2 R] [--csv out.csv]
+
+Equal point masses are assumed (a fluid filled without grains, one point spacing everywhere):
+with grains the fill's masses differ from point to point and are not in the files. --cylinder
+(the jar): nodes farther than R - 2 dx from the axis (AXIS x, y or z through C1 C2 in the other
+two coordinates) are not read; --box: nodes closer than 2 dx to these planes are not read.
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from mpm_io import h5_series, read_points, write_rows  # noqa: E402
+
+
+def bspline2(r):
+    """Quadratic B-spline of the offset r (cells)."""
+    a = np.abs(r)
+    return np.where(a < 0.5, 0.75 - a * a, np.where(a < 1.5, 0.5 * (1.5 - a) ** 2, 0.0))
+
+
+def node_fill(xyz, dx, origin, ppc):
+    """{node index (i, j, k): fill} of points of equal mass, ppc^3 of them per full cell."""
+    rel = (xyz - origin) / dx
+    base = np.floor(rel - 0.5).astype(int)  # lowest node of each point's 3-node stencil
+    fill = {}
+    w = [[bspline2(rel[:, d] - (base[:, d] + a)) for a in range(3)] for d in range(3)]
+    acc = np.zeros((len(xyz),))
+    keys = []
+    vals = []
+    for a in range(3):
+        for b in range(3):
+            for c in range(3):
+                acc = w[0][a] * w[1][b] * w[2][c] / ppc ** 3
+                keys.append(base + np.array([a, b, c]))
+                vals.append(acc)
+    k = np.concatenate(keys)
+    v = np.concatenate(vals)
+    uniq, inv = np.unique(k, axis=0, return_inverse=True)
+    s = np.bincount(inv.ravel(), weights=v)
+    for key, val in zip(map(tuple, uniq), s):
+        fill[key] = val
+    return fill
+
+
+def deep_fill(fill, dx, origin, deep, keep):
+    """Mean fill of the nodes whose 3 x 3 x 3 block all hold at least `deep` and that keep(x) allows;
+    (mean, count)."""
+    vals = []
+    offs = [(a, b, c) for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)]
+    for (i, j, k), f in fill.items():
+        if f < deep:
+            continue
+        x = origin + dx * np.array([i, j, k], dtype=float)
+        if not keep(x):
+            continue
+        if all(fill.get((i + a, j + b, k + c), 0.0) >= deep for a, b, c in offs):
+            vals.append(f)
+    return (float(np.mean(vals)) if vals else float("nan")), len(vals)
+
+
+def segment_area(zs, zc, R, n=4000):
+    """Area and centroid height of the part of a disc (centre height zc, radius R) below z = zs."""
+    z = np.linspace(zc - R, min(zs, zc + R), n)
+    w = 2.0 * np.sqrt(np.maximum(R * R - (z - zc) ** 2, 0.0))
+    a = np.trapezoid(w, z)
+    return a, (np.trapezoid(w * z, z) / a if a > 0 else zc - R)
+
+
+def rest_area(zmean, zc, R):
+    """The segment area whose centroid height is zmean (bisection on the surface height)."""
+    lo, hi = zc - R, zc + R
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if segment_area(mid, zc, R)[1] < zmean:
+            lo = mid
+        else:
+            hi = mid
+    return segment_area(0.5 * (lo + hi), zc, R)[0]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("rundir")
+    ap.add_argument("--prefix", default="jar")
+    ap.add_argument("--dx", type=float, required=True)
+    ap.add_argument("--ppc", type=int, default=1)
+    ap.add_argument("--origin", type=float, nargs=3, default=[0.0, 0.0, 0.0])
+    ap.add_argument("--cylinder", nargs=4, default=None, metavar=("AXIS", "C1", "C2", "R"))
+    ap.add_argument("--box", type=float, nargs=6, default=None)
+    ap.add_argument("--deep", type=float, default=0.9)
+    ap.add_argument("--rest", nargs=4, default=None, metavar=("AXIS", "C1", "C2", "R"))
+    ap.add_argument("--csv", default=None)
+    a = ap.parse_args()
+    origin = np.array(a.origin)
+    dx = a.dx
+
+    def keep(x):
+        if a.cylinder:
+            ax = "xyz".index(a.cylinder[0])
+            other = [d for d in range(3) if d != ax]
+            c = [float(a.cylinder[1]), float(a.cylinder[2])]
+            r = np.hypot(x[other[0]] - c[0], x[other[1]] - c[1])
+            if r > float(a.cylinder[3]) - 2.0 * dx:
+                return False
+        if a.box:
+            for d in range(3):
+                if x[d] < a.box[2 * d] + 2.0 * dx or x[d] > a.box[2 * d + 1] - 2.0 * dx:
+                    return False
+        return True
+
+    rows = []
+    first = None
+    first_area = None
+    for t, path in h5_series(a.rundir, a.prefix):
+        xyz, _, _ = read_points(path)
+        fill = node_fill(xyz, dx, origin, a.ppc)
+        mean, count = deep_fill(fill, dx, origin, a.deep, keep)
+        occ = len({tuple(q) for q in np.floor((xyz - origin) / dx).astype(int)})
+        if first is None:
+            first = mean
+        row = {"t": t, "points": len(xyz), "deep_nodes": count, "deep_fill": mean,
+               "volume_ratio": first / mean, "occupied_cells": occ, "z_max": float(xyz[:, 2].max())}
+        extra = ""
+        if a.rest:
+            area = rest_area(float(xyz[:, 2].mean()), float(a.rest[2]), float(a.rest[3]))
+            if first_area is None:
+                first_area = area
+            row["rest_volume_ratio"] = area / first_area
+            extra = f"  at rest: volume / first {area / first_area:.5f}"
+        rows.append(row)
+        print(f"t {t:8.4f}  deep nodes {count:5d}  fill {mean:.5f}  volume / first {first / mean:.5f}  "
+              f"occupied cells {occ}  highest point {row['z_max']:.5f} m" + extra, flush=True)
+    if a.csv:
+        write_rows(a.csv, rows)
+
+
+if __name__ == "__main__":
+    main()
