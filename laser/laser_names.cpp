@@ -53,15 +53,15 @@ void validate(Config& c) {
                      "(4-25), which --model conduction does not have), got --model conduction");
   // the heat Courant sub-steps split the face heat fluxes of the conservative flow: without
   // them (the ODE b2 of (4-25), or no melt flow) the option would change nothing
-  if (c.heat_courant > 0.0 && !c.flux_heat())
-    throw UsageError("--heat-courant: a value in (0, 10] splits the face heat fluxes of --melt-heat flux, which "
-                     "--melt-heat " + std::string(c.melt_heat == MeltHeat::Ode ? "ode" : "auto with --melt-flow text") +
+  if (c.heat_courant > 0.0 && (!c.flux_heat() || c.model == FlowModel::Conduction)) {
+    const bool fluxes = c.flux_heat();  // (then the missing part is the melt flow)
+    const std::string lacks = !fluxes ? "--melt-heat " + std::string(c.melt_heat == MeltHeat::Ode ? "ode" : "auto with --melt-flow text")
+                                      : std::string("--model conduction");
+    throw UsageError("--heat-courant: a value in (0, 10] splits the face heat fluxes of " +
+                     std::string(!fluxes ? "--melt-heat flux" : "a melt flow") + ", which " + lacks +
                      " does not have (the option would be inert); got --heat-courant " + fmt(c.heat_courant) +
                      " (0 = off is accepted)");
-  if (c.heat_courant > 0.0 && c.model == FlowModel::Conduction)
-    throw UsageError("--heat-courant: a value in (0, 10] splits the face heat fluxes of a melt flow, which --model "
-                     "conduction does not have (the option would be inert); got --heat-courant " +
-                     fmt(c.heat_courant) + " (0 = off is accepted)");
+  }
   if (c.dtau > 0.0) c.dt = c.dtau * c.R * c.R / (m.kl / (m.rho * m.cpl));
   if (c.dt > 0.0 && !(c.dt < c.tp))
     throw UsageError(std::string(c.dtau > 0 ? "--dtau" : "--dt") + ": the time step " + fmt(c.dt) +
