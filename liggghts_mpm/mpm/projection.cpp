@@ -128,10 +128,10 @@ void Projection::project(double *vel, const double *p2g, double mmin, const doub
   const bool film = opt_.front_rate > 0.0;
   if (film) u_old_.resize(3 * grid_.size(), 0.0);  // (outside a work box never read: EMPTY nodes)
   grid_.for_owned([&](int, int, int, std::size_t n) {
-    const double *v = vel + VelRec::N * n + VelRec::V_NEW;
-    for (int d = 0; d < 3; ++d) u_[3 * n + d] = v[d];
+    const double *v = vel + VelRec::N * n;
+    for (int d = 0; d < 3; ++d) u_[3 * n + d] = v[VelRec::V_NEW + d];
     if (film)
-      for (int d = 0; d < 3; ++d) u_old_[3 * n + d] = v[VelRec::V_OLD - VelRec::V_NEW + d];
+      for (int d = 0; d < 3; ++d) u_old_[3 * n + d] = v[VelRec::V_OLD + d];
   });
   make_labels(p2g, mmin, theta, bc.walls(), {u_.data(), 3}, {film ? u_old_.data() : nullptr, 3});
   front_any_ = film && mark_front();
