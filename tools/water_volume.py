@@ -36,24 +36,16 @@ def node_fill(xyz, dx, origin, ppc):
     """{node index (i, j, k): fill} of points of equal mass, ppc^3 of them per full cell."""
     rel = (xyz - origin) / dx
     base = np.floor(rel - 0.5).astype(int)  # lowest node of each point's 3-node stencil
-    fill = {}
     w = [[bspline2(rel[:, d] - (base[:, d] + a)) for a in range(3)] for d in range(3)]
-    acc = np.zeros((len(xyz),))
-    keys = []
-    vals = []
+    keys, vals = [], []
     for a in range(3):
         for b in range(3):
             for c in range(3):
-                acc = w[0][a] * w[1][b] * w[2][c] / ppc ** 3
                 keys.append(base + np.array([a, b, c]))
-                vals.append(acc)
-    k = np.concatenate(keys)
-    v = np.concatenate(vals)
-    uniq, inv = np.unique(k, axis=0, return_inverse=True)
-    s = np.bincount(inv.ravel(), weights=v)
-    for key, val in zip(map(tuple, uniq), s):
-        fill[key] = val
-    return fill
+                vals.append(w[0][a] * w[1][b] * w[2][c] / ppc ** 3)
+    uniq, inv = np.unique(np.concatenate(keys), axis=0, return_inverse=True)
+    s = np.bincount(inv.ravel(), weights=np.concatenate(vals))
+    return dict(zip(map(tuple, uniq), s))
 
 
 def deep_fill(fill, dx, origin, deep, keep):
