@@ -324,6 +324,49 @@ TEST(LaserLaws, LayerContentBalancesTheColumn) {
   EXPECT_GT(checked, 100);
 }
 
+// solve_interface_flux and solve_interface compute the state at their root from one
+// exponential of the vapour pressure, one 1 - exp(-Pe) and the beam once per solve, shared
+// between the flow's part, the gradients, the pressure and the residual: the result is the
+// same to the last bit as the public laws evaluated one by one at the returned phi (b2 from
+// the content of the layer's profile, interface_at, advected_residual / interface_residual).
+TEST(LaserLaws, FluxInterfaceSharesItsExponentials) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  int hot = 0;
+  for (bool adv : {false, true}) {
+    for (double xi : {0.0, 0.8, 1.7}) {
+      for (double g : {1e-3, 2e-2, 8e-2}) {
+        for (auto [beta, gamma] : {std::pair{0.0, 0.0}, {50.0, 0.0}, {5e3, 10.0}, {200.0, 300.0}}) {
+          for (double kappa : {0.0, 2.0, 500.0}) {
+            const double H_old = 0.05 * g;
+            const InterfaceState s = solve_interface_flux(G, xi, g, beta, gamma, adv, kappa, H_old);
+            const double th = s.theta_sat;
+            const double cont = layer_content(interface_at(G, s.phi, g, 0.0, adv), g, 0.0);
+            const double b2 = (beta * th - gamma + (kappa > 0.0 ? kappa * (cont - H_old) : 0.0)) / g;
+            const InterfaceState r = interface_at(G, s.phi, g, b2, adv);
+            EXPECT_EQ(s.grad_top, r.grad_top) << adv << " " << xi << " " << g << " " << beta << " " << kappa;
+            EXPECT_EQ(s.grad_bottom, r.grad_bottom);
+            EXPECT_EQ(s.p_pa, r.p_pa);
+            EXPECT_EQ(s.p_star, r.p_star);
+            EXPECT_EQ(s.w, r.w);
+            EXPECT_EQ(s.peclet, r.peclet);
+            const double E = gaussian_beam(xi);
+            const double res = adv ? advected_residual(G, s.phi, xi, g, b2, nullptr)
+                                   : interface_residual(G, s.phi, xi, g, b2);
+            EXPECT_EQ(s.residual, res / E);
+            EXPECT_LT(std::fabs(s.residual), 1e-10);
+            if (th > 0.0 && b2 != 0.0 && (!adv || s.peclet > 1e-3)) ++hot;
+            // the plain solve: its residual with the beam computed once is the law's
+            const InterfaceState p = solve_interface(G, xi, g, b2, adv);
+            if (p.theta_sat > 0.0 && !adv) EXPECT_EQ(p.residual, interface_residual(G, p.phi, xi, g, b2) / E);
+            if (p.theta_sat > 0.0 && adv) EXPECT_NEAR(p.residual, advected_residual(G, p.phi, xi, g, b2, nullptr) / E, 1e-15);
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(hot, 40);
+}
+
 // What the curvature clamp hides at Pr 1420 (docs section 3, "The cusp on the axis"):
 // (3-37) as printed gives a node deeper than both neighbours (a > 0) C_c < 1, i.e. less
 // heat drawn into the solid, so it melts faster than its shallower neighbours (a < 0,
