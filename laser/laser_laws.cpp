@@ -239,17 +239,16 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
         return advected ? advected_residual_of(G, vapour_parts(G, phi, df != nullptr), phi, E, g, b2, df)
                         : interface_residual_e(G, phi, E, g, b2, df);
       };
-      if (residual(hi, nullptr) > 0.0) {
-        auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
-        // residual(theta_m) = r0 < 0 < residual(hi): the bracket's signs are known
-        const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
-        s.phi = rr.x;
-        s.iterations = rr.iterations;
-        s.converged = rr.converged;
-      } else {
-        // hi - theta_m below round-off (very thin layer): the conduction root.
-        s.phi = hi;
-      }
+      // residual(theta_m) = r0 < 0 < residual(hi): at hi the conduction term is avail, so the
+      // residual is the vapour term there (>= vapour_melt > 0) plus k' theta_sat/g (F - 1) >= 0.
+      // The bracket's signs are known and residual(hi) is not evaluated: where hi - theta_m is
+      // below round-off (a very thin layer) the rounding of theta_sat can make it <= 0, and the
+      // iteration then ends within its tolerance of hi, the conduction root.
+      auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
+      const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
+      s.phi = rr.x;
+      s.iterations = rr.iterations;
+      s.converged = rr.converged;
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
       if (advected) {
         // vapour term, recession rate and pressure from one exponential (the expressions of
@@ -346,13 +345,11 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
     };
     // vapour term >= 0, F >= 1, content0 >= 0: theta_sat <= avail / (k' (1/g + beta))
     const double hi = G.theta_m + avail * (1.0 - G.theta_m) / (G.kprime * (1.0 / g + beta));
-    if (residual(hi, nullptr) > 0.0) {
-      auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
-      rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);  // signs checked above
-      phi = rr.x;
-    } else {
-      phi = hi;
-    }
+    // at hi: residual = vapour term + k' theta_sat/g (F - 1) + k' kappa content0 > 0, as in
+    // solve_interface (not evaluated; below round-off the iteration ends at hi)
+    auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
+    rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
+    phi = rr.x;
   }
   // the state at the root from one exponential of the vapour pressure and one 1 - exp(-Pe):
   // the values of flow_part, interface_at and advected_residual at phi, each of which would

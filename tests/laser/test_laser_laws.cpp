@@ -367,6 +367,34 @@ TEST(LaserLaws, FluxInterfaceSharesItsExponentials) {
   EXPECT_GT(hot, 40);
 }
 
+// The interface solves do not evaluate the residual at the upper end of their bracket
+// (positive there: the vapour term plus k' theta_sat/g (F - 1)). For layers so thin that
+// hi - theta_m is at or below round-off, the root is the conduction root hi to the
+// iteration's tolerance, converged, for both layers and with the face heat fluxes.
+TEST(LaserLaws, VeryThinLayersEndAtTheConductionRoot) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  int checked = 0;
+  for (bool adv : {false, true})
+    for (double xi : {0.0, 1.2})
+      for (double g : {1e-10, 1e-13, 1e-15, 1e-17, 1e-19}) {
+        const double E = gaussian_beam(xi);
+        const double hi = G.theta_m + E * g * (1.0 - G.theta_m) / G.kprime;
+        const InterfaceState s = solve_interface(G, xi, g, 0.0, adv);
+        EXPECT_TRUE(s.converged) << adv << " " << g;
+        EXPECT_LE(s.phi, hi) << adv << " " << g;
+        EXPECT_GE(s.phi, G.theta_m);
+        // the vapour term is at most vapour_melt-sized here: phi lies below hi by about
+        // vapour_melt g (1 - theta_m) / k', or within the tolerance 1e-15 hi
+        EXPECT_NEAR(s.phi, hi, 2e-15 * hi + 2.0 * G.vapour_melt * g * (1.0 - G.theta_m) / G.kprime) << adv << " " << g;
+        const InterfaceState f = solve_interface_flux(G, xi, g, 10.0, 0.0, adv, 0.0, 0.0);
+        const double hif = G.theta_m + E * (1.0 - G.theta_m) / (G.kprime * (1.0 / g + 10.0));
+        EXPECT_TRUE(f.converged);
+        EXPECT_NEAR(f.phi, hif, 2e-15 * hif + 2.0 * G.vapour_melt * g * (1.0 - G.theta_m) / G.kprime);
+        ++checked;
+      }
+  EXPECT_EQ(checked, 20);
+}
+
 // What the curvature clamp hides at Pr 1420 (docs section 3, "The cusp on the axis"):
 // (3-37) as printed gives a node deeper than both neighbours (a > 0) C_c < 1, i.e. less
 // heat drawn into the solid, so it melts faster than its shallower neighbours (a < 0,
