@@ -241,14 +241,21 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       };
       // residual(theta_m) = r0 < 0 < residual(hi): at hi the conduction term is avail, so the
       // residual is the vapour term there (>= vapour_melt > 0) plus k' theta_sat/g (F - 1) >= 0.
-      // The bracket's signs are known and residual(hi) is not evaluated: where hi - theta_m is
-      // below round-off (a very thin layer) the rounding of theta_sat can make it <= 0, and the
-      // iteration then ends within its tolerance of hi, the conduction root.
-      auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
-      const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
-      s.phi = rr.x;
-      s.iterations = rr.iterations;
-      s.converged = rr.converged;
+      // It is therefore not evaluated where vapour_melt is a normal number: where hi - theta_m
+      // is below round-off (a very thin layer) the rounding of theta_sat can make it <= 0, and
+      // the iteration then ends within its tolerance of hi, the conduction root. Where the
+      // vapour term at T_m underflows (latent heats far beyond a metal's) it can jump from 0 to
+      // inf inside the bracket, and the sign at hi is checked.
+      if (std::isnormal(G.vapour_melt) || residual(hi, nullptr) > 0.0) {
+        auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
+        const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
+        s.phi = rr.x;
+        s.iterations = rr.iterations;
+        s.converged = rr.converged;
+      } else {
+        // the conduction root
+        s.phi = hi;
+      }
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
       if (advected) {
         // vapour term, recession rate and pressure from one exponential (the expressions of
@@ -345,11 +352,15 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
     };
     // vapour term >= 0, F >= 1, content0 >= 0: theta_sat <= avail / (k' (1/g + beta))
     const double hi = G.theta_m + avail * (1.0 - G.theta_m) / (G.kprime * (1.0 / g + beta));
-    // at hi: residual = vapour term + k' theta_sat/g (F - 1) + k' kappa content0 > 0, as in
-    // solve_interface (not evaluated; below round-off the iteration ends at hi)
-    auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
-    rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
-    phi = rr.x;
+    // at hi: residual = vapour term + k' theta_sat/g (F - 1) + k' kappa content0 > 0, evaluated
+    // only where vapour_melt underflows, as in solve_interface
+    if (std::isnormal(G.vapour_melt) || residual(hi, nullptr) > 0.0) {
+      auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
+      rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
+      phi = rr.x;
+    } else {
+      phi = hi;
+    }
   }
   // the state at the root from one exponential of the vapour pressure and one 1 - exp(-Pe):
   // the values of flow_part, interface_at and advected_residual at phi, each of which would
