@@ -6,77 +6,6 @@
 
 namespace laser {
 
-RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf, double lo,
-                       double hi, double xtol, int maxit, double x0, bool signs_known) {
-  RootResult r;
-  double flo = -1.0, fhi = 1.0, d;
-  if (!signs_known) {
-    fdf(lo, flo, d);
-    fdf(hi, fhi, d);
-  }
-  if (flo == 0.0) { r.x = lo; r.converged = true; return r; }
-  if (fhi == 0.0) { r.x = hi; r.converged = true; return r; }
-  if ((flo > 0.0) == (fhi > 0.0) || !std::isfinite(flo) || !std::isfinite(fhi)) {
-    r.x = std::numeric_limits<double>::quiet_NaN();
-    return r;
-  }
-  if (flo > 0.0) std::swap(lo, hi);  // orient so that f(lo) < 0 < f(hi)
-  const bool inside = x0 > std::min(lo, hi) && x0 < std::max(lo, hi);
-  double x = inside ? x0 : 0.5 * (lo + hi), dxold = std::fabs(hi - lo), dx = dxold;
-  double f, df;
-  fdf(x, f, df);
-  for (int it = 1; it <= maxit; ++it) {
-    r.iterations = it;
-    const bool newton_leaves = ((x - hi) * df - f) * ((x - lo) * df - f) > 0.0;
-    const bool too_slow = std::fabs(2.0 * f) > std::fabs(dxold * df);
-    dxold = dx;
-    if (newton_leaves || too_slow || !std::isfinite(df) || df == 0.0) {
-      dx = 0.5 * (hi - lo);
-      x = lo + dx;
-    } else {
-      dx = f / df;
-      x -= dx;
-    }
-    if (std::fabs(dx) <= xtol) { r.converged = true; break; }
-    fdf(x, f, df);
-    if (f == 0.0) { r.converged = true; break; }
-    if (f < 0.0) lo = x; else hi = x;
-    if (std::fabs(hi - lo) <= xtol) { r.converged = true; break; }
-  }
-  r.x = x;
-  return r;
-}
-
-RootResult illinois_root(const std::function<double(double)>& f, double a, double b, double fa,
-                         double fb, double xtol, int maxit, double ftol) {
-  RootResult r;
-  if ((fa > 0.0) == (fb > 0.0) && fa != 0.0 && fb != 0.0) {
-    r.x = std::numeric_limits<double>::quiet_NaN();
-    return r;
-  }
-  int side = 0;
-  double c = a;
-  for (int it = 1; it <= maxit; ++it) {
-    r.iterations = it;
-    c = (fa * b - fb * a) / (fa - fb);
-    if (!(c > std::min(a, b) && c < std::max(a, b))) c = 0.5 * (a + b);
-    const double fc = f(c);
-    if (std::fabs(fc) <= ftol || std::fabs(b - a) <= xtol) { r.converged = true; break; }
-    if ((fc > 0.0) == (fb > 0.0)) {
-      b = c; fb = fc;
-      if (side == -1) fa *= 0.5;
-      side = -1;
-    } else {
-      a = c; fa = fc;
-      if (side == 1) fb *= 0.5;
-      side = 1;
-    }
-    if (std::fabs(b - a) <= xtol) { r.converged = true; break; }
-  }
-  r.x = c;
-  return r;
-}
-
 Groups make_groups(const Material& m, double I0, double R) {
   Groups G;
   G.dT = m.Tsat0 - m.Tm;
@@ -117,13 +46,20 @@ inline double vapour_term(const Groups& G, double phi, double* dterm) {
 }
 }  // namespace
 
-double interface_residual(const Groups& G, double phi, double xi, double g, double b2,
-                          double* dres) {
+namespace {
+// interface_residual with the beam E = exp(-xi^2) given (computed once per solve)
+double interface_residual_e(const Groups& G, double phi, double E, double g, double b2, double* dres) {
   double dv = 0;
   const double v = vapour_term(G, phi, dres ? &dv : nullptr);
   const double c = G.kprime / (g * (1.0 - G.theta_m));
   if (dres) *dres = dv + c;
-  return v + c * (phi - G.theta_m) + G.kprime * b2 * g - gaussian_beam(xi);
+  return v + c * (phi - G.theta_m) + G.kprime * b2 * g - E;
+}
+}  // namespace
+
+double interface_residual(const Groups& G, double phi, double xi, double g, double b2,
+                          double* dres) {
+  return interface_residual_e(G, phi, gaussian_beam(xi), g, b2, dres);
 }
 
 double peclet_factor(double Pe) {
@@ -136,10 +72,12 @@ namespace {
 // N_i v - Psi p* sqrt(phi) with its derivative, from one exponential.
 struct VapourParts {
   double v = 0, dv = 0, w = 0, dw = 0;  // w, dw: not clipped at 0
+  double e = 0;                         // exp(H_lv (1 - 1/phi)) = p / p0
 };
 VapourParts vapour_parts(const Groups& G, double phi, bool deriv) {
   VapourParts q;
   const double e = std::exp(G.Hlv * (1.0 - 1.0 / phi));
+  q.e = e;
   const double sq = std::sqrt(phi);
   q.v = e * (1.0 + G.Lambda * phi) / (G.Iprime * sq);
   const double p_star = G.p0 * e / G.p_scale;
@@ -150,13 +88,15 @@ VapourParts vapour_parts(const Groups& G, double phi, bool deriv) {
   }
   return q;
 }
-// advected_residual from the vapour parts at phi
-double advected_residual_of(const Groups& G, const VapourParts& q, double phi, double xi, double g, double b2,
-                            double* dres) {
+// advected_residual from the vapour parts at phi and the beam E = exp(-xi^2); em_out
+// receives 1 - exp(-Pe), which content_factor and interface_at use at the same Pe
+double advected_residual_of(const Groups& G, const VapourParts& q, double phi, double E, double g, double b2,
+                            double* dres, double* em_out = nullptr) {
   const double th = (phi - G.theta_m) / (1.0 - G.theta_m);
   const double w = std::max(q.w, 0.0);
   const double Pe = w * g;
   const double em = -std::expm1(-Pe);  // 1 - exp(-Pe)
+  if (em_out) *em_out = em;
   const double F = Pe < 1e-6 ? 1.0 + 0.5 * Pe : Pe / em;
   if (dres) {
     const double dw = w > 0.0 ? q.dw : 0.0;
@@ -164,7 +104,7 @@ double advected_residual_of(const Groups& G, const VapourParts& q, double phi, d
     const double dF = Pe < 1e-6 ? 0.5 : (em - Pe * (1.0 - em)) / (em * em);
     *dres = q.dv + G.kprime * (F / (g * (1.0 - G.theta_m)) + th * dF * dw);
   }
-  return q.v + G.kprime * (th / g * F + b2 * g) - gaussian_beam(xi);
+  return q.v + G.kprime * (th / g * F + b2 * g) - E;
 }
 }  // namespace
 
@@ -176,24 +116,34 @@ double flux_recession_rate(const Groups& G, double phi, double* dw) {
 
 double advected_residual(const Groups& G, double phi, double xi, double g, double b2, double* dres) {
   // one exponential for the vapour term, the pressure and the flux velocity
-  return advected_residual_of(G, vapour_parts(G, phi, dres != nullptr), phi, xi, g, b2, dres);
+  return advected_residual_of(G, vapour_parts(G, phi, dres != nullptr), phi, gaussian_beam(xi), g, b2, dres);
 }
 
-InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bool advected) {
+namespace {
+// interface_at from the vapour parts q at phi (their exponential gives the pressure) and, where
+// the caller has it, em = 1 - exp(-Pe) at the layer's Pe (else computed, as peclet_factor does)
+InterfaceState interface_at_q(const Groups& G, const VapourParts& q, double phi, double g, double b2, bool advected,
+                              const double* em = nullptr) {
   InterfaceState s;
   s.phi = phi;
   s.theta_sat = (phi - G.theta_m) / (1.0 - G.theta_m);
   double F = 1.0;
   if (advected) {
-    s.w = std::max(flux_recession_rate(G, phi), 0.0);
+    s.w = std::max(q.w, 0.0);
     s.peclet = s.w * g;
-    F = peclet_factor(s.peclet);
+    // peclet_factor(Pe) for Pe >= 0
+    F = s.peclet < 1e-6 ? 1.0 + 0.5 * s.peclet : s.peclet / (em ? *em : -std::expm1(-s.peclet));
   }
   s.grad_top = s.theta_sat / g * F + b2 * g;
   s.grad_bottom = s.theta_sat / g * F * std::exp(-s.peclet) - b2 * g;
-  s.p_pa = G.p0 * std::exp(G.Hlv * (1.0 - 1.0 / phi));
+  s.p_pa = G.p0 * q.e;
   s.p_star = s.p_pa / G.p_scale;
   return s;
+}
+}  // namespace
+
+InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bool advected) {
+  return interface_at_q(G, vapour_parts(G, phi, false), phi, g, b2, advected);
 }
 
 InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected, double phi_guess) {
@@ -215,17 +165,24 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       // Advected layer: vapour + k' (theta_sat/g F(w(phi) g) + b2 g) - beam; every
       // term rises with phi and F >= 1, so the linear layer's bracket [theta_m, hi] holds.
       auto residual = [&](double phi, double* df) {
-        return advected ? advected_residual(G, phi, xi, g, b2, df) : interface_residual(G, phi, xi, g, b2, df);
+        return advected ? advected_residual_of(G, vapour_parts(G, phi, df != nullptr), phi, E, g, b2, df)
+                        : interface_residual_e(G, phi, E, g, b2, df);
       };
-      if (residual(hi, nullptr) > 0.0) {
+      // residual(theta_m) = r0 < 0 < residual(hi): at hi the conduction term is avail, so the
+      // residual is the vapour term there (>= vapour_melt > 0) plus k' theta_sat/g (F - 1) >= 0.
+      // It is therefore not evaluated where vapour_melt is a normal number: where hi - theta_m
+      // is below round-off (a very thin layer) the rounding of theta_sat can make it <= 0, and
+      // the iteration then ends within its tolerance of hi, the conduction root. Where the
+      // vapour term at T_m underflows (latent heats far beyond a metal's) it can jump from 0 to
+      // inf inside the bracket, and the sign at hi is checked.
+      if (std::isnormal(G.vapour_melt) || residual(hi, nullptr) > 0.0) {
         auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
-        // residual(theta_m) = r0 < 0 < residual(hi): the bracket's signs are known
         const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
         s.phi = rr.x;
         s.iterations = rr.iterations;
         s.converged = rr.converged;
       } else {
-        // hi - theta_m below round-off (very thin layer): the conduction root.
+        // the conduction root
         s.phi = hi;
       }
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
@@ -244,7 +201,7 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
         s.p_star = s.p_pa / G.p_scale;
         return s;
       } else {
-        s.residual = interface_residual(G, s.phi, xi, g, b2) / E;
+        s.residual = interface_residual_e(G, s.phi, E, g, b2, nullptr) / E;
       }
     }
     s.grad_top = s.theta_sat / g * F + b2 * g;
@@ -255,15 +212,21 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
   return s;
 }
 
-double content_factor(double Pe, double* dc) {
+namespace {
+// content_factor with em = 1 - exp(-Pe) given where the caller has it (the residual of the
+// advected layer computes it at the same Pe)
+double content_factor_em(double Pe, double* dc, const double* em) {
   if (Pe < 1e-3) {  // series of 1/Pe - 1/(e^Pe - 1)
     if (dc) *dc = -1.0 / 12.0 + Pe * Pe / 240.0;
     return 0.5 - Pe / 12.0 + Pe * Pe * Pe / 720.0;
   }
   const double em1 = std::expm1(Pe);  // e^Pe - 1
-  if (dc) *dc = -1.0 / (Pe * Pe) + (std::isfinite(em1) ? 1.0 / (em1 * -std::expm1(-Pe)) : 0.0);
+  if (dc) *dc = -1.0 / (Pe * Pe) + (std::isfinite(em1) ? 1.0 / (em1 * (em ? *em : -std::expm1(-Pe))) : 0.0);
   return 1.0 / Pe - (std::isfinite(em1) ? 1.0 / em1 : 0.0);
 }
+}  // namespace
+
+double content_factor(double Pe, double* dc) { return content_factor_em(Pe, dc, nullptr); }
 
 double layer_content(const InterfaceState& s, double g, double b2) {
   return s.theta_sat * g * content_factor(s.peclet) - b2 * g * g * g / 6.0;
@@ -275,8 +238,9 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
   const double E = gaussian_beam(xi);
   // content0(phi) = theta_sat g c(Pe(phi)) >= 0, so the flow's part is >= beta theta_sat - gamma - kappa H_old
   const double avail = E + G.kprime * (gamma + kappa * H_old);
-  // q: the vapour parts at p where the caller has them (one exponential per evaluation)
-  auto content0 = [&](double p, double* dcont, const VapourParts* q) {
+  // q: the vapour parts at p where the caller has them (one exponential per evaluation); em:
+  // 1 - exp(-Pe) at p where the caller has it
+  auto content0 = [&](double p, double* dcont, const VapourParts* q, const double* em) {
     const double th = (p - G.theta_m) / (1.0 - G.theta_m);
     double c = 0.5, dc = 0.0, Pe = 0.0, dw = 0.0;
     if (advected) {
@@ -285,15 +249,15 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
       dw = qp.dw;
       Pe = std::max(w, 0.0) * g;
       if (!(w > 0.0)) dw = 0.0;
-      c = content_factor(Pe, &dc);
+      c = content_factor_em(Pe, &dc, em);
     }
     if (dcont) *dcont = g * (c / (1.0 - G.theta_m) + th * dc * g * dw);
     return th * g * c;
   };
-  auto flow_part = [&](double p, double* dpart, const VapourParts* q) {  // b2 g
+  auto flow_part = [&](double p, double* dpart, const VapourParts* q, const double* em) {  // b2 g
     const double th = (p - G.theta_m) / (1.0 - G.theta_m);
     double dcont = 0.0;
-    const double cont = kappa > 0.0 ? content0(p, dpart ? &dcont : nullptr, q) : 0.0;
+    const double cont = kappa > 0.0 ? content0(p, dpart ? &dcont : nullptr, q, em) : 0.0;
     if (dpart) *dpart = beta / (1.0 - G.theta_m) + kappa * dcont;
     return beta * th - gamma + (kappa > 0.0 ? kappa * (cont - H_old) : 0.0);
   };
@@ -302,34 +266,45 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
   rr.converged = true;
   if (G.vapour_melt - avail < 0.0) {
     auto residual = [&](double p, double* df) {
-      double r;
+      double r, em = 0.0;
       VapourParts q;
       if (advected) {
         q = vapour_parts(G, p, true);
-        r = advected_residual_of(G, q, p, xi, g, 0.0, df);
+        r = advected_residual_of(G, q, p, E, g, 0.0, df, &em);
       } else {
-        r = interface_residual(G, p, xi, g, 0.0, df);
+        r = interface_residual_e(G, p, E, g, 0.0, df);
       }
       double dpart = 0.0;
-      const double part = flow_part(p, df ? &dpart : nullptr, advected ? &q : nullptr);
+      const double part = flow_part(p, df ? &dpart : nullptr, advected ? &q : nullptr, advected ? &em : nullptr);
       if (df) *df += G.kprime * dpart;
       return r + G.kprime * part;
     };
     // vapour term >= 0, F >= 1, content0 >= 0: theta_sat <= avail / (k' (1/g + beta))
     const double hi = G.theta_m + avail * (1.0 - G.theta_m) / (G.kprime * (1.0 / g + beta));
-    if (residual(hi, nullptr) > 0.0) {
+    // at hi: residual = vapour term + k' theta_sat/g (F - 1) + k' kappa content0 > 0, evaluated
+    // only where vapour_melt underflows, as in solve_interface
+    if (std::isnormal(G.vapour_melt) || residual(hi, nullptr) > 0.0) {
       auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
-      rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);  // signs checked above
+      rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
       phi = rr.x;
     } else {
       phi = hi;
     }
   }
-  const double b2 = flow_part(phi, nullptr, nullptr) / g;
-  InterfaceState s = interface_at(G, phi, g, b2, advected);
+  // the state at the root from one exponential of the vapour pressure and one 1 - exp(-Pe):
+  // the values of flow_part, interface_at and advected_residual at phi, each of which would
+  // compute them again (test LaserLaws.FluxInterfaceSharesItsExponentials)
+  const VapourParts q = vapour_parts(G, phi, true);
+  const double b2 = flow_part(phi, nullptr, advected ? &q : nullptr, nullptr) / g;
+  double res, em = 0.0;
+  if (advected) {
+    res = advected_residual_of(G, q, phi, E, g, b2, nullptr, &em);
+  } else {
+    res = interface_residual_e(G, phi, E, g, b2, nullptr);
+  }
+  InterfaceState s = interface_at_q(G, q, phi, g, b2, advected, advected ? &em : nullptr);
   s.iterations = rr.iterations;
   s.converged = rr.converged;
-  const double res = advected ? advected_residual(G, phi, xi, g, b2, nullptr) : interface_residual(G, phi, xi, g, b2);
   s.residual = res / E;
   return s;
 }

@@ -2,11 +2,13 @@
 // kept apart from the time stepping so that each can be tested on its own.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 
 namespace laser {
 
@@ -26,15 +28,93 @@ struct RootResult {
 // fast enough, is replaced by bisection, so the iteration never diverges. It starts
 // from x0 where x0 lies inside the bracket, else from its midpoint. signs_known: the
 // caller has checked f(lo) < 0 < f(hi), and the ends are not evaluated again.
-RootResult safe_newton(const std::function<void(double, double&, double&)>& fdf,
-                       double lo, double hi, double xtol, int maxit = 200,
+// (A template, so that the callers' lambdas are called directly: the same arithmetic as
+// through std::function, without its indirection and allocation.)
+template <class FDF>
+RootResult safe_newton(const FDF& fdf, double lo, double hi, double xtol, int maxit = 200,
                        double x0 = std::numeric_limits<double>::quiet_NaN(), bool signs_known = false);
 
 // Derivative-free bracketed root (Illinois variant of regula falsi): f(a) and
 // f(b) of opposite sign; superlinear and never leaves [a, b]. Stops when the bracket is
 // below xtol or |f| <= ftol (for f' >= 1, |f(x)| bounds the distance to the root).
-RootResult illinois_root(const std::function<double(double)>& f, double a, double b, double fa,
-                         double fb, double xtol, int maxit = 200, double ftol = 0.0);
+template <class Fn>
+RootResult illinois_root(const Fn& f, double a, double b, double fa, double fb, double xtol, int maxit = 200,
+                         double ftol = 0.0);
+
+// ---- definitions of the two templates
+template <class FDF>
+RootResult safe_newton(const FDF& fdf, double lo, double hi, double xtol, int maxit,
+                       double x0, bool signs_known) {
+  RootResult r;
+  double flo = -1.0, fhi = 1.0, d;
+  if (!signs_known) {
+    fdf(lo, flo, d);
+    fdf(hi, fhi, d);
+  }
+  if (flo == 0.0) { r.x = lo; r.converged = true; return r; }
+  if (fhi == 0.0) { r.x = hi; r.converged = true; return r; }
+  if ((flo > 0.0) == (fhi > 0.0) || !std::isfinite(flo) || !std::isfinite(fhi)) {
+    r.x = std::numeric_limits<double>::quiet_NaN();
+    return r;
+  }
+  if (flo > 0.0) std::swap(lo, hi);  // orient so that f(lo) < 0 < f(hi)
+  const bool inside = x0 > std::min(lo, hi) && x0 < std::max(lo, hi);
+  double x = inside ? x0 : 0.5 * (lo + hi), dxold = std::fabs(hi - lo), dx = dxold;
+  double f, df;
+  fdf(x, f, df);
+  for (int it = 1; it <= maxit; ++it) {
+    r.iterations = it;
+    const bool newton_leaves = ((x - hi) * df - f) * ((x - lo) * df - f) > 0.0;
+    const bool too_slow = std::fabs(2.0 * f) > std::fabs(dxold * df);
+    dxold = dx;
+    if (newton_leaves || too_slow || !std::isfinite(df) || df == 0.0) {
+      dx = 0.5 * (hi - lo);
+      x = lo + dx;
+    } else {
+      dx = f / df;
+      x -= dx;
+    }
+    if (std::fabs(dx) <= xtol) { r.converged = true; break; }
+    fdf(x, f, df);
+    if (f == 0.0) { r.converged = true; break; }
+    if (f < 0.0) lo = x; else hi = x;
+    if (std::fabs(hi - lo) <= xtol) { r.converged = true; break; }
+  }
+  r.x = x;
+  return r;
+}
+
+template <class Fn>
+RootResult illinois_root(const Fn& f, double a, double b, double fa, double fb, double xtol, int maxit,
+                         double ftol) {
+  RootResult r;
+  if ((fa > 0.0) == (fb > 0.0) && fa != 0.0 && fb != 0.0) {
+    r.x = std::numeric_limits<double>::quiet_NaN();
+    return r;
+  }
+  int side = 0;
+  double c = a;
+  for (int it = 1; it <= maxit; ++it) {
+    r.iterations = it;
+    c = (fa * b - fb * a) / (fa - fb);
+    if (!(c > std::min(a, b) && c < std::max(a, b))) c = 0.5 * (a + b);
+    const double fc = f(c);
+    if (std::fabs(fc) <= ftol || std::fabs(b - a) <= xtol) { r.converged = true; break; }
+    if ((fc > 0.0) == (fb > 0.0)) {
+      b = c; fb = fc;
+      if (side == -1) fa *= 0.5;
+      side = -1;
+    } else {
+      a = c; fa = fc;
+      if (side == 1) fb *= 0.5;
+      side = 1;
+    }
+    if (std::fabs(b - a) <= xtol) { r.converged = true; break; }
+  }
+  r.x = c;
+  return r;
+}
+
 
 // --------------------------------------------------------- Clausius-Clapeyron
 // (3-15): vapour pressure [Pa] at the surface temperature T [K].

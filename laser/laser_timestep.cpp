@@ -178,6 +178,20 @@ namespace {
 bool finished(const Result& r) { return r.status == "ok" || r.status == "inaccurate"; }
 }  // namespace
 
+// Halvings of the automatic step skipped after its first (coarse) run, whose steps the heat
+// Courant limit split into mbar = (steps + sub-steps added) / steps on average: a run split into
+// m sub-steps per step costs about as much as an unsplit run at 1/m of its step, and its
+// step-doubling difference leaves out the heat march's sub-step error, for which a split level is
+// refined anyway (kMaxSubstepShare). Where mbar > kSkipSubsteps, the ladder restarts at the
+// level whose reported run (at half the coarse step) is expected unsplit: k = ceil(log2 mbar) - 1
+// halvings (the rate that sets the split is that of the flow, about the same at every step).
+int TimeStepPolicy::heat_courant_skip(const Result& coarse) {
+  if (!(coarse.steps > 0) || coarse.heat_substeps_extra <= 0) return 0;
+  const double mbar = double(coarse.steps + coarse.heat_substeps_extra) / double(coarse.steps);
+  if (!(mbar > kSkipSubsteps)) return 0;
+  return static_cast<int>(std::ceil(std::log2(mbar))) - 1;
+}
+
 // The three runs of the estimate at 2 dt, dt and dt/2 (the reported one in the middle); where
 // 2 dt is not admissible (unstable, not shorter than the pulse, a run that did not finish) dt,
 // dt/2 and dt/4, the error of dt then being twice the larger difference. Returns
@@ -206,6 +220,23 @@ bool TimeStepPolicy::first_levels(const Config& cfg, Levels& L, long& steps, int
       return false;
     }
     L.has_coarse = finished(L.coarse);
+    const int skip = L.has_coarse ? heat_courant_skip(L.coarse) : 0;
+    if (skip > 0) {
+      const double mbar = double(L.coarse.steps + L.coarse.heat_substeps_extra) / double(L.coarse.steps);
+      const double dt0 = dt;
+      dt = std::ldexp(dt, -skip);
+      L.skipped = "the heat Courant limit split the steps of the first run (" + fmt(2.0 * dt0, 4) + " s) into " +
+                  fmt(mbar, 3) + " sub-steps on average: the ladder skipped " + std::to_string(skip) +
+                  " halvings and started at dt = " + fmt(dt, 4) + " s, where the reported run is expected unsplit";
+      if (!cfg.quiet) std::fprintf(stderr, "laser_drill: %s\n", L.skipped.c_str());
+      L.coarse = run_at(cfg, 2.0 * dt, true, steps, make_sink);
+      ++runs;
+      if (L.coarse.status == "unstable_time_step" || L.coarse.status == "diverged") {
+        L.mid = std::move(L.coarse);
+        return false;
+      }
+      L.has_coarse = finished(L.coarse);
+    }
   }
   L.mid = run_at(cfg, dt, true, steps, make_sink);
   ++runs;
@@ -304,6 +335,7 @@ Result TimeStepPolicy::run(const Config& cfg, const SinkFactory& make_sink) cons
   est.volume = qv;
   grid_estimate(L.mid, L.coarse, cfg, est);
   report(L.mid, cfg, est);
+  if (!L.skipped.empty()) L.mid.notes.push_back(L.skipped);
   const double split = std::max(substep_share(L.mid), substep_share(L.fine));
   if (split > kMaxSubstepShare)
     L.mid.notes.push_back("the heat Courant limit split " + fmt(100.0 * split, 3) +

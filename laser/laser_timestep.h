@@ -32,6 +32,10 @@ class TimeStepPolicy {
   // the estimate is below cfg.tol or the step budget is spent. Frames of the
   // reported run go to a fresh sink from make_sink (may be empty).
   Result run(const Config& cfg, const SinkFactory& make_sink) const;
+  // Halvings an automatic ladder skips after its first (coarse) run: ceil(log2 mbar) - 1 where
+  // the heat Courant limit split that run's steps into mbar > kSkipSubsteps sub-steps on average
+  // (mbar = (steps + sub-steps added) / steps), else 0.
+  static int heat_courant_skip(const Result& coarse);
 
   // At most this many time steps over all runs of one case.
   static constexpr double kMaxSteps = 4e6;
@@ -48,6 +52,10 @@ class TimeStepPolicy {
   static constexpr double kMaxRatio = 0.7071067811865476;
   static constexpr double kNoiseFraction = 0.1;
   static constexpr double kMaxSubstepShare = 0.1;
+  // An automatic ladder whose first (coarse) run the heat Courant limit split into more than this
+  // many sub-steps per step on average skips the levels down to the one whose reported run is
+  // expected unsplit (heat_courant_start).
+  static constexpr double kSkipSubsteps = 4.0;
   // Frames of a candidate run are kept in memory up to this size (fields per node and frame).
   static constexpr double kMaxFrameBytes = 256.0 * 1024 * 1024;
   static constexpr double kFrameFields = 11;
@@ -61,6 +69,7 @@ class TimeStepPolicy {
   struct Levels {
     Result coarse, mid, fine, finest;
     bool has_coarse = false;
+    std::string skipped;  // note on the levels skipped by the heat Courant start (empty: none)
   };
   static Level3 three_level(double Dc, double Dm, double Df);
   static void estimate(const Levels& L, Level3& qd, Level3& qv);

@@ -106,3 +106,49 @@ TEST(LaserCourant, Prandtl1420StaysWithinItsEstimate) {
   EXPECT_LT(dd, r.step.depth_error);
   EXPECT_LT(dv, r.step.volume_error);
 }
+
+// The heat Courant start of the automatic ladder (docs 2.10): the halvings skipped after a first
+// run whose steps the limit split into mbar sub-steps on average are ceil(log2 mbar) - 1 above
+// mbar = 4 (the reported run, at half the coarse step, expected unsplit), none at or below it.
+TEST(LaserCourant, SkipCountFollowsTheFirstRunsSplit) {
+  Result r;
+  auto skip = [&](long steps, long extra) {
+    r.steps = static_cast<int>(steps);
+    r.heat_substeps_extra = extra;
+    return TimeStepPolicy::heat_courant_skip(r);
+  };
+  EXPECT_EQ(skip(201, 7209), 5);  // Pr 1420, 700 us, X = 0.5: mbar 36.9
+  EXPECT_EQ(skip(200, 417), 0);   // Pr 142, X = 0.5: mbar 3.09
+  EXPECT_EQ(skip(100, 300), 0);   // mbar 4: not above the threshold
+  EXPECT_EQ(skip(100, 301), 2);   // mbar 4.01: log2 just above 2
+  EXPECT_EQ(skip(100, 700), 2);   // mbar 8
+  EXPECT_EQ(skip(100, 701), 3);
+  EXPECT_EQ(skip(100, 0), 0);     // not split
+  EXPECT_EQ(skip(0, 0), 0);       // no steps
+}
+
+// The skip in a run (Pr 1420, 50 us, d(xi) 0.025, X = 0.1, first run split into about 7): the
+// reported run names the skip, its steps are not split beyond kMaxSubstepShare, its three-level
+// estimate is accepted (the only cause the grid's), and it starts below the automatic step by
+// the halvings skipped.
+TEST(LaserCourant, SplitFirstRunSkipsToTheUnsplitLevel) {
+  Config c;
+  read_config_file(c, std::string(LASER_INPUTS_DIR) + "/prandtl142.toml");
+  c.mat.Pr = 1420;
+  c.heat_courant = 0.1;
+  c.tp = 50e-6;
+  c.dxi = 0.025;
+  c.quiet = true;
+  validate(c);
+  const TimeStepPolicy p(c);
+  const Result r = p.run(c, nullptr);
+  ASSERT_TRUE(r.status == "ok" || r.status == "inaccurate") << r.status << ": " << r.message;
+  for (const auto& cause : r.causes) EXPECT_EQ(cause, "grid error estimate above --tol") << r.message;
+  bool named = false;
+  for (const auto& n : r.notes) named = named || n.find("the ladder skipped 2 halvings") != std::string::npos;
+  EXPECT_TRUE(named);
+  EXPECT_LE(double(r.heat_substeps_extra) / r.steps, TimeStepPolicy::kMaxSubstepShare);
+  EXPECT_LE(r.dt, p.dt() / 4.0 * (1.0 + 1e-12));
+  EXPECT_LE(std::max(r.step.depth_error, r.step.volume_error), c.tol);
+  EXPECT_EQ(r.b2_clamps, 0);
+}

@@ -324,6 +324,77 @@ TEST(LaserLaws, LayerContentBalancesTheColumn) {
   EXPECT_GT(checked, 100);
 }
 
+// solve_interface_flux and solve_interface compute the state at their root from one
+// exponential of the vapour pressure, one 1 - exp(-Pe) and the beam once per solve, shared
+// between the flow's part, the gradients, the pressure and the residual: the result is the
+// same to the last bit as the public laws evaluated one by one at the returned phi (b2 from
+// the content of the layer's profile, interface_at, advected_residual / interface_residual).
+TEST(LaserLaws, FluxInterfaceSharesItsExponentials) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  int hot = 0;
+  for (bool adv : {false, true}) {
+    for (double xi : {0.0, 0.8, 1.7}) {
+      for (double g : {1e-3, 2e-2, 8e-2}) {
+        for (auto [beta, gamma] : {std::pair{0.0, 0.0}, {50.0, 0.0}, {5e3, 10.0}, {200.0, 300.0}}) {
+          for (double kappa : {0.0, 2.0, 500.0}) {
+            const double H_old = 0.05 * g;
+            const InterfaceState s = solve_interface_flux(G, xi, g, beta, gamma, adv, kappa, H_old);
+            const double th = s.theta_sat;
+            const double cont = layer_content(interface_at(G, s.phi, g, 0.0, adv), g, 0.0);
+            const double b2 = (beta * th - gamma + (kappa > 0.0 ? kappa * (cont - H_old) : 0.0)) / g;
+            const InterfaceState r = interface_at(G, s.phi, g, b2, adv);
+            EXPECT_EQ(s.grad_top, r.grad_top) << adv << " " << xi << " " << g << " " << beta << " " << kappa;
+            EXPECT_EQ(s.grad_bottom, r.grad_bottom);
+            EXPECT_EQ(s.p_pa, r.p_pa);
+            EXPECT_EQ(s.p_star, r.p_star);
+            EXPECT_EQ(s.w, r.w);
+            EXPECT_EQ(s.peclet, r.peclet);
+            const double E = gaussian_beam(xi);
+            const double res = adv ? advected_residual(G, s.phi, xi, g, b2, nullptr)
+                                   : interface_residual(G, s.phi, xi, g, b2);
+            EXPECT_EQ(s.residual, res / E);
+            EXPECT_LT(std::fabs(s.residual), 1e-10);
+            if (th > 0.0 && b2 != 0.0 && (!adv || s.peclet > 1e-3)) ++hot;
+            // the plain solve: its residual with the beam computed once is the law's
+            const InterfaceState p = solve_interface(G, xi, g, b2, adv);
+            if (p.theta_sat > 0.0 && !adv) EXPECT_EQ(p.residual, interface_residual(G, p.phi, xi, g, b2) / E);
+            if (p.theta_sat > 0.0 && adv) EXPECT_NEAR(p.residual, advected_residual(G, p.phi, xi, g, b2, nullptr) / E, 1e-15);
+          }
+        }
+      }
+    }
+  }
+  EXPECT_GT(hot, 40);
+}
+
+// The interface solves do not evaluate the residual at the upper end of their bracket
+// (positive there: the vapour term plus k' theta_sat/g (F - 1)). For layers so thin that
+// hi - theta_m is at or below round-off, the root is the conduction root hi to the
+// iteration's tolerance, converged, for both layers and with the face heat fluxes.
+TEST(LaserLaws, VeryThinLayersEndAtTheConductionRoot) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  int checked = 0;
+  for (bool adv : {false, true})
+    for (double xi : {0.0, 1.2})
+      for (double g : {1e-10, 1e-13, 1e-15, 1e-17, 1e-19}) {
+        const double E = gaussian_beam(xi);
+        const double hi = G.theta_m + E * g * (1.0 - G.theta_m) / G.kprime;
+        const InterfaceState s = solve_interface(G, xi, g, 0.0, adv);
+        EXPECT_TRUE(s.converged) << adv << " " << g;
+        EXPECT_LE(s.phi, hi) << adv << " " << g;
+        EXPECT_GE(s.phi, G.theta_m);
+        // the vapour term is at most vapour_melt-sized here: phi lies below hi by about
+        // vapour_melt g (1 - theta_m) / k', or within the tolerance 1e-15 hi
+        EXPECT_NEAR(s.phi, hi, 2e-15 * hi + 2.0 * G.vapour_melt * g * (1.0 - G.theta_m) / G.kprime) << adv << " " << g;
+        const InterfaceState f = solve_interface_flux(G, xi, g, 10.0, 0.0, adv, 0.0, 0.0);
+        const double hif = G.theta_m + E * (1.0 - G.theta_m) / (G.kprime * (1.0 / g + 10.0));
+        EXPECT_TRUE(f.converged);
+        EXPECT_NEAR(f.phi, hif, 2e-15 * hif + 2.0 * G.vapour_melt * g * (1.0 - G.theta_m) / G.kprime);
+        ++checked;
+      }
+  EXPECT_EQ(checked, 20);
+}
+
 // What the curvature clamp hides at Pr 1420 (docs section 3, "The cusp on the axis"):
 // (3-37) as printed gives a node deeper than both neighbours (a > 0) C_c < 1, i.e. less
 // heat drawn into the solid, so it melts faster than its shallower neighbours (a < 0,
