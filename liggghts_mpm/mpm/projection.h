@@ -232,9 +232,10 @@ class Projection {
   // nearest triangle off the box's faces (mesh_wall_labels), kWallFar beyond the shape's reach
   static constexpr double kWallFar = 2.0;
   std::vector<double> wall_dist_;
-  // the fills a node reads at rest from a fluid that fills the space in front of the wall evenly:
-  // lo for a lattice at a random offset from the wall, hi for a lattice parallel to it
-  void expected_fill(int i, int j, int k, std::size_t n, int np, double *lo, double *hi) const;
+  // node (i, j, k) = n beside a mesh wall: *full := the fill it reads from an even fill of
+  // points (np per cell) at rest, *gaps := whether a fill below it is a gap (left as they are
+  // farther than kWallFar from the wall)
+  void expected_fill(int i, int j, int k, std::size_t n, int np, double *full, bool *gaps) const;
   std::vector<double> q_, grad_q_, drift_;  // volume correction: its potential, gradient and drift
   void add_volume_correction(const double *pvol, const double *theta, double h, double share);
   void volume_drift(const double *pvol, const double *theta, double h, double share, long step);
