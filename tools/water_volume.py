@@ -6,10 +6,12 @@ walls). A point keeps its mass, so the water's volume is its mass over its densi
 relative to rest is the mean fill of those nodes: the volume relative to the first file is the first
 file's mean fill over this file's. Also the occupied cells (cells holding a point) and the highest
 point, and with --rest AXIS C1 C2 R (a horizontal cylinder, z up: the jar) the volume the points'
-mean height gives when the water is at rest, a circular segment whose centroid is that height.
+mean height gives when the water is at rest, a circular segment whose centroid is that height;
+with --length L as well, the segment below the level at rest (the highest points across the middle
+fifth, plus half a spacing) times L over the points' own volume.
 
     tools/python tools/water_volume.py RUNDIR --prefix jar --dx 0.005556 --ppc 1 \
-        [--origin 0 0 0] [--cylinder AXIS C1 C2 R] [--box LO HI LO HI LO HI] [--deep 0.9] [--rest AXIS C1 C2 R] [--csv out.csv]
+        [--origin 0 0 0] [--cylinder AXIS C1 C2 R] [--box LO HI LO HI LO HI] [--deep 0.9] [--rest AXIS C1 C2 R [--length L]] [--csv out.csv]
 
 Equal point masses are assumed (a fluid filled without grains, one point spacing everywhere):
 with grains the fill's masses differ from point to point and are not in the files. --cylinder
@@ -84,6 +86,23 @@ def rest_area(zmean, zc, R):
     return segment_area(0.5 * (lo + hi), zc, R)[0]
 
 
+def level_ratio(xyz, dx, ppc, axis, c1, c2, R, length):
+    """The segment below the level at rest (the mean over the columns of cells across the middle
+    fifth of the jar of their highest point, plus half a point spacing) times the jar's length,
+    over the points' own volume (one point spacing everywhere: n (dx / ppc)^3)."""
+    ax = "xyz".index(axis)
+    horiz = [d for d in range(3) if d != ax and d != 2][0]  # the horizontal coordinate across
+    centre = c1 if [d for d in range(3) if d != ax][0] == horiz else c2
+    top = {}
+    for q in xyz:
+        key = (int(np.floor(q[horiz] / dx)), int(np.floor(q[ax] / dx)))
+        top[key] = max(top.get(key, -np.inf), q[2])
+    mid = [z for (i, _), z in top.items() if abs((i + 0.5) * dx - centre) < 0.2 * R]
+    level = float(np.mean(mid)) + 0.5 * dx / ppc
+    zc = c2 if [d for d in range(3) if d != ax][1] == 2 else c1
+    return segment_area(level, zc, R)[0] * length / (len(xyz) * (dx / ppc) ** 3)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("rundir")
@@ -95,6 +114,8 @@ def main():
     ap.add_argument("--box", type=float, nargs=6, default=None)
     ap.add_argument("--deep", type=float, default=0.9)
     ap.add_argument("--rest", nargs=4, default=None, metavar=("AXIS", "C1", "C2", "R"))
+    ap.add_argument("--length", type=float, default=None,
+                    help="with --rest: the jar's length along its axis; adds the level at rest over the points' volume")
     ap.add_argument("--csv", default=None)
     a = ap.parse_args()
     origin = np.array(a.origin)
@@ -133,6 +154,11 @@ def main():
                 first_area = area
             row["rest_volume_ratio"] = area / first_area
             extra = f"  at rest: volume / first {area / first_area:.5f}"
+            if a.length:
+                lev = level_ratio(xyz, dx, a.ppc, a.rest[0], float(a.rest[1]), float(a.rest[2]), float(a.rest[3]),
+                                  a.length)
+                row["level_over_points"] = lev
+                extra += f"  level / points' volume {lev:.5f}"
         rows.append(row)
         print(f"t {t:8.4f}  deep nodes {count:5d}  fill {mean:.5f}  volume / first {first / mean:.5f}  "
               f"occupied cells {occ}  highest point {row['z_max']:.5f} m" + extra, flush=True)

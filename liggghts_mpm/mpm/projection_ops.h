@@ -112,6 +112,12 @@ struct ProjectionGeometry {
 // lattice_fill: G(s) (slope: dG/ds, if not null); surface_distance: the level of the fill f, G^-1(f).
 double lattice_fill(double s, ShapeKind shape, int np, double *slope = nullptr);
 double surface_distance(double f, ShapeKind shape, int np);
+// The limit np -> inf of G: F(s) = int_{-s}^{inf} N, the share of a node's shape function on the
+// fluid side of a plane s cells from it (s < 0: the node beyond the plane). A lattice of points
+// whose layers lie at random offsets from the plane (a wall at an angle to the lattice, or one
+// the points move along) gives the node this fill on average; a lattice parallel to the plane
+// gives G(s), up to 5.4 % more with one point per cell, 1.3 % with two (the quadratic B-spline).
+double continuum_fill(double s, ShapeKind shape);
 
 // Smallest fraction of a cell between a FLUID node and the surface (clamp of the ghost-fluid
 // coefficient 1 / s_f: at most 20x the face's own).

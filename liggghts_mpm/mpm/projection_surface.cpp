@@ -56,6 +56,14 @@ double lattice_fill(double s, ShapeKind shape, int np, double *slope) {
   return g * h;
 }
 
+double continuum_fill(double s, ShapeKind shape) {
+  if (s < 0.0) return 1.0 - continuum_fill(-s, shape);
+  if (shape == ShapeKind::Linear) return s >= 1.0 ? 1.0 : 1.0 - 0.5 * (1.0 - s) * (1.0 - s);
+  if (s >= 1.5) return 1.0;
+  if (s >= 0.5) return 1.0 - (1.5 - s) * (1.5 - s) * (1.5 - s) / 6.0;
+  return 0.5 + 0.75 * s - s * s * s / 3.0;
+}
+
 double surface_distance(double f, ShapeKind shape, int np) {
   const double lo = (shape == ShapeKind::Linear ? -1.0 : -1.5) + 0.5 / np, hi = -lo;
   if (f <= 0.0) return lo;
@@ -213,6 +221,18 @@ void Projection::mesh_wall_labels(const WallGeometry &walls) {
   const GridSpec &gs = opt_.grid;
   const double dx = gs.dx;
   frac_.assign(grid_.size(), 1.0);
+  // the volume correction's expected fill beside the walls: the distance to the nearest triangle
+  // that is not in a face of the box (there mirror_sum adds the fluid's image behind it)
+  const bool cover = opt_.volume_correction > 0.0;
+  std::vector<std::pair<int, double>> planes;
+  if (cover) {
+    wall_dist_.assign(grid_.size(), kWallFar);
+    for (int d = 0; d < 3; ++d)
+      if (!gs.periodic[d]) {
+        planes.emplace_back(d, gs.origin[d]);
+        planes.emplace_back(d, gs.origin[d] + gs.ncell[d] * dx);
+      }
+  }
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kSolid) return;
     const double x[3] = {gs.origin[0] + i * dx, gs.origin[1] + j * dx, gs.origin[2] + k * dx};
@@ -226,6 +246,7 @@ void Projection::mesh_wall_labels(const WallGeometry &walls) {
     const int side = walls.node_side(x, 2.0 * dx, &dist);
     if (side < 0) lab_.kind[n] = kSolid;
     if (side > 0) frac_[n] = std::min(1.0, 0.5 + dist / dx);
+    if (cover && side > 0 && dist < kWallFar * dx) wall_dist_[n] = walls.distance_off_planes(x, kWallFar * dx, planes) / dx;
   });
 }
 

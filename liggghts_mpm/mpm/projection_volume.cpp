@@ -11,6 +11,7 @@
 
 #include "mpm/error.h"
 #include "mpm/grid_fields.h"
+#include "mpm/projection_ops.h"
 
 namespace mpm {
 
@@ -37,8 +38,9 @@ constexpr double kVolumeBand = 0.02;
    (volume_correction_every): the drift w it gives has
        D(w) = volume(n) theta_n a e_n / h,
    i.e. rhs_n -= volume(n) theta_n a e_n / h^2: crowded points (e > 0) are pushed apart, and gaps
-   (e < 0) drawn together, but the latter only where no EMPTY node lies within two nodes
-   (deep_inside): under the free surface phi falls from 1 to 0 over 1.5 cells and is no error.
+   (e < 0) drawn together, but the latter only where no EMPTY node is among the 26 neighbours
+   (deep_inside): under the free surface phi falls from 1 to 0 over 1.5 cells and is no error;
+   beside mesh walls phi is read against the fill an even fill gives there (expected_fill).
    Measured: correcting compression alone removed it better but opened gaps, the fluid's volume
    on the grid growing by 2-8 % (docs/theory/projection.md). The density-error source of the pressure
    equation of Kugelstadt, Longva, Thuerey & Bender (2021), "Implicit density projection for
@@ -49,15 +51,21 @@ void Projection::add_volume_correction(const double *pvol, const double *theta, 
   vol_.assign(pvol, pvol + grid_.size());
   grid_.forward(vol_.data(), 1);  // the padding nodes' shares, wherever they are owned
   const double dx = gs.dx, dx3 = dx * dx * dx;
+  const int np = std::max({opt_.fill_ppc[0], opt_.fill_ppc[1], opt_.fill_ppc[2]});
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] != kFluid || near_flow_face(i, j, k)) return;
     const double sum = mirror_sum(vol_, i, j, k);
     const double cv = geo_.volume(i, j, k);
     // the part of the error beyond the band kVolumeBand: what the points' own sampling of a
-    // moving fluid gives is left alone
-    double e = sum / (dx3 * cv) - 1.0;
+    // moving fluid gives is left alone; beside a mesh wall, the fill of a lattice at rest there
+    // in place of 1, and gaps not read where the wall's share is unknown (expected_fill)
+    double full = 1.0;
+    bool gaps = true;
+    if (mesh_) expected_fill(i, j, k, n, np, &full, &gaps);
+    double e = sum / (dx3 * cv * full) - 1.0;
     e = e > kVolumeBand ? e - kVolumeBand : (e < -kVolumeBand ? e + kVolumeBand : 0.0);
-    if (e < 0.0 && !deep_inside(i, j, k)) return;  // a partly filled node under the surface
+    // a partly filled node under the surface, or beside a mesh wall
+    if (e < 0.0 && (!gaps || !deep_inside(i, j, k))) return;
     const double th = theta ? theta[n] : 1.0;
     rhs_[n] -= cv * th * a * e / (h * h);
   });
@@ -105,25 +113,41 @@ void Projection::volume_drift(const double *pvol, const double *theta, double h,
   grid_.forward(drift_.data(), 3);
 }
 
-// no EMPTY node among the 26 neighbours and no node behind a mesh wall within two nodes: phi is within the band
-// kVolumeBand of 1 there for a regular fill (under the surface phi falls from 1 to 0 over 1.5 cells:
-// one node below the last FLUID one it is F(1) = 0.979 for the quadratic B-spline). With two nodes
-// instead, a tank 5 cells deep had almost no node where gaps were closed, only crowding was
-// corrected, and the water's volume grew by 1-3 % over 10 s of sloshing (20 cells along 1 m,
-// stopped at 9.5 / 10 / 10.5 / 11 s: 1.034 / 1.020 / 1.025 / 1.021; now 1.004 / 1.000 / 1.000 /
-// 1.003). Beside a mesh wall the B-spline's share behind the triangles holds no points and
-// has no mirror image, so phi < 1 at rest there: counted as a gap, it moved columns at rest beside
-// vertical / 30 / 60 degree walls at 8.4e-3 / 1.0e-2 / 6.0e-2 m/s after 1 s with k = 10; with
-// these nodes left out 1.9e-12 / 3.5e-12 / 7.0e-12 m/s, test mpm_case.projection_mesh_rest)
+/* Beside a mesh wall the share of the shape function behind the triangle holds no points and has
+   no mirror image, so the fill of a node s cells in front of the wall is F(s) (continuum_fill) for
+   an even fill up to the wall, not 1. A lattice of points seeded or moving beside the wall ends
+   within half a spacing b = 1 / (2 np) cells of where an even fill would: at rest the fill lies
+   between F(s - b) and F(s + b). Crowding is read against F(s + b); gaps are read only where
+   F(s - b) = 1, from 1.5 + b cells off the wall (the fill nearer the wall cannot tell a gap from
+   the lattice's offset). Counted as gaps with 1 in place of F, the missing share moved columns
+   at rest beside vertical / 30 / 60 degree walls at 8.4e-3 / 1.0e-2 / 6.0e-2 m/s after 1 s with
+   k = 10 (test mpm_case.projection_mesh_rest). Within one node of a box face the crowding is read
+   against 1 (mirror_sum folds the image of the fluid behind the face there, and with it a share
+   that a wall at an angle to the face leaves out: beside a 30 degree wall the corner node on the
+   floor read 0.985 against F(s + b) = 0.939, and the drift broke the column's hydrostatic rows by
+   0.25 rho g dz). */
+void Projection::expected_fill(int i, int j, int k, std::size_t n, int np, double *full, bool *gaps) const {
+  const double s = wall_dist_[n], b = 0.5 / np;
+  if (s >= kWallFar) return;
+  *gaps = s >= 1.5 + b;
+  const GridSpec &gs = opt_.grid;
+  const int idx[3] = {i, j, k};
+  for (int d = 0; d < 3; ++d)
+    if (!gs.periodic[d] && (idx[d] <= 1 || idx[d] >= gs.ncell[d] - 1)) return;
+  *full = continuum_fill(s + b, opt_.shape);
+}
+
+// no EMPTY node among the 26 neighbours: phi is within the band kVolumeBand of 1 there for a
+// regular fill (under the surface phi falls from 1 to 0 over 1.5 cells: one node below the last
+// FLUID one it is F(1) = 0.979 for the quadratic B-spline). With two nodes instead, a tank 5 cells
+// deep had almost no node where gaps were closed, only crowding was corrected, and the water's
+// volume grew by 1-3 % over 10 s of sloshing (20 cells along 1 m, stopped at 9.5 / 10 / 10.5 /
+// 11 s: 1.034 / 1.020 / 1.025 / 1.021; now 1.004 / 1.000 / 1.000 / 1.003)
 bool Projection::deep_inside(int i, int j, int k) const {
-  for (int c = -2; c <= 2; ++c)
-    for (int b = -2; b <= 2; ++b)
-      for (int a = -2; a <= 2; ++a)
-        if (grid_.in_patch(i + a, j + b, k + c)) {
-          const std::size_t q = grid_.index(i + a, j + b, k + c);
-          const bool near = a >= -1 && a <= 1 && b >= -1 && b <= 1 && c >= -1 && c <= 1;
-          if ((near && lab_.kind[q] == kEmpty) || (mesh_ && behind_mesh(i + a, j + b, k + c, q))) return false;
-        }
+  for (int c = -1; c <= 1; ++c)
+    for (int b = -1; b <= 1; ++b)
+      for (int a = -1; a <= 1; ++a)
+        if (grid_.in_patch(i + a, j + b, k + c) && lab_.kind[grid_.index(i + a, j + b, k + c)] == kEmpty) return false;
   return true;
 }
 

@@ -333,6 +333,29 @@ bool WallGeometry::crosses(const double a[3], int d, double len, double *w_d) co
   return false;
 }
 
+double WallGeometry::distance_off_planes(const double x[3], double reach,
+                                         const std::vector<std::pair<int, double>> &planes) const {
+  const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
+  const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
+  const double tol = 1e-9 * reach;
+  double best = reach * reach;
+  for (int c = 0; c < ncand; ++c) {
+    const Tri &t = tris_[cand ? (*cand)[c] : c];
+    const int side = walls_[t.mesh].side;
+    if ((side != SIDE_NORMAL && side != SIDE_OPPOSITE) || beyond_box(t, x, reach)) continue;
+    bool in_plane = false;
+    for (const auto &pl : planes)
+      in_plane = in_plane || (std::fabs(t.p[0][pl.first] - pl.second) <= tol &&
+                              std::fabs(t.p[1][pl.first] - pl.second) <= tol &&
+                              std::fabs(t.p[2][pl.first] - pl.second) <= tol);
+    if (in_plane) continue;
+    Hit h;
+    closest_point(t, x, h);
+    best = std::min(best, h.dist2);
+  }
+  return std::sqrt(best);
+}
+
 int WallGeometry::node_side(const double x[3], double reach, double *dist) const {
   *dist = reach;
   if (tris_.empty()) return 0;

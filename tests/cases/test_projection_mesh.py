@@ -54,7 +54,7 @@ def case_rest(r):
         vmax = max(s["vmax"])
         print(f"  {label}: |v|max over 1 s {vmax:.2e} m/s, {len(points(d))} points")
         # measured 1.6e-12 (60 deg); 0.15 m/s at 30 deg before the gradient fill next to the walls;
-        # volume_correction 10: 1.9e-12 to 7.0e-12 (8.4e-3 to 6.0e-2 m/s when the nodes beside the
+        # volume_correction 10: 1.2e-12 to 4.7e-12 (8.4e-3 to 6.0e-2 m/s when the nodes beside the
         # wall counted their missing share behind it as a gap to close)
         check(vmax < 1e-4, f"{label}: fluid at rest for 1 s (|v|max {vmax:.2e} < 1e-4 m/s)")
         check(all(m == s["mass0"][0] for m in s["mass"]), f"{label}: fluid mass exact")

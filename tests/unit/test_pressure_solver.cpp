@@ -1021,3 +1021,33 @@ TEST(PressureSolver, SurfaceLevelOfAPointLatticeIsTheDistance) {
   EXPECT_NEAR(mpm::surface_distance(0.0, mpm::ShapeKind::QuadraticBSpline, 2), -1.25, 1e-15);
   EXPECT_NEAR(mpm::surface_distance(1e-12, mpm::ShapeKind::QuadraticBSpline, 2), -1.25, 1e-5);
 }
+
+// continuum_fill (projection_ops.h): the share of a node's shape function on the fluid side of a
+// plane s cells away, against the integral of the shape function by the midpoint rule (4e5
+// intervals), the limit of the lattice's fill G as the points per cell grow (np = 400), and
+// F(s) + F(-s) = 1; the two ends: 1/2 on the plane, 1 beyond the reach.
+TEST(PressureSolver, ContinuumFillIsTheShareOfTheShapeFunction) {
+  auto bspline = [](double x) {
+    x = std::fabs(x);
+    return x < 0.5 ? 0.75 - x * x : (x < 1.5 ? 0.5 * (1.5 - x) * (1.5 - x) : 0.0);
+  };
+  auto hat = [](double x) { return std::max(0.0, 1.0 - std::fabs(x)); };
+  for (const mpm::ShapeKind shape : {mpm::ShapeKind::QuadraticBSpline, mpm::ShapeKind::Linear}) {
+    for (const double s : {-1.7, -1.2, -0.6, -0.25, 0.0, 0.1, 0.5, 0.73, 1.0, 1.4, 2.0}) {
+      const int n = 400000;
+      const double lo = -s, hi = 2.0, du = (hi - lo) / n;
+      double share = 0.0;
+      for (int q = 0; q < n; ++q) {
+        const double u = lo + (q + 0.5) * du;
+        share += (shape == mpm::ShapeKind::Linear ? hat(u) : bspline(u)) * du;
+      }
+      if (lo >= hi) share = 0.0;
+      const double f = mpm::continuum_fill(s, shape);
+      EXPECT_NEAR(f, share, 1e-9) << mpm::shape_name(shape) << ", s = " << s;
+      EXPECT_NEAR(f, mpm::lattice_fill(s, shape, 400), 2e-5) << mpm::shape_name(shape) << ", s = " << s;
+      EXPECT_NEAR(f + mpm::continuum_fill(-s, shape), 1.0, 1e-15);
+    }
+    EXPECT_EQ(mpm::continuum_fill(0.0, shape), 0.5);
+    EXPECT_EQ(mpm::continuum_fill(1.5, shape), 1.0);
+  }
+}
