@@ -242,11 +242,11 @@ void Projection::mesh_wall_labels(const WallGeometry &walls) {
       double w = 0.0;
       if (walls.crosses(x, d, dx, &w)) lab_.close_face(grid_, i, j, k, d, w);
     }
-    double dist;
-    const int side = walls.node_side(x, 2.0 * dx, &dist);
+    double dist, off;
+    const int side = walls.node_side(x, 2.0 * dx, &dist, &planes, cover ? &off : nullptr);
     if (side < 0) lab_.kind[n] = kSolid;
     if (side > 0) frac_[n] = std::min(1.0, 0.5 + dist / dx);
-    if (cover && side > 0 && dist < kWallFar * dx) wall_dist_[n] = walls.distance_off_planes(x, kWallFar * dx, planes) / dx;
+    if (cover && side > 0) wall_dist_[n] = std::min(off / dx, kWallFar);
   });
 }
 

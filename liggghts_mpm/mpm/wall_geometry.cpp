@@ -333,48 +333,44 @@ bool WallGeometry::crosses(const double a[3], int d, double len, double *w_d) co
   return false;
 }
 
-double WallGeometry::distance_off_planes(const double x[3], double reach,
-                                         const std::vector<std::pair<int, double>> &planes) const {
-  const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
-  const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
-  const double tol = 1e-9 * reach;
-  double best = reach * reach;
-  for (int c = 0; c < ncand; ++c) {
-    const Tri &t = tris_[cand ? (*cand)[c] : c];
-    const int side = walls_[t.mesh].side;
-    if ((side != SIDE_NORMAL && side != SIDE_OPPOSITE) || beyond_box(t, x, reach)) continue;
-    bool in_plane = false;
-    for (const auto &pl : planes)
-      in_plane = in_plane || (std::fabs(t.p[0][pl.first] - pl.second) <= tol &&
-                              std::fabs(t.p[1][pl.first] - pl.second) <= tol &&
-                              std::fabs(t.p[2][pl.first] - pl.second) <= tol);
-    if (in_plane) continue;
-    Hit h;
-    closest_point(t, x, h);
-    best = std::min(best, h.dist2);
-  }
-  return std::sqrt(best);
+namespace {
+// t lies in one of the planes x_d = c given as (d, c), to tol
+bool in_planes(const WallGeometry::Tri &t, const std::vector<std::pair<int, double>> &planes, double tol) {
+  for (const auto &pl : planes)
+    if (std::fabs(t.p[0][pl.first] - pl.second) <= tol && std::fabs(t.p[1][pl.first] - pl.second) <= tol &&
+        std::fabs(t.p[2][pl.first] - pl.second) <= tol)
+      return true;
+  return false;
 }
+}  // namespace
 
-int WallGeometry::node_side(const double x[3], double reach, double *dist) const {
+int WallGeometry::node_side(const double x[3], double reach, double *dist,
+                            const std::vector<std::pair<int, double>> *planes, double *dist_off) const {
   *dist = reach;
+  if (dist_off) *dist_off = reach;
   if (tris_.empty()) return 0;
   const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
   const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
   // nearest distance, then the sides of the triangles at that distance (face hits first)
-  double best = reach * reach;
+  double best = reach * reach, best_off = best;
   bool any = false, best_face = false;
   for (int c = 0; c < ncand; ++c) {
     const Tri &t = tris_[cand ? (*cand)[c] : c];
     if (beyond_box(t, x, reach)) continue;
     Hit h;
     closest_point(t, x, h);
+    if (dist_off && h.dist2 < best_off) {
+      const int side = walls_[t.mesh].side;
+      if ((side == SIDE_NORMAL || side == SIDE_OPPOSITE) && !(planes && in_planes(t, *planes, 1e-9 * reach)))
+        best_off = h.dist2;
+    }
     if (h.dist2 > best * (1.0 + 1e-9) + 1e-24) continue;
     if (h.dist2 < best * (1.0 - 1e-9)) best_face = false;
     best = std::min(best, h.dist2);
     best_face = best_face || h.face;
     any = true;
   }
+  if (dist_off) *dist_off = std::sqrt(best_off);
   if (!any) return 0;
   *dist = std::sqrt(best);
   bool all_back = true, two_sided = false, found = false;

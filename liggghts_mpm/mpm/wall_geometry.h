@@ -182,12 +182,11 @@ class WallGeometry {
   // Side of x with respect to the nearest triangle within 'reach': -1 behind a one-sided mesh
   // (behind the planes of all equally near triangles; face hits first), +1 in front of one,
   // 0 none within reach or the nearest is two-sided. *dist: the distance to it (reach if none).
-  int node_side(const double x[3], double reach, double *dist) const;
-
-  // Distance from x to the nearest triangle of a one-sided mesh within 'reach' (reach if none),
-  // leaving out the triangles that lie in one of the planes x_d = c given as (d, c): the faces
-  // of the grid box, behind which the fluid's mirror image stands already.
-  double distance_off_planes(const double x[3], double reach, const std::vector<std::pair<int, double>> &planes) const;
+  // dist_off (optional): the distance to the nearest triangle of a one-sided mesh within reach
+  // (reach if none) that does not lie in one of the planes x_d = c given as (d, c) (the faces of
+  // the grid box, behind which the fluid's mirror image stands already), from the same scan.
+  int node_side(const double x[3], double reach, double *dist,
+                const std::vector<std::pair<int, double>> *planes = nullptr, double *dist_off = nullptr) const;
 
   int walls() const { return static_cast<int>(walls_.size()); }
   const WallSpec &wall(int k) const { return walls_[k]; }

@@ -512,11 +512,12 @@ TEST(WallGeometry, LoadQueriesNameTheMesh) {
   EXPECT_LT(p[2], 0.8);
 }
 
-// distance_off_planes: the distance to the nearest triangle of a one-sided mesh, leaving out the
+// node_side's dist_off: the distance to the nearest triangle of a one-sided mesh, leaving out the
 // triangles in the given planes (the box faces of the volume correction's expected fill). A floor
 // plate in the plane z = 0.5 and a wall plate x = 0.8 (two triangles each); from x = (0.5, 0.5,
 // 0.6) the floor is nearer (0.1) than the wall (0.3): with the plane z = 0.5 left out the wall's
-// 0.3; with x = 0.8 left out too, nothing within reach. A two-sided plate counts never.
+// 0.3; with x = 0.8 left out too, nothing within reach. The nearest triangle and the side stay
+// those of all triangles. A two-sided plate counts never.
 TEST(WallGeometry, DistanceOffPlanesLeavesOutTheBoxFaces) {
   std::vector<Tri> tris = plate(0.5, nullptr);
   const double a[3] = {0.8, 0, 0}, b[3] = {0.8, 1, 0}, c[3] = {0.8, 1, 1}, e[3] = {0.8, 0, 1};
@@ -528,15 +529,23 @@ TEST(WallGeometry, DistanceOffPlanesLeavesOutTheBoxFaces) {
     g.set_triangles(tris, kBox, margin);
     const double reach = 0.4 <= margin ? 0.4 : 0.09;
     const std::vector<std::pair<int, double>> none, floor{{2, 0.5}}, both{{2, 0.5}, {0, 0.8}};
+    double dist, off;
     if (reach > 0.3) {
-      EXPECT_NEAR(g.distance_off_planes(x, reach, none), 0.1, 1e-14);
-      EXPECT_NEAR(g.distance_off_planes(x, reach, floor), 0.3, 1e-14);
-      EXPECT_EQ(g.distance_off_planes(x, reach, both), reach);
+      EXPECT_EQ(g.node_side(x, reach, &dist, &none, &off), 1);
+      EXPECT_NEAR(dist, 0.1, 1e-14);
+      EXPECT_NEAR(off, 0.1, 1e-14);
+      EXPECT_EQ(g.node_side(x, reach, &dist, &floor, &off), 1);
+      EXPECT_NEAR(dist, 0.1, 1e-14);
+      EXPECT_NEAR(off, 0.3, 1e-14);
+      g.node_side(x, reach, &dist, &both, &off);
+      EXPECT_EQ(off, reach);
     } else {
-      EXPECT_EQ(g.distance_off_planes(x, reach, none), reach);
+      EXPECT_EQ(g.node_side(x, reach, &dist, &none, &off), 0);
+      EXPECT_EQ(off, reach);
     }
     WallGeometry two({wall(mpm::WALL_FREESLIP, 1.0, mpm::SIDE_BOTH)});
     two.set_triangles(tris, kBox, margin);
-    EXPECT_EQ(two.distance_off_planes(x, reach, none), reach);
+    two.node_side(x, reach, &dist, &none, &off);
+    EXPECT_EQ(off, reach);
   }
 }
