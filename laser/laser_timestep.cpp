@@ -203,6 +203,16 @@ bool TimeStepPolicy::first_levels(const Config& cfg, Levels& L, long& steps, int
   const auto coarse_ok = [&](double c) {
     return c < cfg.tp && (dt_stable_ == 0.0 || c <= kAcceptFraction * dt_stable_);
   };
+  // after a coarse run: true where it ended unstable or diverged (it is then the reported run),
+  // else whether it finished noted
+  auto coarse_stopped = [&]() {
+    if (L.coarse.status == "unstable_time_step" || L.coarse.status == "diverged") {
+      L.mid = std::move(L.coarse);
+      return true;
+    }
+    L.has_coarse = finished(L.coarse);
+    return false;
+  };
   if (automatic_ && coarse_ok(2.0 * dt)) {
     // the run-time check of (4-14) may still fire: the automatic step is halved then
     L.coarse = run_at(cfg, 2.0 * dt, true, steps, make_sink);
@@ -215,11 +225,7 @@ bool TimeStepPolicy::first_levels(const Config& cfg, Levels& L, long& steps, int
       L.coarse = run_at(cfg, 2.0 * dt, true, steps, make_sink);
       ++runs;
     }
-    if (L.coarse.status == "unstable_time_step" || L.coarse.status == "diverged") {
-      L.mid = std::move(L.coarse);
-      return false;
-    }
-    L.has_coarse = finished(L.coarse);
+    if (coarse_stopped()) return false;
     const int skip = L.has_coarse ? heat_courant_skip(L.coarse) : 0;
     if (skip > 0) {
       const double mbar = double(L.coarse.steps + L.coarse.heat_substeps_extra) / double(L.coarse.steps);
@@ -231,11 +237,7 @@ bool TimeStepPolicy::first_levels(const Config& cfg, Levels& L, long& steps, int
       if (!cfg.quiet) std::fprintf(stderr, "laser_drill: %s\n", L.skipped.c_str());
       L.coarse = run_at(cfg, 2.0 * dt, true, steps, make_sink);
       ++runs;
-      if (L.coarse.status == "unstable_time_step" || L.coarse.status == "diverged") {
-        L.mid = std::move(L.coarse);
-        return false;
-      }
-      L.has_coarse = finished(L.coarse);
+      if (coarse_stopped()) return false;
     }
   }
   L.mid = run_at(cfg, dt, true, steps, make_sink);
