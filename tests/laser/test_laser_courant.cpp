@@ -47,6 +47,19 @@ Point run_pr1420(double dxi, double dt, long* substeps = nullptr) {
 }
 
 double rel(double a, double b) { return std::fabs(a / b - 1.0); }
+// The shipped Pr 142 config at Pr 1420 with the heat Courant limit X, 50 us, d(xi) 0.025, quiet
+Config prandtl1420(double X) {
+  Config c;
+  read_config_file(c, std::string(LASER_INPUTS_DIR) + "/prandtl142.toml");
+  c.mat.Pr = 1420;
+  c.heat_courant = X;
+  c.tp = 50e-6;
+  c.dxi = 0.025;
+  c.quiet = true;
+  validate(c);
+  return c;
+}
+
 }  // namespace
 
 TEST(LaserCourant, Prandtl1420StepLadderConvergesWithoutLimiter) {
@@ -84,14 +97,7 @@ TEST(LaserCourant, Prandtl1420GridLadderConvergesWithoutLimiter) {
 // a run at a quarter of the reported step moves centre depth and removed volume by less than
 // the step's estimate.
 TEST(LaserCourant, Prandtl1420StaysWithinItsEstimate) {
-  Config c;
-  read_config_file(c, std::string(LASER_INPUTS_DIR) + "/prandtl142.toml");
-  c.mat.Pr = 1420;
-  c.heat_courant = 0.5;
-  c.tp = 50e-6;
-  c.dxi = 0.025;
-  c.quiet = true;
-  validate(c);
+  const Config c = prandtl1420(0.5);
   const Result r = TimeStepPolicy(c).run(c, nullptr);
   ASSERT_TRUE(r.status == "ok" || r.status == "inaccurate") << r.status << ": " << r.message;
   for (const auto& cause : r.causes) EXPECT_EQ(cause, "grid error estimate above --tol") << r.message;
@@ -132,14 +138,7 @@ TEST(LaserCourant, SkipCountFollowsTheFirstRunsSplit) {
 // estimate is accepted (the only cause the grid's), and it starts below the automatic step by
 // the halvings skipped.
 TEST(LaserCourant, SplitFirstRunSkipsToTheUnsplitLevel) {
-  Config c;
-  read_config_file(c, std::string(LASER_INPUTS_DIR) + "/prandtl142.toml");
-  c.mat.Pr = 1420;
-  c.heat_courant = 0.1;
-  c.tp = 50e-6;
-  c.dxi = 0.025;
-  c.quiet = true;
-  validate(c);
+  const Config c = prandtl1420(0.1);
   const TimeStepPolicy p(c);
   const Result r = p.run(c, nullptr);
   ASSERT_TRUE(r.status == "ok" || r.status == "inaccurate") << r.status << ": " << r.message;
