@@ -68,6 +68,11 @@ double peclet_factor(double Pe) {
 }
 
 namespace {
+// peclet_factor for Pe >= 0 with em = 1 - exp(-Pe) given by a caller that needs it too
+double peclet_factor_em(double Pe, double em) { return Pe < 1e-6 ? 1.0 + 0.5 * Pe : Pe / em; }
+}  // namespace
+
+namespace {
 // The vapour term (vapour_term), its derivative, and the flux recession rate
 // N_i v - Psi p* sqrt(phi) with its derivative, from one exponential.
 struct VapourParts {
@@ -97,7 +102,7 @@ double advected_residual_of(const Groups& G, const VapourParts& q, double phi, d
   const double Pe = w * g;
   const double em = -std::expm1(-Pe);  // 1 - exp(-Pe)
   if (em_out) *em_out = em;
-  const double F = Pe < 1e-6 ? 1.0 + 0.5 * Pe : Pe / em;
+  const double F = peclet_factor_em(Pe, em);
   if (dres) {
     const double dw = w > 0.0 ? q.dw : 0.0;
     // F'(Pe) = (1 - e^-Pe (1 + Pe)) / (1 - e^-Pe)^2
@@ -131,8 +136,7 @@ InterfaceState interface_at_q(const Groups& G, const VapourParts& q, double phi,
   if (advected) {
     s.w = std::max(q.w, 0.0);
     s.peclet = s.w * g;
-    // peclet_factor(Pe) for Pe >= 0
-    F = s.peclet < 1e-6 ? 1.0 + 0.5 * s.peclet : s.peclet / (em ? *em : -std::expm1(-s.peclet));
+    F = peclet_factor_em(s.peclet, em ? *em : -std::expm1(-s.peclet));
   }
   s.grad_top = s.theta_sat / g * F + b2 * g;
   s.grad_bottom = s.theta_sat / g * F * std::exp(-s.peclet) - b2 * g;
@@ -151,7 +155,6 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
   const double E = gaussian_beam(xi);
   s.phi = G.theta_m;
   s.theta_sat = 0.0;
-  double F = 1.0;
   if (!(g > 0.0)) {
     // Vanishing layer: all that is not evaporated at T_m is conducted through.
     const double q = std::max(E - G.vapour_melt, 0.0) / G.kprime;
@@ -187,25 +190,22 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       }
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
       if (advected) {
-        // vapour term, recession rate and pressure from one exponential (the expressions of
-        // vapour_term and flux_recession_rate)
-        const double e = std::exp(G.Hlv * (1.0 - 1.0 / s.phi)), sq = std::sqrt(s.phi);
-        const double v = e * (1.0 + G.Lambda * s.phi) / (G.Iprime * sq);
-        s.w = std::max(G.Ni * v - G.Psi * (G.p0 * e / G.p_scale) * sq, 0.0);
-        s.peclet = s.w * g;
-        F = peclet_factor(s.peclet);
-        s.residual = (v + G.kprime * (s.theta_sat / g * F + b2 * g) - E) / E;
-        s.grad_top = s.theta_sat / g * F + b2 * g;
-        s.grad_bottom = s.theta_sat / g * F * std::exp(-s.peclet) - b2 * g;
-        s.p_pa = G.p0 * e;
-        s.p_star = s.p_pa / G.p_scale;
-        return s;
-      } else {
-        s.residual = interface_residual_e(G, s.phi, E, g, b2, nullptr) / E;
+        // the state at the root from one exponential of the vapour pressure and one 1 - exp(-Pe)
+        const VapourParts q = vapour_parts(G, s.phi, false);
+        double em = 0.0;
+        const double res = advected_residual_of(G, q, s.phi, E, g, b2, nullptr, &em);
+        InterfaceState a = interface_at_q(G, q, s.phi, g, b2, true, &em);
+        a.residual = res / E;
+        a.iterations = s.iterations;
+        a.converged = s.converged;
+        return a;
       }
+      s.residual = interface_residual_e(G, s.phi, E, g, b2, nullptr) / E;
     }
-    s.grad_top = s.theta_sat / g * F + b2 * g;
-    s.grad_bottom = s.theta_sat / g * F * std::exp(-s.peclet) - b2 * g;
+    // the linear profile of (4-26): a layer without a vapour root has w = 0 (the advected one
+    // with its root returned above)
+    s.grad_top = s.theta_sat / g + b2 * g;
+    s.grad_bottom = s.theta_sat / g - b2 * g;
   }
   s.p_pa = G.p0 * std::exp(G.Hlv * (1.0 - 1.0 / s.phi));
   s.p_star = s.p_pa / G.p_scale;
