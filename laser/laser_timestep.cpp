@@ -149,6 +149,8 @@ bool safeguarded(const Result& r) {
 // advances by the limit's sub-step whatever the step, so halving the step does not halve it
 // and a step-doubling difference leaves that part of the error out
 double substep_share(const Result& r) { return r.steps > 0 ? double(r.heat_substeps_extra) / r.steps : 0.0; }
+// sub-steps per step of a run on average, mbar = (steps + sub-steps added) / steps (steps > 0)
+double mean_substeps(const Result& r) { return double(r.steps + r.heat_substeps_extra) / double(r.steps); }
 }  // namespace
 
 // Step-doubling estimate of the middle run of three at steps 2h, h, h/2 (quantities Dc, Dm,
@@ -187,7 +189,7 @@ bool finished(const Result& r) { return r.status == "ok" || r.status == "inaccur
 // halvings (the rate that sets the split is that of the flow, about the same at every step).
 int TimeStepPolicy::heat_courant_skip(const Result& coarse) {
   if (!(coarse.steps > 0) || coarse.heat_substeps_extra <= 0) return 0;
-  const double mbar = double(coarse.steps + coarse.heat_substeps_extra) / double(coarse.steps);
+  const double mbar = mean_substeps(coarse);
   if (!(mbar > kSkipSubsteps)) return 0;
   return static_cast<int>(std::ceil(std::log2(mbar))) - 1;
 }
@@ -228,7 +230,7 @@ bool TimeStepPolicy::first_levels(const Config& cfg, Levels& L, long& steps, int
     if (coarse_stopped()) return false;
     const int skip = L.has_coarse ? heat_courant_skip(L.coarse) : 0;
     if (skip > 0) {
-      const double mbar = double(L.coarse.steps + L.coarse.heat_substeps_extra) / double(L.coarse.steps);
+      const double mbar = mean_substeps(L.coarse);
       const double dt0 = dt;
       dt = std::ldexp(dt, -skip);
       L.skipped = "the heat Courant limit split the steps of the first run (" + fmt(2.0 * dt0, 4) + " s) into " +
