@@ -86,21 +86,21 @@ def rest_area(zmean, zc, R):
     return segment_area(0.5 * (lo + hi), zc, R)[0]
 
 
-def level_ratio(xyz, dx, ppc, axis, c1, c2, R, length):
+def level_ratio(xyz, dx, origin, ppc, axis, c1, c2, R, length):
     """The segment below the level at rest (the mean over the columns of cells across the middle
     fifth of the jar of their highest point, plus half a point spacing) times the jar's length,
-    over the points' own volume (one point spacing everywhere: n (dx / ppc)^3)."""
+    over the points' own volume (one point spacing everywhere: n (dx / ppc)^3). The jar's axis is
+    horizontal, z up: C1 and C2 are the centre's coordinates across it in the order x, y, z."""
     ax = "xyz".index(axis)
-    horiz = [d for d in range(3) if d != ax and d != 2][0]  # the horizontal coordinate across
-    centre = c1 if [d for d in range(3) if d != ax][0] == horiz else c2
+    centre = dict(zip([d for d in range(3) if d != ax], (c1, c2)))
+    horiz = next(d for d in centre if d != 2)  # the horizontal coordinate across the axis
     top = {}
     for q in xyz:
-        key = (int(np.floor(q[horiz] / dx)), int(np.floor(q[ax] / dx)))
+        key = (int(np.floor((q[horiz] - origin[horiz]) / dx)), int(np.floor((q[ax] - origin[ax]) / dx)))
         top[key] = max(top.get(key, -np.inf), q[2])
-    mid = [z for (i, _), z in top.items() if abs((i + 0.5) * dx - centre) < 0.2 * R]
+    mid = [z for (i, _), z in top.items() if abs(origin[horiz] + (i + 0.5) * dx - centre[horiz]) < 0.2 * R]
     level = float(np.mean(mid)) + 0.5 * dx / ppc
-    zc = c2 if [d for d in range(3) if d != ax][1] == 2 else c1
-    return segment_area(level, zc, R)[0] * length / (len(xyz) * (dx / ppc) ** 3)
+    return segment_area(level, centre[2], R)[0] * length / (len(xyz) * (dx / ppc) ** 3)
 
 
 def main():
@@ -155,8 +155,8 @@ def main():
             row["rest_volume_ratio"] = area / first_area
             extra = f"  at rest: volume / first {area / first_area:.5f}"
             if a.length:
-                lev = level_ratio(xyz, dx, a.ppc, a.rest[0], float(a.rest[1]), float(a.rest[2]), float(a.rest[3]),
-                                  a.length)
+                lev = level_ratio(xyz, dx, origin, a.ppc, a.rest[0], float(a.rest[1]), float(a.rest[2]),
+                                  float(a.rest[3]), a.length)
                 row["level_over_points"] = lev
                 extra += f"  level / points' volume {lev:.5f}"
         rows.append(row)
