@@ -512,41 +512,54 @@ TEST(WallGeometry, LoadQueriesNameTheMesh) {
   EXPECT_LT(p[2], 0.8);
 }
 
-// node_side's dist_off: the distance to the nearest triangle of a one-sided mesh, leaving out the
-// triangles in the given planes (the box faces of the volume correction's expected fill). A floor
-// plate in the plane z = 0.5 and a wall plate x = 0.8 (two triangles each); from x = (0.5, 0.5,
-// 0.6) the floor is nearer (0.1) than the wall (0.3): with the plane z = 0.5 left out the wall's
-// 0.3; with x = 0.8 left out too, nothing within reach. The nearest triangle and the side stay
-// those of all triangles. A two-sided plate counts never.
+// node_side's dist_off: the distances to the walls of one-sided meshes, leaving out the triangles
+// in the given planes (the box faces of the volume correction's expected fill). A floor plate in
+// the plane z = 0.5 (fluid above) and a wall plate x = 0.8 (two triangles each); from x = (0.5,
+// 0.5, 0.6) the floor is nearer (0.1) than the wall (0.3). With the wall's fluid side towards x <
+// 0.8 the node is in the concave corner, in front of both faces: dist_off = {0.1, 0.3}; with the
+// plane z = 0.5 left out, the wall's 0.3 alone; with x = 0.8 left out too, nothing within reach.
+// With the wall's fluid side away from the node, the wall is no direction (the node is behind it).
+// The nearest triangle and the side stay those of all triangles. A two-sided plate counts never.
 TEST(WallGeometry, DistanceOffPlanesLeavesOutTheBoxFaces) {
-  std::vector<Tri> tris = plate(0.5, nullptr);
   const double a[3] = {0.8, 0, 0}, b[3] = {0.8, 1, 0}, c[3] = {0.8, 1, 1}, e[3] = {0.8, 0, 1};
-  tris.push_back(make_tri(a, b, c, 0, 54));
-  tris.push_back(make_tri(a, c, e, 0, 81));
   const double x[3] = {0.5, 0.5, 0.6};
-  for (const double margin : {0.1, 1.0}) {  // queries within the bins' margin, and scanning all
-    WallGeometry g({wall(mpm::WALL_FREESLIP)});
-    g.set_triangles(tris, kBox, margin);
-    const double reach = 0.4 <= margin ? 0.4 : 0.09;
-    const std::vector<std::pair<int, double>> none, floor{{2, 0.5}}, both{{2, 0.5}, {0, 0.8}};
-    double dist, off;
-    if (reach > 0.3) {
-      EXPECT_EQ(g.node_side(x, reach, &dist, &none, &off), 1);
-      EXPECT_NEAR(dist, 0.1, 1e-14);
-      EXPECT_NEAR(off, 0.1, 1e-14);
-      EXPECT_EQ(g.node_side(x, reach, &dist, &floor, &off), 1);
-      EXPECT_NEAR(dist, 0.1, 1e-14);
-      EXPECT_NEAR(off, 0.3, 1e-14);
-      g.node_side(x, reach, &dist, &both, &off);
-      EXPECT_EQ(off, reach);
+  constexpr int K = WallGeometry::kWallDirs;
+  for (const bool facing : {true, false}) {  // the wall's normal towards the node (-x) or away (+x)
+    std::vector<Tri> tris = plate(0.5, nullptr);
+    if (facing) {
+      tris.push_back(make_tri(a, c, b, 0, 54));
+      tris.push_back(make_tri(a, e, c, 0, 81));
     } else {
-      EXPECT_EQ(g.node_side(x, reach, &dist, &none, &off), 0);
-      EXPECT_EQ(off, reach);
+      tris.push_back(make_tri(a, b, c, 0, 54));
+      tris.push_back(make_tri(a, c, e, 0, 81));
     }
-    WallGeometry two({wall(mpm::WALL_FREESLIP, 1.0, mpm::SIDE_BOTH)});
-    two.set_triangles(tris, kBox, margin);
-    two.node_side(x, reach, &dist, &none, &off);
-    EXPECT_EQ(off, reach);
+    for (const double margin : {0.1, 1.0}) {  // queries within the bins' margin, and scanning all
+      WallGeometry g({wall(mpm::WALL_FREESLIP)});
+      g.set_triangles(tris, kBox, margin);
+      const double reach = 0.4 <= margin ? 0.4 : 0.09;
+      const std::vector<std::pair<int, double>> none, floor{{2, 0.5}}, both{{2, 0.5}, {0, 0.8}};
+      double dist, off[K];
+      if (reach > 0.3) {
+        EXPECT_EQ(g.node_side(x, reach, &dist, &none, off), 1);
+        EXPECT_NEAR(dist, 0.1, 1e-14);
+        EXPECT_NEAR(off[0], 0.1, 1e-14);
+        EXPECT_NEAR(off[1], facing ? 0.3 : reach, 1e-14) << facing;
+        EXPECT_EQ(off[2], reach);
+        EXPECT_EQ(g.node_side(x, reach, &dist, &floor, off), 1);
+        EXPECT_NEAR(dist, 0.1, 1e-14);
+        EXPECT_NEAR(off[0], 0.3, 1e-14);  // behind the wall: the nearest distance alone
+        EXPECT_EQ(off[1], reach);
+        g.node_side(x, reach, &dist, &both, off);
+        EXPECT_EQ(off[0], reach);
+      } else {
+        EXPECT_EQ(g.node_side(x, reach, &dist, &none, off), 0);
+        EXPECT_EQ(off[0], reach);
+      }
+      WallGeometry two({wall(mpm::WALL_FREESLIP, 1.0, mpm::SIDE_BOTH)});
+      two.set_triangles(tris, kBox, margin);
+      two.node_side(x, reach, &dist, &none, off);
+      for (int k = 0; k < K; ++k) EXPECT_EQ(off[k], reach);
+    }
   }
 }
 
