@@ -191,8 +191,32 @@ def case_spin(r):
     check(max(s["mass"]) == min(s["mass"]) and s["corrections"][-1] == 0, "fluid mass exact, no point put back")
 
 
+def spin_run(r, name, np, wall):
+    """The turning jar of case_spin (12 cells, 0.3 s) on np ranks; its dump frames."""
+    d = r.fresh(f"projection_mesh/{name}")
+    shutil.copy(os.path.join(DATA, "in.projection_jar_spin"), d)
+    subprocess.run([sys.executable, os.path.join(HERE, "..", "..", "tools", "make_jar_stl.py"), "jar.stl",
+                    "--axis", "y", "--centre", "0.05", "0.05", "0.05"], cwd=d, check=True,
+                   stdout=subprocess.DEVNULL)
+    r.execute(d, "in.projection_jar_spin", {"cells": 12, "rpm": 104.0, "wall": wall}, np=np)
+    return dump_frames(os.path.join(d, "dump.points"))
+
+
 def case_np2_vs_np1(r):
-    """The inclined wall at rest and the piston on 2 ranks (split in z, through the fluid) against 1."""
+    """The inclined wall at rest and the piston on 2 ranks (split in z, through the fluid) against 1;
+    the turning jar of case_spin (split in x, the corner frames of its mesh gathered on every rank),
+    free-slip and with the shear wall: the same to the bit (points matched by their first position:
+    the ranks number them in their own order)."""
+    for wall in ("freeslip", "shear auto 1"):
+        fa, fb = spin_run(r, "spin_np1", 1, wall), spin_run(r, "spin_np2", 2, wall)
+        first = {tuple(q[1:4]): q[0] for q in fa[0][1]}
+        ids = {q[0]: first.get(tuple(q[1:4])) for q in fb[0][1]}
+        a = {q[0]: q[1:] for q in fa[-1][1]}
+        b = {ids[q[0]]: q[1:] for q in fb[-1][1]}
+        check(len(fa) == len(fb) == 2 and set(a) == set(b), f"jar, {wall}: the same points on 2 ranks")
+        diff = max(max(abs(a[k][i] - b[k][i]) for i in range(6)) for k in a)
+        print(f"  jar turning, {wall}: np2 - np1: positions and velocities {diff:.1e}")
+        check(diff == 0.0, f"jar, {wall}: np2 equals np1 to the bit")
     for name, v in (("rest30", {"angle": 30, "xw": 0.4137}), ("piston", {"mode": "piston"})):
         d1, _, _ = run(r, f"{name}_np1", **v)
         d2, _, _ = run(r, f"{name}_np2", np=2, **v)
