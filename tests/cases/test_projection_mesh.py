@@ -205,7 +205,7 @@ def spin_run(r, name, np, wall):
 def case_np2_vs_np1(r):
     """The inclined wall at rest and the piston on 2 ranks (split in z, through the fluid) against 1;
     the turning jar of case_spin (split in x, the corner frames of its mesh gathered on every rank),
-    free-slip and with the shear wall: the same to the bit (points matched by their first position:
+    free-slip and with the shear wall: the same to round-off (points matched by their first position:
     the ranks number them in their own order)."""
     for wall in ("freeslip", "shear auto 1"):
         fa, fb = spin_run(r, "spin_np1", 1, wall), spin_run(r, "spin_np2", 2, wall)
@@ -214,9 +214,11 @@ def case_np2_vs_np1(r):
         a = {q[0]: q[1:] for q in fa[-1][1]}
         b = {ids[q[0]]: q[1:] for q in fb[-1][1]}
         check(len(fa) == len(fb) == 2 and set(a) == set(b), f"jar, {wall}: the same points on 2 ranks")
-        diff = max(max(abs(a[k][i] - b[k][i]) for i in range(6)) for k in a)
-        print(f"  jar turning, {wall}: np2 - np1: positions and velocities {diff:.1e}")
-        check(diff == 0.0, f"jar, {wall}: np2 equals np1 to the bit")
+        dx = max(max(abs(a[k][i] - b[k][i]) for i in range(3)) for k in a)
+        dv = max(max(abs(a[k][i] - b[k][i]) for i in range(3, 6)) for k in a)
+        print(f"  jar turning, {wall}: np2 - np1: positions {dx:.1e} m, velocities {dv:.1e} m/s")
+        # measured 0 and 0 (the same to the bit)
+        check(dx < 1e-9 and dv < 1e-6, f"jar, {wall}: np2 equals np1 to round-off")
     for name, v in (("rest30", {"angle": 30, "xw": 0.4137}), ("piston", {"mode": "piston"})):
         d1, _, _ = run(r, f"{name}_np1", **v)
         d2, _, _ = run(r, f"{name}_np2", np=2, **v)
