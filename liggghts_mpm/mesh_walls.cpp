@@ -103,6 +103,19 @@ void pack_for_ranks(const double *rec, const double lo[3], const double hi[3], c
   }
 }
 
+// a triangle from its packed record (finish_tri still to do)
+WallGeometry::Tri unpack_tri(const double *r) {
+  WallGeometry::Tri t;
+  for (int j = 0; j < 3; ++j)
+    for (int d = 0; d < 3; ++d) {
+      t.p[j][d] = r[3 * j + d];
+      t.w[j][d] = r[9 + 3 * j + d];
+    }
+  t.mesh = static_cast<int>(r[18]);
+  t.key = static_cast<long long>(r[19]) * 27 + static_cast<long long>(r[20]);
+  return t;
+}
+
 }  // namespace
 
 bool MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], double margin) {
@@ -132,8 +145,10 @@ bool MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
     }
   }
 
-  // pack my triangles for every rank whose box they (or an image) touch
+  // pack my triangles for every rank whose box they (or an image) touch; the first time, all of
+  // them for every rank as well (the corner frames)
   std::vector<std::vector<double>> out(nprocs);
+  std::vector<double> whole;
   for (size_t k = 0; k < ids_.size(); ++k) {
     auto *fm = static_cast<FixMeshSurface *>(resolve(static_cast<int>(k)));
     TriMesh *m = fm->triMesh();
@@ -153,6 +168,8 @@ bool MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
       }
       rec[18] = static_cast<double>(k);
       rec[19] = static_cast<double>(m->id(i));
+      rec[20] = 0.0;  // no periodic image
+      if (!frames_set_) whole.insert(whole.end(), rec, rec + kPack);
       double lo[3], hi[3];
       for (int d = 0; d < 3; ++d) {
         lo[d] = std::min({rec[d], rec[3 + d], rec[6 + d]});
@@ -160,6 +177,11 @@ bool MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
       }
       pack_for_ranks(rec, lo, hi, boxes, shifts, out);
     }
+  }
+
+  if (!frames_set_) {
+    set_corner_frames(whole);
+    frames_set_ = true;
   }
 
   // exchange
@@ -170,18 +192,31 @@ bool MeshWalls::refresh(const double patch_lo[3], const double patch_hi[3], doub
   std::vector<WallGeometry::Tri> tris;
   tris.reserve(rtot / kPack);
   for (int at = 0; at + kPack <= rtot; at += kPack) {
-    WallGeometry::Tri t;
-    const double *r = &rbuf[at];
-    for (int j = 0; j < 3; ++j)
-      for (int d = 0; d < 3; ++d) {
-        t.p[j][d] = r[3 * j + d];
-        t.w[j][d] = r[9 + 3 * j + d];
-      }
-    t.mesh = static_cast<int>(r[18]);
-    t.key = static_cast<long long>(r[19]) * 27 + static_cast<long long>(r[20]);
+    WallGeometry::Tri t = unpack_tri(&rbuf[at]);
     if (WallGeometry::finish_tri(t)) tris.push_back(t);  // degenerate (zero area) ones are dropped
   }
   return geo_.set_triangles(std::move(tris), mybox, margin);
+}
+
+/* Every triangle of every mesh on every rank, once (collective): the corner frames of the smooth
+   surface the meshes stand for (WallGeometry::set_corner_frames). 'mine' holds this rank's records. */
+void MeshWalls::set_corner_frames(const std::vector<double> &mine) {
+  MPI_Comm world = lmp_->world;
+  int nprocs = 1;
+  MPI_Comm_size(world, &nprocs);
+  const int n = static_cast<int>(mine.size());
+  std::vector<int> counts(nprocs), displs(nprocs, 0);
+  MPI_Allgather(&n, 1, MPI_INT, counts.data(), 1, MPI_INT, world);
+  for (int r = 1; r < nprocs; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  std::vector<double> all(static_cast<std::size_t>(displs[nprocs - 1]) + counts[nprocs - 1]);
+  MPI_Allgatherv(mine.data(), n, MPI_DOUBLE, all.data(), counts.data(), displs.data(), MPI_DOUBLE, world);
+  std::vector<WallGeometry::Tri> tris;
+  tris.reserve(all.size() / kPack);
+  for (std::size_t at = 0; at + kPack <= all.size(); at += kPack) {
+    WallGeometry::Tri t = unpack_tri(&all[at]);
+    if (WallGeometry::finish_tri(t)) tris.push_back(t);
+  }
+  geo_.set_corner_frames(tris);
 }
 
 // ---------------------------------------------------------------------------------------------

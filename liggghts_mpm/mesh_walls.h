@@ -81,10 +81,12 @@ class MeshWalls {
 
  private:
   void *resolve(int k) const;   // FixMeshSurface* of mesh k (re-looked up by ID)
+  void set_corner_frames(const std::vector<double> &mine);  // refresh, the first time
 
   LAMMPS_NS::LAMMPS *lmp_;
   std::vector<std::string> ids_;  // fix IDs of the meshes
   WallGeometry geo_;
+  bool frames_set_ = false;  // the corner frames of the meshes (WallGeometry::set_corner_frames)
 };
 
 }  // namespace mpm

@@ -228,14 +228,15 @@ class Projection {
   std::vector<double> theta_last_;  // theta of the last solve (the d(theta)/dt source)
   bool have_theta_last_ = false;
   std::vector<double> vol_;         // volume correction: sum S V with the padding folded back
-  // volume correction with mesh walls: per node in front of a wall its distance (cells) to the
-  // nearest triangle off the box's faces (mesh_wall_labels), kWallFar beyond the shape's reach
+  // volume correction with mesh walls: per node in front of walls its distances (cells) to the
+  // walls off the box's faces, WallGeometry::kWallDirs per node (mesh_wall_labels,
+  // WallGeometry::node_side), kWallFar beyond the shape's reach
   static constexpr double kWallFar = 2.0;
   std::vector<double> wall_dist_;
-  // node (i, j, k) = n beside a mesh wall: *full := the fill it reads from an even fill of
-  // points (np per cell) at rest, *gaps := whether a fill below it is a gap (left as they are
-  // farther than kWallFar from the wall)
-  void expected_fill(int i, int j, int k, std::size_t n, int np, double *full, bool *gaps) const;
+  // node (i, j, k) = n beside mesh walls: the fill it reads from an even fill of points (np per
+  // cell) at rest, against which crowding (*crowd) and gaps (*gap) are read (left as they are,
+  // 1, farther than kWallFar from every wall)
+  void expected_fill(int i, int j, int k, std::size_t n, int np, double *crowd, double *gap) const;
   std::vector<double> q_, grad_q_, drift_;  // volume correction: its potential, gradient and drift
   void add_volume_correction(const double *pvol, const double *theta, double h, double share);
   void volume_drift(const double *pvol, const double *theta, double h, double share, long step);

@@ -226,7 +226,7 @@ void Projection::mesh_wall_labels(const WallGeometry &walls) {
   const bool cover = opt_.volume_correction > 0.0;
   std::vector<std::pair<int, double>> planes;
   if (cover) {
-    wall_dist_.assign(grid_.size(), kWallFar);
+    wall_dist_.assign(WallGeometry::kWallDirs * grid_.size(), kWallFar);
     for (int d = 0; d < 3; ++d)
       if (!gs.periodic[d]) {
         planes.emplace_back(d, gs.origin[d]);
@@ -242,11 +242,13 @@ void Projection::mesh_wall_labels(const WallGeometry &walls) {
       double w = 0.0;
       if (walls.crosses(x, d, dx, &w)) lab_.close_face(grid_, i, j, k, d, w);
     }
-    double dist, off;
-    const int side = walls.node_side(x, 2.0 * dx, &dist, &planes, cover ? &off : nullptr);
+    double dist, off[WallGeometry::kWallDirs];
+    const int side = walls.node_side(x, 2.0 * dx, &dist, &planes, cover ? off : nullptr);
     if (side < 0) lab_.kind[n] = kSolid;
     if (side > 0) frac_[n] = std::min(1.0, 0.5 + dist / dx);
-    if (cover && side > 0) wall_dist_[n] = std::min(off / dx, kWallFar);
+    if (cover && side > 0)
+      for (int q = 0; q < WallGeometry::kWallDirs; ++q)
+        wall_dist_[WallGeometry::kWallDirs * n + q] = std::min(off[q] / dx, kWallFar);
   });
 }
 

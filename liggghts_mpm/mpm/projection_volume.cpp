@@ -59,13 +59,18 @@ void Projection::add_volume_correction(const double *pvol, const double *theta, 
     // the part of the error beyond the band kVolumeBand: what the points' own sampling of a
     // moving fluid gives is left alone; beside a mesh wall, the fill of a lattice at rest there
     // in place of 1, and gaps not read where the wall's share is unknown (expected_fill)
-    double full = 1.0;
-    bool gaps = true;
-    if (mesh_) expected_fill(i, j, k, n, np, &full, &gaps);
-    double e = sum / (dx3 * cv * full) - 1.0;
-    e = e > kVolumeBand ? e - kVolumeBand : (e < -kVolumeBand ? e + kVolumeBand : 0.0);
-    // a partly filled node under the surface, or beside a mesh wall
-    if (e < 0.0 && (!gaps || !deep_inside(i, j, k))) return;
+    double crowd = 1.0, gap = 1.0;
+    if (mesh_) expected_fill(i, j, k, n, np, &crowd, &gap);
+    const double fill = sum / (dx3 * cv);
+    double e = fill / crowd - 1.0;
+    if (e > kVolumeBand) {
+      e -= kVolumeBand;
+    } else {
+      e = fill / gap - 1.0;
+      e = e < -kVolumeBand ? e + kVolumeBand : 0.0;
+    }
+    // a partly filled node under the surface
+    if (e < 0.0 && !deep_inside(i, j, k)) return;
     const double th = theta ? theta[n] : 1.0;
     rhs_[n] -= cv * th * a * e / (h * h);
   });
@@ -126,15 +131,20 @@ void Projection::volume_drift(const double *pvol, const double *theta, double h,
    that a wall at an angle to the face leaves out: beside a 30 degree wall the corner node on the
    floor read 0.985 against F(s + b) = 0.939, and the drift broke the column's hydrostatic rows by
    0.25 rho g dz). */
-void Projection::expected_fill(int i, int j, int k, std::size_t n, int np, double *full, bool *gaps) const {
-  const double s = wall_dist_[n], b = 0.5 / np;
-  if (s >= kWallFar) return;
-  *gaps = s >= 1.5 + b;
+void Projection::expected_fill(int i, int j, int k, std::size_t n, int np, double *crowd, double *gap) const {
+  const double *s = &wall_dist_[WallGeometry::kWallDirs * n], b = 0.5 / np;
+  if (s[0] >= kWallFar) return;
+  double fc = 1.0, fg = 1.0;
+  for (int q = 0; q < WallGeometry::kWallDirs && s[q] < kWallFar; ++q) {
+    fc *= continuum_fill(s[q] + b, opt_.shape);
+    fg *= continuum_fill(s[q] - b, opt_.shape);
+  }
+  *gap = fg;
   const GridSpec &gs = opt_.grid;
   const int idx[3] = {i, j, k};
   for (int d = 0; d < 3; ++d)
     if (!gs.periodic[d] && (idx[d] <= 1 || idx[d] >= gs.ncell[d] - 1)) return;
-  *full = continuum_fill(s + b, opt_.shape);
+  *crowd = fc;
 }
 
 // no EMPTY node among the 26 neighbours: phi is within the band kVolumeBand of 1 there for a

@@ -181,6 +181,23 @@ void WallGeometry::keep_hits(const double x[3], double reach, double r2, const s
   }
 }
 
+namespace {
+// The smooth surface's normal at barycentric weights b of triangle t (its corner normals
+// interpolated), oriented as n: in n if it lies within kSmoothCos of n (an edge between facets of
+// one smooth surface, seen from a node near it), and true; else n is left (a real edge).
+bool smooth_normal(const WallGeometry::Tri &t, const double b[3], double n[3]) {
+  double s[3];
+  for (int q = 0; q < 3; ++q) s[q] = b[0] * t.cn[0][q] + b[1] * t.cn[1][q] + b[2] * t.cn[2][q];
+  const double len = std::sqrt(dot3(s, s));
+  if (!(len > 0.0)) return false;
+  double c = dot3(s, n) / len;
+  const double sg = c < 0.0 ? -1.0 : 1.0;
+  if (sg * c < WallGeometry::kSmoothCos) return false;
+  for (int q = 0; q < 3; ++q) n[q] = sg * s[q] / len;
+  return true;
+}
+}  // namespace
+
 // collect's constraints from the kept hits (at most kMaxConstraints in out); returns their number.
 int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_fluid, double rf2, double rb2,
                               WallConstraint *out) const {
@@ -194,12 +211,17 @@ int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_f
     // Face-region hits of a mesh take precedence over its edge/vertex hits, so that the internal
     // edges of a flat or gently curved wall add no constraint. A node near edges/vertices only is
     // behind the mesh if it is behind the planes of all those triangles (outside a closed box's
-    // edge or corner); else it faces a rounded edge.
+    // edge or corner); else it faces a rounded edge. Of edge/vertex hits only the nearest one acts:
+    // the others are farther points of the same surface (beyond a jar's rim, the vertices of its
+    // end cap along the rim, at directions tens of degrees apart, which together imposed the whole
+    // wall velocity of a turning jar on the node).
     bool any_face = false, any = false, all_back = true;
+    int nearest = -1;
     for (int h = 0; h < nh; ++h) {
       if (tris_[idx[h]].mesh != static_cast<int>(k)) continue;
       any = true;
       if (hits[h].face) any_face = true;
+      if (nearest < 0 || hits[h].dist2 < hits[nearest].dist2) nearest = h;
     }
     if (!any) continue;
     if (!any_face)
@@ -210,8 +232,9 @@ int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_f
     for (int h = 0; h < nh; ++h) {
       const Tri &t = tris_[idx[h]];
       if (t.mesh != static_cast<int>(k) || hits[h].face != any_face) continue;
+      if (!any_face && h != nearest) continue;
       double n[3];
-      bool behind;
+      bool behind, smooth_edge = false;
       if (any_face) {
         double sg;
         if (side == SIDE_NORMAL) sg = 1.0;
@@ -229,11 +252,18 @@ int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_f
         // normal from the edge towards the fluid
         const double f = behind ? -1.0 / dl : 1.0 / dl;
         for (int q = 0; q < 3; ++q) n[q] = f * dd[h][q];
+        smooth_edge = t.smooth && smooth_normal(t, hits[h].b, n);
       }
       if (hits[h].dist2 > (behind ? rb2 : rf2)) continue;
       if (nout >= kMaxConstraints) continue;
       WallConstraint &o = out[nout++];
       wall_velocity(t, hits[h].b, o.w);
+      if (smooth_edge) {
+        // at an edge of a smooth surface: its normal there, and its normal speed along it
+        const double *b = hits[h].b;
+        const double dn = b[0] * t.vn[0] + b[1] * t.vn[1] + b[2] * t.vn[2] - dot3(o.w, n);
+        for (int q = 0; q < 3; ++q) o.w[q] += dn * n[q];
+      }
       for (int q = 0; q < 3; ++q) o.n[q] = n[q];
       o.sticky = sticky;
       o.rate = walls_[k].kind == WALL_SHEAR ? wall_layer_rate(nu_, layer_thickness(static_cast<int>(k)), reach_fluid) : 0.0;

@@ -6,10 +6,12 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
-#include <cstring>
 #include <cmath>
+#include <cstring>
+#include <map>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
 #include "mpm/wall_tri_ops.h"
@@ -21,6 +23,7 @@ namespace {
 using geom::dot3;
 using geom::sub3;
 using wall_tri::beyond_box;
+using wall_tri::wall_velocity;
 
 }  // namespace
 
@@ -84,6 +87,7 @@ bool WallGeometry::set_triangles(std::vector<Tri> tris, const double box[6], dou
   tris_ = std::move(tris);
   margin_ = margin;
   fit_rotation();
+  normal_speeds();
 
   // bins over my box
   for (int d = 0; d < 3; ++d) {
@@ -93,6 +97,94 @@ bool WallGeometry::set_triangles(std::vector<Tri> tris, const double box[6], dou
   bins_.clear();
   if (box[0] <= box[3] && box[1] <= box[4] && box[2] <= box[5]) bins_build(box);
   return true;
+}
+
+namespace {
+// the key of a triangle's corner frames: its wall and triangle ID (key / 27: images share it)
+long long frame_key(const WallGeometry::Tri &t, int nwalls) {
+  return (t.key / 27) * static_cast<long long>(std::max(nwalls, 1)) + t.mesh;
+}
+
+// the triangle's own frame: unit normal n, unit first edge e1, e2 = n x e1
+void tri_frame(const WallGeometry::Tri &t, double e1[3], double e2[3]) {
+  double len = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    e1[d] = t.p[1][d] - t.p[0][d];
+    len += e1[d] * e1[d];
+  }
+  len = std::sqrt(len);
+  for (int d = 0; d < 3; ++d) e1[d] /= len;
+  e2[0] = t.n[1] * e1[2] - t.n[2] * e1[1];
+  e2[1] = t.n[2] * e1[0] - t.n[0] * e1[2];
+  e2[2] = t.n[0] * e1[1] - t.n[1] * e1[0];
+}
+}  // namespace
+
+void WallGeometry::set_corner_frames(const std::vector<Tri> &all) {
+  frames_.clear();
+  have_set_ = false;  // the next set_triangles recomputes the normal speeds
+  const int nw = walls();
+  // the corners at each vertex of each wall (positions to the bit)
+  std::map<std::tuple<int, double, double, double>, std::vector<std::pair<int, int>>> at;
+  for (int i = 0; i < static_cast<int>(all.size()); ++i)
+    for (int c = 0; c < 3; ++c) at[{all[i].mesh, all[i].p[c][0], all[i].p[c][1], all[i].p[c][2]}].push_back({i, c});
+  // interior angle of triangle t at corner c
+  auto angle = [](const Tri &t, int c) {
+    const double *o = t.p[c], *a = t.p[(c + 1) % 3], *b = t.p[(c + 2) % 3];
+    double u[3], v[3];
+    sub3(a, o, u);
+    sub3(b, o, v);
+    const double cr[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    return std::atan2(std::sqrt(dot3(cr, cr)), dot3(u, v));
+  };
+  for (const Tri &t : all) {
+    std::array<double, 9> f{};
+    bool flat = true;
+    double m[3][3];
+    for (int c = 0; c < 3; ++c) {
+      double s[3] = {0.0, 0.0, 0.0};
+      for (const auto &tc : at[{t.mesh, t.p[c][0], t.p[c][1], t.p[c][2]}]) {
+        const Tri &u = all[tc.first];
+        if (dot3(u.n, t.n) < kSmoothCos) continue;  // a real edge, or the other side of a wall
+        const double a = angle(u, tc.second);
+        for (int d = 0; d < 3; ++d) s[d] += a * u.n[d];
+      }
+      const double len = std::sqrt(dot3(s, s));
+      for (int d = 0; d < 3; ++d) m[c][d] = len > 0.0 ? s[d] / len : t.n[d];
+      double r[3];
+      sub3(m[c], t.n, r);
+      if (dot3(r, r) > 1e-24) flat = false;
+    }
+    if (flat) continue;  // the triangle's own normal at every corner: no frame (crosses as before)
+    double e1[3], e2[3];
+    tri_frame(t, e1, e2);
+    for (int c = 0; c < 3; ++c) {
+      f[3 * c] = dot3(m[c], t.n);
+      f[3 * c + 1] = dot3(m[c], e1);
+      f[3 * c + 2] = dot3(m[c], e2);
+    }
+    frames_[frame_key(t, nw)] = f;
+  }
+}
+
+// vn and smooth of every triangle of tris_ from frames_ (set_triangles)
+void WallGeometry::normal_speeds() {
+  const int nw = walls();
+  for (Tri &t : tris_) {
+    t.smooth = false;
+    if (frames_.empty()) continue;
+    const auto it = frames_.find(frame_key(t, nw));
+    if (it == frames_.end()) continue;
+    const std::array<double, 9> &f = it->second;
+    double e1[3], e2[3];
+    tri_frame(t, e1, e2);
+    for (int c = 0; c < 3; ++c) {
+      double *m = t.cn[c];
+      for (int d = 0; d < 3; ++d) m[d] = f[3 * c] * t.n[d] + f[3 * c + 1] * e1[d] + f[3 * c + 2] * e2[d];
+      t.vn[c] = dot3(t.w[c], m);
+    }
+    t.smooth = true;
+  }
 }
 
 void WallGeometry::bins_build(const double box[6]) {
@@ -326,7 +418,7 @@ bool WallGeometry::crosses(const double a[3], int d, double len, double *w_d) co
     x[d] += std::min(std::max(f, 0.0), 1.0) * len;
     if (!inside_tri(t, x, 1e-9, bw)) continue;
     double w[3];
-    for (int e = 0; e < 3; ++e) w[e] = bw[0] * t.w[0][e] + bw[1] * t.w[1][e] + bw[2] * t.w[2][e];
+    wall_velocity(t, bw, w);
     *w_d = dot3(w, t.n) * t.n[d];
     return true;
   }
@@ -347,22 +439,41 @@ bool in_planes(const WallGeometry::Tri &t, const std::vector<std::pair<int, doub
 int WallGeometry::node_side(const double x[3], double reach, double *dist,
                             const std::vector<std::pair<int, double>> *planes, double *dist_off) const {
   *dist = reach;
-  if (dist_off) *dist_off = reach;
+  if (dist_off) std::fill(dist_off, dist_off + kWallDirs, reach);
   if (tris_.empty()) return 0;
   const std::vector<int> *cand = reach <= margin_ ? candidates(x) : nullptr;
   const int ncand = cand ? static_cast<int>(cand->size()) : static_cast<int>(tris_.size());
-  // nearest distance, then the sides of the triangles at that distance (face hits first)
+  // nearest distance, then the sides of the triangles at that distance (face hits first); off the
+  // planes: the nearest triangle, whether it is a face hit in front, and the nearest face hit in
+  // front in each direction
   double best = reach * reach, best_off = best;
-  bool any = false, best_face = false;
+  bool any = false, best_face = false, off_face = false;
+  int nd = 0;
+  double dir_n[kMax][3], dir_d2[kMax];
   for (int c = 0; c < ncand; ++c) {
     const Tri &t = tris_[cand ? (*cand)[c] : c];
     if (beyond_box(t, x, reach)) continue;
     Hit h;
     closest_point(t, x, h);
-    if (dist_off && h.dist2 < best_off) {
-      const int side = walls_[t.mesh].side;
-      if ((side == SIDE_NORMAL || side == SIDE_OPPOSITE) && !(planes && in_planes(t, *planes, 1e-9 * reach)))
-        best_off = h.dist2;
+    const int side = walls_[t.mesh].side;
+    if (dist_off && h.dist2 < reach * reach && (side == SIDE_NORMAL || side == SIDE_OPPOSITE) &&
+        !(planes && in_planes(t, *planes, 1e-9 * reach))) {
+      double r[3];
+      sub3(x, h.p, r);
+      const bool front_face = h.face && side * dot3(r, t.n) >= -5e-10 * reach;  // on the plane too
+      if (h.dist2 < best_off * (1.0 - 1e-9)) off_face = front_face;
+      else if (h.dist2 <= best_off * (1.0 + 1e-9)) off_face = off_face || front_face;
+      best_off = std::min(best_off, h.dist2);
+      if (front_face) {
+        int k = 0;
+        while (k < nd && side * dot3(dir_n[k], t.n) <= kCos) ++k;
+        if (k == nd && nd < kMax) {
+          for (int q = 0; q < 3; ++q) dir_n[nd][q] = side * t.n[q];
+          dir_d2[nd++] = h.dist2;
+        } else if (k < nd) {
+          dir_d2[k] = std::min(dir_d2[k], h.dist2);
+        }
+      }
     }
     if (h.dist2 > best * (1.0 + 1e-9) + 1e-24) continue;
     if (h.dist2 < best * (1.0 - 1e-9)) best_face = false;
@@ -370,7 +481,14 @@ int WallGeometry::node_side(const double x[3], double reach, double *dist,
     best_face = best_face || h.face;
     any = true;
   }
-  if (dist_off) *dist_off = std::sqrt(best_off);
+  if (dist_off) {
+    if (off_face) {
+      std::sort(dir_d2, dir_d2 + nd);
+      for (int k = 0; k < std::min(nd, kWallDirs); ++k) dist_off[k] = std::sqrt(dir_d2[k]);
+    } else {
+      dist_off[0] = std::sqrt(best_off);
+    }
+  }
   if (!any) return 0;
   *dist = std::sqrt(best);
   bool all_back = true, two_sided = false, found = false;

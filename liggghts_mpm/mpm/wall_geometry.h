@@ -11,8 +11,10 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -87,6 +89,11 @@ class WallGeometry {
     double lo[3], hi[3];
     int mesh;         // index of the wall (WallSpec) the triangle belongs to
     long long key;    // e.g. 27 * global triangle ID + periodic image code (the order of application)
+    // the normal of the smooth surface the mesh stands for at the corners (cn) and the normal
+    // speed along it there (vn) (set_corner_frames; set by set_triangles), used where 'smooth'
+    double cn[3][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+    double vn[3] = {0.0, 0.0, 0.0};
+    bool smooth = false;
   };
   // Closest point of a triangle to a point.
   struct Hit {
@@ -111,6 +118,21 @@ class WallGeometry {
   // sorting), the box and the margin are those of the last call to the bit: walls at rest need no
   // new constraints at the nodes.
   bool set_triangles(std::vector<Tri> tris, const double box[6], double margin);
+
+  // The normal of the smooth surface a mesh of flat triangles stands for, at each corner of each
+  // triangle: the angle-weighted mean of the normals of the triangles of the same wall that share
+  // the corner's vertex (the same position to the bit) and whose normal lies within kSmoothCos
+  // of the triangle's own (an edge sharper than that, such as a lifter bar's, is a real edge).
+  // 'all' holds every triangle of every wall once (no periodic images), finished; the corner
+  // normals are kept per (wall, triangle ID = key / 27) in the triangle's own frame (normal, first
+  // edge, their cross product), so that they follow a rigid motion of the mesh, and set_triangles
+  // gives every triangle with such a frame the normal speeds vn of its corners. A rotating
+  // tessellated surface of revolution (a drum, a jar) then moves along itself at the grid's
+  // closed faces (crosses): the flat facets' own normal motion, omega times the distance from a
+  // facet's centre line, is a source of fluid at the scale of the facets that the grid cannot
+  // resolve (docs/theory/projection.md, "Mesh walls").
+  void set_corner_frames(const std::vector<Tri> &all);
+  static constexpr double kSmoothCos = 0.8660;  // 30 degrees
 
   // Applies the wall condition to the velocity vel of a grid node at x, for every triangle within
   // 'reach' of x on its fluid side, or within 'reach_behind' (default: reach) of x behind it
@@ -176,15 +198,21 @@ class WallGeometry {
   // a two-sided wall is cut off on both sides) and the crossing point inside the triangle (1e-9 in
   // barycentric weights). *w_d: the d component of the wall velocity's normal part, (w . n) n_d,
   // at the crossing (of the first such triangle in the fixed order): a wall moving along itself
-  // is no source of fluid (docs/theory/projection.md, "Mesh walls"). len <= margin, else all triangles
-  // are scanned.
+  // is no source of fluid (docs/theory/projection.md, "Mesh walls"); on a triangle with corner
+  // frames (set_corner_frames) the normal speed w . n is the corners' smooth-surface normal
+  // speeds vn interpolated to the crossing. len <= margin, else all triangles are scanned.
   bool crosses(const double a[3], int d, double len, double *w_d) const;
   // Side of x with respect to the nearest triangle within 'reach': -1 behind a one-sided mesh
   // (behind the planes of all equally near triangles; face hits first), +1 in front of one,
   // 0 none within reach or the nearest is two-sided. *dist: the distance to it (reach if none).
-  // dist_off (optional): the distance to the nearest triangle of a one-sided mesh within reach
-  // (reach if none) that does not lie in one of the planes x_d = c given as (d, c) (the faces of
-  // the grid box, behind which the fluid's mirror image stands already), from the same scan.
+  // dist_off (optional, kWallDirs entries): the walls of one-sided meshes within reach that do not
+  // lie in one of the planes x_d = c given as (d, c) (the faces of the grid box, behind which the
+  // fluid's mirror image stands already), from the same scan: where the nearest of their
+  // triangles is a face hit that x is in front of, the distance to the nearest face in each of up
+  // to kWallDirs directions (normals within kCos of each other are one direction; the nearest
+  // directions), x in a concave corner being in front of several; else (x beyond an edge or a
+  // vertex, or behind) the distance to the nearest triangle alone. Unused entries: reach.
+  static constexpr int kWallDirs = 3;
   int node_side(const double x[3], double reach, double *dist,
                 const std::vector<std::pair<int, double>> *planes = nullptr, double *dist_off = nullptr) const;
 
@@ -238,6 +266,10 @@ class WallGeometry {
   double nu_ = 0.0;  // kinematic viscosity (shear walls)
   std::vector<double> omega_;  // rotation rate of each wall (set_triangles)
   void fit_rotation();
+  // set_corner_frames: per wall and triangle ID, the corner normals' coefficients (normal, first
+  // edge, their cross product) of the three corners; normal_speeds() applies them to tris_
+  std::unordered_map<long long, std::array<double, 9>> frames_;
+  void normal_speeds();
   // uniform bins over [blo_, blo_ + nb_*bsize_]
   double blo_[3] = {0, 0, 0}, bsize_ = 1.0;
   int nb_[3] = {0, 0, 0};

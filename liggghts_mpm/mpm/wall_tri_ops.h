@@ -13,9 +13,15 @@ inline bool beyond_box(const WallGeometry::Tri &t, const double x[3], double r) 
          x[2] < t.lo[2] - r || x[2] > t.hi[2] + r;
 }
 
-// Velocity of the wall at barycentric weights b.
+// Velocity of the wall at barycentric weights b. On a facet of a smooth surface (t.smooth), the
+// component along the facet's normal is the smooth surface's normal speed at b (set_corner_frames):
+// a tessellated surface of revolution turning about its axis moves along itself.
 inline void wall_velocity(const WallGeometry::Tri &t, const double b[3], double w[3]) {
   for (int d = 0; d < 3; ++d) w[d] = b[0] * t.w[0][d] + b[1] * t.w[1][d] + b[2] * t.w[2][d];
+  if (!t.smooth) return;
+  const double dn = b[0] * t.vn[0] + b[1] * t.vn[1] + b[2] * t.vn[2] -
+                    (w[0] * t.n[0] + w[1] * t.n[1] + w[2] * t.n[2]);
+  for (int d = 0; d < 3; ++d) w[d] += dn * t.n[d];
 }
 
 }  // namespace wall_tri

@@ -512,40 +512,225 @@ TEST(WallGeometry, LoadQueriesNameTheMesh) {
   EXPECT_LT(p[2], 0.8);
 }
 
-// node_side's dist_off: the distance to the nearest triangle of a one-sided mesh, leaving out the
-// triangles in the given planes (the box faces of the volume correction's expected fill). A floor
-// plate in the plane z = 0.5 and a wall plate x = 0.8 (two triangles each); from x = (0.5, 0.5,
-// 0.6) the floor is nearer (0.1) than the wall (0.3): with the plane z = 0.5 left out the wall's
-// 0.3; with x = 0.8 left out too, nothing within reach. The nearest triangle and the side stay
-// those of all triangles. A two-sided plate counts never.
+// node_side's dist_off: the distances to the walls of one-sided meshes, leaving out the triangles
+// in the given planes (the box faces of the volume correction's expected fill). A floor plate in
+// the plane z = 0.5 (fluid above) and a wall plate x = 0.8 (two triangles each); from x = (0.5,
+// 0.5, 0.6) the floor is nearer (0.1) than the wall (0.3). With the wall's fluid side towards x <
+// 0.8 the node is in the concave corner, in front of both faces: dist_off = {0.1, 0.3}; with the
+// plane z = 0.5 left out, the wall's 0.3 alone; with x = 0.8 left out too, nothing within reach.
+// With the wall's fluid side away from the node, the wall is no direction (the node is behind it).
+// The nearest triangle and the side stay those of all triangles. A two-sided plate counts never.
 TEST(WallGeometry, DistanceOffPlanesLeavesOutTheBoxFaces) {
-  std::vector<Tri> tris = plate(0.5, nullptr);
   const double a[3] = {0.8, 0, 0}, b[3] = {0.8, 1, 0}, c[3] = {0.8, 1, 1}, e[3] = {0.8, 0, 1};
-  tris.push_back(make_tri(a, b, c, 0, 54));
-  tris.push_back(make_tri(a, c, e, 0, 81));
   const double x[3] = {0.5, 0.5, 0.6};
-  for (const double margin : {0.1, 1.0}) {  // queries within the bins' margin, and scanning all
-    WallGeometry g({wall(mpm::WALL_FREESLIP)});
-    g.set_triangles(tris, kBox, margin);
-    const double reach = 0.4 <= margin ? 0.4 : 0.09;
-    const std::vector<std::pair<int, double>> none, floor{{2, 0.5}}, both{{2, 0.5}, {0, 0.8}};
-    double dist, off;
-    if (reach > 0.3) {
-      EXPECT_EQ(g.node_side(x, reach, &dist, &none, &off), 1);
-      EXPECT_NEAR(dist, 0.1, 1e-14);
-      EXPECT_NEAR(off, 0.1, 1e-14);
-      EXPECT_EQ(g.node_side(x, reach, &dist, &floor, &off), 1);
-      EXPECT_NEAR(dist, 0.1, 1e-14);
-      EXPECT_NEAR(off, 0.3, 1e-14);
-      g.node_side(x, reach, &dist, &both, &off);
-      EXPECT_EQ(off, reach);
+  constexpr int K = WallGeometry::kWallDirs;
+  for (const bool facing : {true, false}) {  // the wall's normal towards the node (-x) or away (+x)
+    std::vector<Tri> tris = plate(0.5, nullptr);
+    if (facing) {
+      tris.push_back(make_tri(a, c, b, 0, 54));
+      tris.push_back(make_tri(a, e, c, 0, 81));
     } else {
-      EXPECT_EQ(g.node_side(x, reach, &dist, &none, &off), 0);
-      EXPECT_EQ(off, reach);
+      tris.push_back(make_tri(a, b, c, 0, 54));
+      tris.push_back(make_tri(a, c, e, 0, 81));
     }
-    WallGeometry two({wall(mpm::WALL_FREESLIP, 1.0, mpm::SIDE_BOTH)});
-    two.set_triangles(tris, kBox, margin);
-    two.node_side(x, reach, &dist, &none, &off);
-    EXPECT_EQ(off, reach);
+    for (const double margin : {0.1, 1.0}) {  // queries within the bins' margin, and scanning all
+      WallGeometry g({wall(mpm::WALL_FREESLIP)});
+      g.set_triangles(tris, kBox, margin);
+      const double reach = 0.4 <= margin ? 0.4 : 0.09;
+      const std::vector<std::pair<int, double>> none, floor{{2, 0.5}}, both{{2, 0.5}, {0, 0.8}};
+      double dist, off[K];
+      if (reach > 0.3) {
+        EXPECT_EQ(g.node_side(x, reach, &dist, &none, off), 1);
+        EXPECT_NEAR(dist, 0.1, 1e-14);
+        EXPECT_NEAR(off[0], 0.1, 1e-14);
+        EXPECT_NEAR(off[1], facing ? 0.3 : reach, 1e-14) << facing;
+        EXPECT_EQ(off[2], reach);
+        EXPECT_EQ(g.node_side(x, reach, &dist, &floor, off), 1);
+        EXPECT_NEAR(dist, 0.1, 1e-14);
+        EXPECT_NEAR(off[0], 0.3, 1e-14);  // behind the wall: the nearest distance alone
+        EXPECT_EQ(off[1], reach);
+        g.node_side(x, reach, &dist, &both, off);
+        EXPECT_EQ(off[0], reach);
+      } else {
+        EXPECT_EQ(g.node_side(x, reach, &dist, &none, off), 0);
+        EXPECT_EQ(off[0], reach);
+      }
+      WallGeometry two({wall(mpm::WALL_FREESLIP, 1.0, mpm::SIDE_BOTH)});
+      two.set_triangles(tris, kBox, margin);
+      two.node_side(x, reach, &dist, &none, off);
+      for (int k = 0; k < K; ++k) EXPECT_EQ(off[k], reach);
+    }
   }
+}
+
+namespace {
+// A drum band: nf facets (two triangles each) of the cylinder of radius R about the axis along y
+// through (xc, *, zc), from y = 0 to y = len, turning at omega about that axis; shared vertices
+// are the same to the bit (the same expression); the normals point to the axis (the fluid inside).
+std::vector<Tri> turning_band(int nf, double R, double len, double omega, int mesh = 0) {
+  const double xc = 0.05, zc = 0.05;
+  auto point = [&](double y, int f, double *x, double *w) {
+    const double phi = 2.0 * M_PI * (f % nf) / nf;  // the last facet ends where the first begins
+    x[0] = xc + R * std::cos(phi);
+    x[1] = y;
+    x[2] = zc + R * std::sin(phi);
+    w[0] = omega * (x[2] - zc);  // omega e_y x r
+    w[1] = 0.0;
+    w[2] = -omega * (x[0] - xc);
+  };
+  std::vector<Tri> tris;
+  for (int f = 0; f < nf; ++f) {
+    double p[4][3], w[4][3];
+    point(0.0, f, p[0], w[0]);
+    point(len, f, p[1], w[1]);
+    point(len, f + 1, p[2], w[2]);
+    point(0.0, f + 1, p[3], w[3]);
+    const int q[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int h = 0; h < 2; ++h) {
+      Tri t = make_tri(p[q[h][0]], p[q[h][1]], p[q[h][2]], mesh, 27LL * (2 * f + h));
+      for (int j = 0; j < 3; ++j)
+        for (int d = 0; d < 3; ++d) t.w[j][d] = w[q[h][j]][d];
+      tris.push_back(t);
+    }
+  }
+  return tris;
+}
+
+// normal speed of the raw facet velocity (the triangle's own normal) at barycentric weights b
+double facet_normal_speed(const Tri &t, const double b[3]) {
+  double s = 0.0;
+  for (int d = 0; d < 3; ++d) s += (b[0] * t.w[0][d] + b[1] * t.w[1][d] + b[2] * t.w[2][d]) * t.n[d];
+  return s;
+}
+}  // namespace
+
+// A tessellated drum turning about its axis moves along itself: each flat facet has a normal
+// speed omega times the distance from its centre line (up to omega R sin(pi / nf)), the smooth
+// surface it stands for none. With the corner frames (set_corner_frames) the wall conditions and
+// the projection's closed faces see the smooth surface's normal speed, 0 to round-off; without
+// them the facets' own. The frames follow the mesh: set from the band at one angle, they serve
+// the band turned by 0.3 rad. A flat plate has no frames (its triangles keep their own normal, bit
+// for bit), and a box's 90-degree edges are real edges.
+TEST(WallGeometry, TurningDrumMovesAlongItself) {
+  const int nf = 72;
+  const double R = 0.05, len = 0.1, omega = 10.9, wr = omega * R;
+  const double box[6] = {-0.02, -0.02, -0.02, 0.12, 0.12, 0.12};
+  WallGeometry raw({wall(mpm::WALL_FREESLIP, 0.0, mpm::SIDE_OPPOSITE)});
+  WallGeometry smooth({wall(mpm::WALL_FREESLIP, 0.0, mpm::SIDE_OPPOSITE)});
+  std::vector<Tri> band = turning_band(nf, R, len, omega);
+  smooth.set_corner_frames(band);
+  // the band turned by 0.3 rad (its triangles' IDs kept): the frames are in each triangle's own frame
+  std::vector<Tri> turned = band;
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  for (Tri &t : turned) {
+    for (int j = 0; j < 3; ++j) {
+      const double x = t.p[j][0] - 0.05, z = t.p[j][2] - 0.05;
+      t.p[j][0] = 0.05 + c * x - s * z;
+      t.p[j][2] = 0.05 + s * x + c * z;
+      t.w[j][0] = omega * (t.p[j][2] - 0.05);
+      t.w[j][2] = -omega * (t.p[j][0] - 0.05);
+    }
+    ASSERT_TRUE(WallGeometry::finish_tri(t));
+  }
+  raw.set_triangles(turned, box, 0.02);
+  smooth.set_triangles(turned, box, 0.02);
+  double raw_max = 0.0;
+  for (const Tri &t : smooth.triangles()) {
+    ASSERT_TRUE(t.smooth);
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(t.vn[j], 0.0, 1e-12 * wr);
+    const double b[3] = {1.0, 0.0, 0.0};
+    raw_max = std::max(raw_max, std::fabs(facet_normal_speed(t, b)));
+  }
+  EXPECT_NEAR(raw_max, wr * std::sin(M_PI / nf), 1e-9 * wr);  // what the facets alone would give
+  // a node inside the drum near the wall, at angles across one facet: the wall condition
+  // imposes the normal speed 0 (smooth) against up to omega R sin(pi / nf) (raw)
+  double seen_raw = 0.0;
+  for (int k = 0; k <= 10; ++k) {
+    const double phi = 0.3 + 2.0 * M_PI * (7.0 + 0.1 * k) / nf, r = R - 0.002;
+    const double x[3] = {0.05 + r * std::cos(phi), 0.04, 0.05 + r * std::sin(phi)};
+    for (WallGeometry *g : {&raw, &smooth}) {
+      WallConstraint con[WallGeometry::kMaxConstraints];
+      const int nc = g->collect(x, 0.005, 0.01, con);
+      ASSERT_EQ(nc, 1) << k;
+      const double wn = con[0].w[0] * con[0].n[0] + con[0].w[1] * con[0].n[1] + con[0].w[2] * con[0].n[2];
+      if (g == &smooth) EXPECT_NEAR(wn, 0.0, 1e-12 * wr) << k;
+      else seen_raw = std::max(seen_raw, std::fabs(wn));
+    }
+    // the projection's closed face along the radius through x
+    double a[3] = {x[0], x[1], x[2]}, wd_raw = 0.0, wd = 0.0;
+    const int d = std::fabs(std::cos(phi)) > std::fabs(std::sin(phi)) ? 0 : 2;
+    const double step = 0.004 * (d == 0 ? (std::cos(phi) > 0 ? 1.0 : -1.0) : (std::sin(phi) > 0 ? 1.0 : -1.0));
+    if (step < 0) a[d] += step;
+    ASSERT_TRUE(smooth.crosses(a, d, std::fabs(step), &wd)) << k;
+    ASSERT_TRUE(raw.crosses(a, d, std::fabs(step), &wd_raw)) << k;
+    EXPECT_NEAR(wd, 0.0, 1e-12 * wr) << k;
+  }
+  EXPECT_GT(seen_raw, 0.5 * wr * std::sin(M_PI / nf));
+  // a flat plate: no frames, its triangles as they were
+  WallGeometry flat({wall(mpm::WALL_FREESLIP)});
+  const double w[3] = {0.1, 0.2, -0.3};
+  std::vector<Tri> pl = plate(0.5, w);
+  flat.set_corner_frames(pl);
+  flat.set_triangles(pl, kBox, 0.1);
+  for (const Tri &t : flat.triangles()) EXPECT_FALSE(t.smooth);
+  // a cube's faces meet at 90 degrees: real edges, no frames either
+  WallGeometry cube({wall(mpm::WALL_FREESLIP)});
+  std::vector<Tri> ct;
+  for (int d = 0; d < 3; ++d)
+    for (int side = 0; side < 2; ++side) {
+      double p[4][3];
+      for (int q = 0; q < 4; ++q) {
+        const int e = (d + 1) % 3, f = (d + 2) % 3;
+        p[q][d] = side;
+        p[q][e] = (q == 1 || q == 2) ? 1.0 : 0.0;
+        p[q][f] = q >= 2 ? 1.0 : 0.0;
+      }
+      const long long key = 27LL * (4 * d + 2 * side);
+      ct.push_back(make_tri(p[0], p[1], p[2], 0, key, w));
+      ct.push_back(make_tri(p[0], p[2], p[3], 0, key + 27, w));
+    }
+  cube.set_corner_frames(ct);
+  cube.set_triangles(ct, kBox, 0.1);
+  for (const Tri &t : cube.triangles()) EXPECT_FALSE(t.smooth);
+}
+
+// Beyond the rim of a turning disk (a fan of 72 triangles in the plane z = 0.5 turning about its
+// axis), a node in the disk's plane sees only edges and vertices of the rim, tens of degrees
+// apart within its reach. Only the nearest acts: the node's velocity keeps the rim's normal
+// speed, not the whole wall velocity that all of them together imposed (the corner node of a
+// turning jar next to a face of the box).
+TEST(WallGeometry, EdgeHitsActOnlyByTheNearest) {
+  const int nf = 72;
+  const double R = 0.05, omega = 10.9, wr = omega * R;
+  std::vector<Tri> fan;
+  const double o[3] = {0.5, 0.5, 0.5}, wo[3] = {0.0, 0.0, 0.0};
+  for (int f = 0; f < nf; ++f) {
+    double p[2][3], w[2][3];
+    for (int q = 0; q < 2; ++q) {
+      const double phi = 2.0 * M_PI * (f + q) / nf;
+      p[q][0] = 0.5 + R * std::cos(phi);
+      p[q][1] = 0.5 + R * std::sin(phi);
+      p[q][2] = 0.5;
+      w[q][0] = -omega * (p[q][1] - 0.5);
+      w[q][1] = omega * (p[q][0] - 0.5);
+      w[q][2] = 0.0;
+    }
+    Tri t = make_tri(o, p[0], p[1], 0, 27LL * f);
+    for (int d = 0; d < 3; ++d) {
+      t.w[0][d] = wo[d];
+      t.w[1][d] = w[0][d];
+      t.w[2][d] = w[1][d];
+    }
+    fan.push_back(t);
+  }
+  WallGeometry g({wall(mpm::WALL_FREESLIP, 0.0, mpm::SIDE_NORMAL)});
+  g.set_triangles(fan, kBox, 0.02);
+  const double dx = 0.1 / 18;
+  const double x[3] = {0.5 + R + 0.3 * dx, 0.5 + 0.2 * dx, 0.5};
+  WallConstraint con[WallGeometry::kMaxConstraints];
+  const int nc = g.collect(x, dx, 2.0 * dx, con);
+  ASSERT_EQ(nc, 1);
+  double v[3] = {0.0, 0.0, 0.0};
+  WallGeometry::impose(con, nc, v, 1e-3);
+  EXPECT_LT(std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]), wr * std::sin(M_PI / nf) + 1e-12);
 }
