@@ -207,6 +207,11 @@ Result Drill::run() {
   long next_progress = nsteps / 10;
   auto last_progress = std::chrono::steady_clock::now();
   double tau = 0.0;
+  // the first run of an automatic ladder stops after its probe steps where they were split into
+  // more than heat_probe_mbar sub-steps on average (Config::heat_probe_share)
+  const long probe_steps =
+      cfg_.heat_probe_share > 0.0 ? std::max(1L, static_cast<long>(std::ceil(cfg_.heat_probe_share * nsteps))) : 0;
+  bool probed = false;
   for (long step_no = 0; step_no < nsteps; ++step_no) {
     const double ta = tau;
     const double tb = (step_no == nsteps - 1) ? tau_p : std::min(tau_p, (step_no + 1) * dtau_);
@@ -219,6 +224,11 @@ Result Drill::run() {
     for (int k = 1; k <= m && going; ++k)
       going = step(step_no, ta + (tb - ta) * (k - 1) / m, k == m ? tb : ta + (tb - ta) * k / m, tau);
     if (!going) break;
+    if (step_no + 1 == probe_steps && step_no + 1 < nsteps &&
+        double(step_no + 1 + heat_substeps_total_) / double(step_no + 1) > cfg_.heat_probe_mbar) {
+      probed = true;
+      break;
+    }
     const bool frame = tb >= tau_p * next_frame / (nframes - 1) - 1e-12 * tau_p;
     if (frame) ++next_frame;
     if (frame || step_no % centre_every == 0 || step_no == nsteps - 1) record(tb, frame);
@@ -236,6 +246,7 @@ Result Drill::run() {
   if (res_.frames_written == 0 || (res_.status != "diverged" && res_.final_frame.t < tau * G_.t_scale))
     record(tau, true);
   if (sink_) sink_->finish();
+  if (probed) res_.status = "split_probe";
   finish(tau);
   return res_;
 }

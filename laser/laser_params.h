@@ -93,6 +93,12 @@ struct Config {
   // heat Courant number kept per step by --melt-heat flux by splitting the step
   // (docs/theory/laser_model.md 2.10); 0: no splitting
   double heat_courant = 0.0;
+  // Set by the time-step policy for the first run of an automatic ladder (no option): where the
+  // heat Courant limit split the first heat_probe_share of the run's steps into more than
+  // heat_probe_mbar sub-steps on average, the run stops there with status "split_probe" (the
+  // ladder then skips to finer levels, laser_timestep.h); 0: the run goes to the end.
+  double heat_probe_share = 0.0;
+  double heat_probe_mbar = 0.0;
   int frames = 200;        // HDF5 frames
   std::string out = "laser_out";
   bool overwrite = false;

@@ -216,25 +216,33 @@ bool TimeStepPolicy::first_levels(const Config& cfg, Levels& L, long& steps, int
     return false;
   };
   if (automatic_ && coarse_ok(2.0 * dt)) {
+    // the first run stops after kSkipProbeShare of its steps where they were split into more
+    // than kSkipSubsteps sub-steps on average (status "split_probe": the ladder skips below it)
+    Config first = cfg;
+    first.heat_probe_share = kSkipProbeShare;
+    first.heat_probe_mbar = kSkipSubsteps;
     // the run-time check of (4-14) may still fire: the automatic step is halved then
-    L.coarse = run_at(cfg, 2.0 * dt, true, steps, make_sink);
+    L.coarse = run_at(first, 2.0 * dt, true, steps, make_sink);
     ++runs;
     for (int k = 0; k < 6 && L.coarse.status == "unstable_time_step"; ++k) {
       dt *= 0.5;
       if (!cfg.quiet)
         std::fprintf(stderr, "laser_drill: automatic step unstable (%s); retrying with dt = %.4g s\n",
                      L.coarse.message.c_str(), dt);
-      L.coarse = run_at(cfg, 2.0 * dt, true, steps, make_sink);
+      L.coarse = run_at(first, 2.0 * dt, true, steps, make_sink);
       ++runs;
     }
     if (coarse_stopped()) return false;
-    const int skip = L.has_coarse ? heat_courant_skip(L.coarse) : 0;
+    const bool probed = L.coarse.status == "split_probe";
+    const int skip = L.has_coarse || probed ? heat_courant_skip(L.coarse) : 0;
     if (skip > 0) {
       const double mbar = mean_substeps(L.coarse);
       const double dt0 = dt;
       dt = std::ldexp(dt, -skip);
       L.skipped = "the heat Courant limit split the steps of the first run (" + fmt(2.0 * dt0, 4) + " s) into " +
-                  fmt(mbar, 3) + " sub-steps on average: the ladder skipped " + std::to_string(skip) +
+                  fmt(mbar, 3) + " sub-steps on average" +
+                  (probed ? " over its first " + std::to_string(L.coarse.steps) + " steps (where it stopped)" : "") +
+                  ": the ladder skipped " + std::to_string(skip) +
                   " halvings and started at dt = " + fmt(dt, 4) + " s, where the reported run is expected unsplit";
       if (!cfg.quiet) std::fprintf(stderr, "laser_drill: %s\n", L.skipped.c_str());
       L.coarse = run_at(cfg, 2.0 * dt, true, steps, make_sink);

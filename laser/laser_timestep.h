@@ -56,6 +56,9 @@ class TimeStepPolicy {
   // many sub-steps per step on average skips the levels down to the one whose reported run is
   // expected unsplit (heat_courant_start).
   static constexpr double kSkipSubsteps = 4.0;
+  // The first run is judged on this share of its steps: where they were split into more than
+  // kSkipSubsteps sub-steps on average it stops there and the skip is taken from their mean.
+  static constexpr double kSkipProbeShare = 0.1;
   // Frames of a candidate run are kept in memory up to this size (fields per node and frame).
   static constexpr double kMaxFrameBytes = 256.0 * 1024 * 1024;
   static constexpr double kFrameFields = 11;

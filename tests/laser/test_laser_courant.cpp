@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "laser_model.h"
@@ -150,4 +151,43 @@ TEST(LaserCourant, SplitFirstRunSkipsToTheUnsplitLevel) {
   EXPECT_LE(r.dt, p.dt() / 4.0 * (1.0 + 1e-12));
   EXPECT_LE(std::max(r.step.depth_error, r.step.volume_error), c.tol);
   EXPECT_EQ(r.b2_clamps, 0);
+}
+
+// The first run of an automatic ladder is judged on its first kSkipProbeShare of steps (docs 2.10):
+// where they were split into more than kSkipSubsteps sub-steps on average it stops there
+// ("split_probe") and the skip taken from them is the one the whole run gives (Pr 1420, 50 us,
+// X = 0.1); where they were not, it runs to the end with the state of a run without the probe,
+// to the bit (the shipped Pr 142 config with X = 0.5, whose first run is split into 3.1 on
+// average, and 3.85 over its first tenth).
+TEST(LaserCourant, FirstRunProbeStopsOnlyWhereTheSkipIsDecided) {
+  auto first_runs = [](Config c) {
+    c.dt = 2.0 * TimeStepPolicy(c).dt();
+    const Result full = run_simulation(c);
+    c.heat_probe_share = TimeStepPolicy::kSkipProbeShare;
+    c.heat_probe_mbar = TimeStepPolicy::kSkipSubsteps;
+    return std::make_pair(full, run_simulation(c));
+  };
+  const auto [full, probe] = first_runs(prandtl1420(0.1));
+  ASSERT_EQ(full.status, "ok") << full.message;
+  EXPECT_EQ(probe.status, "split_probe");
+  EXPECT_EQ(probe.steps, static_cast<int>(std::ceil(TimeStepPolicy::kSkipProbeShare * full.steps)));
+  EXPECT_GT(double(probe.steps + probe.heat_substeps_extra) / probe.steps, TimeStepPolicy::kSkipSubsteps);
+  EXPECT_EQ(TimeStepPolicy::heat_courant_skip(probe), TimeStepPolicy::heat_courant_skip(full));
+  EXPECT_EQ(TimeStepPolicy::heat_courant_skip(full), 2);
+  std::printf("[ PR1420 ] first run: %d steps, %ld sub-steps added; stopped after %d, %ld added\n", full.steps,
+              full.heat_substeps_extra, probe.steps, probe.heat_substeps_extra);
+
+  Config c142;
+  read_config_file(c142, std::string(LASER_INPUTS_DIR) + "/prandtl142.toml");
+  c142.heat_courant = 0.5;
+  c142.quiet = true;
+  validate(c142);
+  const auto [f142, p142] = first_runs(c142);
+  EXPECT_EQ(p142.status, f142.status);
+  EXPECT_EQ(p142.steps, f142.steps);
+  EXPECT_EQ(p142.heat_substeps_extra, f142.heat_substeps_extra);
+  EXPECT_GT(f142.heat_substeps_extra, 0);
+  EXPECT_EQ(p142.depth_center, f142.depth_center);
+  EXPECT_EQ(p142.volume_removed, f142.volume_removed);
+  EXPECT_EQ(TimeStepPolicy::heat_courant_skip(f142), 0);
 }
