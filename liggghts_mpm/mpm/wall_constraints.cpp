@@ -21,6 +21,8 @@ namespace {
 using geom::dot3;
 using geom::sub3;
 using wall_tri::beyond_box;
+using wall_tri::set_normal_part;
+using wall_tri::smooth_normal_speed;
 using wall_tri::wall_velocity;
 
 // Relative velocity r = v - w: normal part along unit n -> max(0, r.n) (fluid side) or 0 (behind).
@@ -258,12 +260,8 @@ int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_f
       if (nout >= kMaxConstraints) continue;
       WallConstraint &o = out[nout++];
       wall_velocity(t, hits[h].b, o.w);
-      if (smooth_edge) {
-        // at an edge of a smooth surface: its normal there, and its normal speed along it
-        const double *b = hits[h].b;
-        const double dn = b[0] * t.vn[0] + b[1] * t.vn[1] + b[2] * t.vn[2] - dot3(o.w, n);
-        for (int q = 0; q < 3; ++q) o.w[q] += dn * n[q];
-      }
+      // at an edge of a smooth surface: its normal there, and its normal speed along it
+      if (smooth_edge) set_normal_part(o.w, n, smooth_normal_speed(t, hits[h].b));
       for (int q = 0; q < 3; ++q) o.n[q] = n[q];
       o.sticky = sticky;
       o.rate = walls_[k].kind == WALL_SHEAR ? wall_layer_rate(nu_, layer_thickness(static_cast<int>(k)), reach_fluid) : 0.0;
