@@ -225,7 +225,7 @@ Result Drill::run() {
       going = step(step_no, ta + (tb - ta) * (k - 1) / m, k == m ? tb : ta + (tb - ta) * k / m, tau);
     if (!going) break;
     if (step_no + 1 == probe_steps && step_no + 1 < nsteps &&
-        double(step_no + 1 + heat_substeps_total_) / double(step_no + 1) > cfg_.heat_probe_mbar) {
+        mean_substeps(step_no + 1, heat_substeps_total_) > cfg_.heat_probe_mbar) {
       probed = true;
       break;
     }

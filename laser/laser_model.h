@@ -146,6 +146,10 @@ struct Result {
   Groups groups;
 };
 
+// Model steps per step of a run whose heat Courant limit added 'extra' sub-steps to 'steps' steps
+// (the mean split, 1 for none).
+inline double mean_substeps(long steps, long extra) { return double(steps + extra) / double(steps); }
+
 // Runs one case at cfg.dt (> 0); never throws for physical reasons (status
 // says why it ended). Frames go to sink when given, else into Result::frames.
 Result run_simulation(const Config& cfg, FrameSink* sink = nullptr);

@@ -150,7 +150,7 @@ bool safeguarded(const Result& r) {
 // and a step-doubling difference leaves that part of the error out
 double substep_share(const Result& r) { return r.steps > 0 ? double(r.heat_substeps_extra) / r.steps : 0.0; }
 // sub-steps per step of a run on average, mbar = (steps + sub-steps added) / steps (steps > 0)
-double mean_substeps(const Result& r) { return double(r.steps + r.heat_substeps_extra) / double(r.steps); }
+double mean_substeps(const Result& r) { return laser::mean_substeps(r.steps, r.heat_substeps_extra); }
 }  // namespace
 
 // Step-doubling estimate of the middle run of three at steps 2h, h, h/2 (quantities Dc, Dm,
