@@ -354,7 +354,7 @@ void Drill::flux_heat_march() {
     const double s = transient ? 1.0 / (1.0 + g * g / (12.0 * dtn)) : 1.0;
     const double kappa = transient ? s / (2.0 * dtn) : 0.0, H_old = transient ? n.H : 0.0;
     const double beta = qout / (3.0 * a), gamma = hin / (2.0 * a);
-    n.itf = solve_interface_flux(G_, n.xi, g, s * beta, s * gamma, advected_, kappa, H_old, n.itf.phi);
+    n.itf = solve_interface_flux(G_, n.xi, g, s * beta, s * gamma, advected_, kappa, H_old, n.itf);
     const double th = std::max(n.itf.theta_sat, 0.0);
     n.b2 = (s * (beta * th - gamma) + (transient ? kappa * (layer_content(n.itf, g, 0.0) - H_old) : 0.0)) / g;
     // a hit whose flow part alone is within the limit is the layer's content asking for more

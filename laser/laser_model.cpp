@@ -54,7 +54,7 @@ void Drill::melt_onset(double tb) {
 void Drill::solve_interfaces() {
   for (auto& n : nodes_) {
     if (!n.molten) continue;
-    n.itf = solve_interface(G_, n.xi, n.g, n.b2, advected_, n.itf.phi);
+    n.itf = solve_interface(G_, n.xi, n.g, n.b2, advected_, n.itf);
     res_.max_interface_residual = std::max(res_.max_interface_residual, std::fabs(n.itf.residual));
   }
 }
