@@ -10,12 +10,12 @@
 namespace laser {
 namespace detail {
 
-double Drill::solid_gradient_mean(const Node& n, double ta, double tb) const {
+double Drill::solid_gradient_mean(Node& n, double ta, double tb) const {
   const double ti = G_.theta_i;
   switch (cfg_.solid) {
     case SolidModel::Exact: {
       const double sa = (ta - n.tau_m) / n.tau_m, sb = (tb - n.tau_m) / n.tau_m;
-      return ti / std::sqrt(G_.Na * n.tau_m) * exact_->gradient_mean(std::max(sa, 0.0), sb);
+      return ti / std::sqrt(G_.Na * n.tau_m) * exact_->gradient_mean(std::max(sa, 0.0), sb, n.solid);
     }
     case SolidModel::Shifted:
       return stefan_gradient_mean(ti, G_.Na, n.tau_m, ta, tb, cfg_.shift);

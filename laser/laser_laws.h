@@ -143,8 +143,17 @@ inline double recoil_pressure_from_flux(double q, double T, double hlv, double M
 }
 
 // ------------------------------------------------------------------ beam
-// (3-21), nondimensional: I / I0.
-inline double gaussian_beam(double xi) { return std::exp(-xi * xi); }
+// (3-21), nondimensional: I / I0. A run asks for the beam at one node many times in a row
+// (each evaluation of the interface balance and of the recession rate): the last value is
+// kept (per thread) and returned for the same xi, the same number.
+inline double gaussian_beam(double xi) {
+  thread_local double last_xi = std::numeric_limits<double>::quiet_NaN(), last = 0.0;
+  if (!(xi == last_xi)) {
+    last = std::exp(-xi * xi);
+    last_xi = xi;
+  }
+  return last;
+}
 
 // ----------------------------------------------------- nondimensional groups
 struct Material {
