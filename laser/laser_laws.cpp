@@ -131,6 +131,23 @@ const VapourParts& Memo::parts(const Groups& G, double p) {
   return q;
 }
 
+// a solved state keeps its vapour parts and 1 - exp(-Pe) for a solve started from it
+void keep_vapour(InterfaceState& s, const VapourParts& q, double em) {
+  s.vapour = q;
+  s.em = em;
+  s.has_vapour = true;
+}
+
+// The root of an interface solve: where its last Newton correction was at the level of
+// rounding (at most kRoundingUlps units in the last place of phi), the point last evaluated,
+// which is as close to the root as phi can be resolved and whose vapour parts and
+// 1 - exp(-Pe) the solve holds; else the corrected point (evaluated again for the state).
+constexpr double kRoundingUlps = 4.0;
+double at_rounding(const RootResult& rr) {
+  const bool rounding = rr.converged && std::fabs(rr.x - rr.x_eval) <= kRoundingUlps * 0x1p-52 * std::fabs(rr.x);
+  return rounding ? rr.x_eval : rr.x;
+}
+
 // advected_residual from the vapour parts at phi and the beam E = exp(-xi^2); em_out
 // receives 1 - exp(-Pe), which content_factor and interface_at use at the same Pe;
 // memo: where 1 - exp(-Pe) may be known
@@ -222,7 +239,7 @@ InterfaceState solve_interface_m(const Groups& G, double xi, double g, double b2
       if (std::isnormal(G.vapour_melt) || residual(hi, nullptr) > 0.0) {
         auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
         const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
-        s.phi = rr.x;
+        s.phi = at_rounding(rr);
         s.iterations = rr.iterations;
         s.converged = rr.converged;
       } else {
@@ -239,9 +256,7 @@ InterfaceState solve_interface_m(const Groups& G, double xi, double g, double b2
         a.residual = res / E;
         a.iterations = s.iterations;
         a.converged = s.converged;
-        a.vapour = q;
-        a.em = em;
-        a.has_vapour = true;
+        keep_vapour(a, q, em);
         return a;
       }
       s.residual = interface_residual_e(G, s.phi, E, g, b2, nullptr) / E;
@@ -345,7 +360,7 @@ InterfaceState solve_interface_flux_m(const Groups& G, double xi, double g, doub
     if (std::isnormal(G.vapour_melt) || residual(hi, nullptr) > 0.0) {
       auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
       rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
-      phi = rr.x;
+      phi = at_rounding(rr);
     } else {
       phi = hi;
     }
@@ -365,11 +380,7 @@ InterfaceState solve_interface_flux_m(const Groups& G, double xi, double g, doub
   s.iterations = rr.iterations;
   s.converged = rr.converged;
   s.residual = res / E;
-  if (advected) {
-    s.vapour = q;
-    s.em = em;
-    s.has_vapour = true;
-  }
+  if (advected) keep_vapour(s, q, em);
   return s;
 }
 }  // namespace

@@ -21,6 +21,7 @@ struct RootResult {
   double x = 0.0;
   int iterations = 0;
   bool converged = false;
+  double x_eval = std::numeric_limits<double>::quiet_NaN();  // safe_newton: the last point f was evaluated at
 };
 
 // Safeguarded Newton ("rtsafe"): f(lo) and f(hi) must have opposite signs; a
@@ -62,6 +63,7 @@ RootResult safe_newton(const FDF& fdf, double lo, double hi, double xtol, int ma
   double x = inside ? x0 : 0.5 * (lo + hi), dxold = std::fabs(hi - lo), dx = dxold;
   double f, df;
   fdf(x, f, df);
+  r.x_eval = x;
   for (int it = 1; it <= maxit; ++it) {
     r.iterations = it;
     const bool newton_leaves = ((x - hi) * df - f) * ((x - lo) * df - f) > 0.0;
@@ -76,6 +78,7 @@ RootResult safe_newton(const FDF& fdf, double lo, double hi, double xtol, int ma
     }
     if (std::fabs(dx) <= xtol) { r.converged = true; break; }
     fdf(x, f, df);
+    r.x_eval = x;
     if (f == 0.0) { r.converged = true; break; }
     if (f < 0.0) lo = x; else hi = x;
     if (std::fabs(hi - lo) <= xtol) { r.converged = true; break; }
