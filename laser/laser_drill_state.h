@@ -30,6 +30,9 @@ struct Node {
   // the last step, and its change in the last march (booked with the step that uses its b2 g)
   double H = 0, dH = 0;
   int flips = 0;       // consecutive sign changes of dg/dtau with lambda dtau > 2
+  // itf was solved by the face heat march at this g and b2 (its flow part b2 g tied to the
+  // surface temperature, b2 the value at that root): the next step starts from it as it is
+  bool itf_solved = false;
   CorrectedConduction::Cumulative solid;  // the corrected conduction's integral at the last step's end
 };
 

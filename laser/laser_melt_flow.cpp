@@ -324,6 +324,7 @@ void Drill::flux_heat_march() {
     const int i = outward ? k : N - 1 - k;
     Node& n = nodes_[i];
     n.dH = 0.0;
+    n.itf_solved = false;
     if (!active(i) || face_c_.empty()) {
       n.b2 = 0.0;
       n.H = 0.0;
@@ -359,6 +360,7 @@ void Drill::flux_heat_march() {
     n.b2 = (s * (beta * th - gamma) + (transient ? kappa * (layer_content(n.itf, g, 0.0) - H_old) : 0.0)) / g;
     // a hit whose flow part alone is within the limit is the layer's content asking for more
     limit_b2(n, g, th, transient && std::fabs(beta * th - gamma) * g <= th);
+    n.itf_solved = true;
     // the column's heat balance: what it sends on is what came in, plus what its
     // gradients give the flow (2 a b2 g), minus what it keeps in its content; with
     // the solved b2 this is qout 2 theta_sat/3; where the limit of (4-25) held b2
