@@ -139,12 +139,15 @@ std::shared_ptr<const CorrectedConduction> shared_corrected_conduction(double c0
   return t;
 }
 
+double CorrectedConduction::correction_in(double s, size_t k) const {
+  const double w = (s - s_[k - 1]) / (s_[k] - s_[k - 1]);
+  return (1.0 - w) * h_[k - 1] + w * h_[k];
+}
+
 double CorrectedConduction::correction(double s) const {
   if (s <= 0.0) return h_[0];
   if (s >= s_.back()) return asym_coef_ / std::pow(s, 1.5);
-  const size_t k = std::upper_bound(s_.begin(), s_.end(), s) - s_.begin();
-  const double w = (s - s_[k - 1]) / (s_[k] - s_[k - 1]);
-  return (1.0 - w) * h_[k - 1] + w * h_[k];
+  return correction_in(s, std::upper_bound(s_.begin(), s_.end(), s) - s_.begin());
 }
 
 double CorrectedConduction::cumulative(double s) const {
@@ -153,7 +156,8 @@ double CorrectedConduction::cumulative(double s) const {
     return H_.back() + 2.0 * asym_coef_ * (1.0 / std::sqrt(s_.back()) - 1.0 / std::sqrt(s));
   const size_t k = std::upper_bound(s_.begin(), s_.end(), s) - s_.begin();
   const double ds = s - s_[k - 1];
-  return H_[k - 1] + 0.5 * (h_[k - 1] + correction(s)) * ds;
+  const double h = correction_in(s, k);
+  return H_[k - 1] + 0.5 * (h_[k - 1] + h) * ds;
 }
 
 double CorrectedConduction::correction_mean(double sa, double sb) const {
@@ -169,6 +173,16 @@ double CorrectedConduction::gradient_mean(double sa, double sb) const {
   const double xa = sa + c0_, xb = sb + c0_;
   const double stefan = 2.0 / (std::sqrt(kPi) * (std::sqrt(xa) + std::sqrt(xb)));
   return stefan + correction_mean(sa, sb);
+}
+
+double CorrectedConduction::gradient_mean(double sa, double sb, Cumulative& known) const {
+  const double xa = sa + c0_, xb = sb + c0_;
+  const double stefan = 2.0 / (std::sqrt(kPi) * (std::sqrt(xa) + std::sqrt(xb)));
+  if (sb - sa <= 1e-14 * std::max(1.0, sb)) return stefan + correction(0.5 * (sa + sb));
+  const double ca = sa == known.s ? known.value : cumulative(sa), cb = cumulative(sb);
+  known.s = sb;
+  known.value = cb;
+  return stefan + (cb - ca) / (sb - sa);
 }
 
 std::vector<double> reference_gradient(const std::vector<double>& s_out, double dx, double L) {

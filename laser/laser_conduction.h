@@ -53,6 +53,14 @@ class CorrectedConduction {
   // total scaled gradient d(theta_s/theta_i)/dx at x = 0, (3-29)
   double gradient(double s) const;
   double gradient_mean(double sa, double sb) const;
+  // The integral of h from 0 to s, kept by a caller that asks for the means over successive
+  // intervals [s0, s1], [s1, s2], ...: the end of one is the start of the next.
+  struct Cumulative {
+    double s = -1.0, value = 0.0;
+  };
+  // gradient_mean(sa, sb) taking the integral at sa from 'known' where it is at sa, and leaving
+  // the one at sb there: the same number.
+  double gradient_mean(double sa, double sb, Cumulative& known) const;
   const std::vector<double>& s_table() const { return s_; }
   const std::vector<double>& g2_table() const { return g2_; }
   const std::vector<double>& g3_table() const { return g3_; }
@@ -60,6 +68,7 @@ class CorrectedConduction {
 
  private:
   double cumulative(double s) const;  // integral of h from 0 to s
+  double correction_in(double s, size_t k) const;  // correction(s) for s in [s_[k-1], s_[k])
   double c0_;
   std::vector<double> s_, g2_, g3_, th2b_, h_, H_;
   double asym_coef_ = 0;  // h ~ asym_coef / s^1.5 beyond the table

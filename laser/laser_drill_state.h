@@ -30,6 +30,10 @@ struct Node {
   // the last step, and its change in the last march (booked with the step that uses its b2 g)
   double H = 0, dH = 0;
   int flips = 0;       // consecutive sign changes of dg/dtau with lambda dtau > 2
+  // itf was solved by the face heat march at this g and b2 (its flow part b2 g tied to the
+  // surface temperature, b2 the value at that root): the next step starts from it as it is
+  bool itf_solved = false;
+  CorrectedConduction::Cumulative solid;  // the corrected conduction's integral at the last step's end
 };
 
 constexpr int kUnstableFlips = 3;
@@ -64,7 +68,7 @@ class Drill {
   bool solve_melt_flow(double ta, double tb);
   bool conservative_flow(const FlowProfile& profile, int first, double ta, double tb);
   void solve_boundary_layer(int& last_bl);
-  double solid_gradient_mean(const Node& n, double ta, double tb) const;
+  double solid_gradient_mean(Node& n, double ta, double tb) const;
   // phases of advance_interfaces, per node
   struct Geometry { double J = 1, Cc = 1; };
   struct Rates { double dS2 = 0, dS1 = 0, drive = 0; };

@@ -10,12 +10,12 @@
 namespace laser {
 namespace detail {
 
-double Drill::solid_gradient_mean(const Node& n, double ta, double tb) const {
+double Drill::solid_gradient_mean(Node& n, double ta, double tb) const {
   const double ti = G_.theta_i;
   switch (cfg_.solid) {
     case SolidModel::Exact: {
       const double sa = (ta - n.tau_m) / n.tau_m, sb = (tb - n.tau_m) / n.tau_m;
-      return ti / std::sqrt(G_.Na * n.tau_m) * exact_->gradient_mean(std::max(sa, 0.0), sb);
+      return ti / std::sqrt(G_.Na * n.tau_m) * exact_->gradient_mean(std::max(sa, 0.0), sb, n.solid);
     }
     case SolidModel::Shifted:
       return stefan_gradient_mean(ti, G_.Na, n.tau_m, ta, tb, cfg_.shift);
@@ -66,18 +66,23 @@ void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n
   // held over the step; holding b2 itself would let b2 g grow with g_new.
   const double b2g = n.b2 * n.g;
   auto b2_at = [&](double g) { return g > 0.0 ? b2g / g : 0.0; };
-  double phi_last = n.itf.phi;  // the root of the last evaluation starts the next one
-  double g_last = -1.0;         // and its state is kept for the root
-  InterfaceState st;
+  // the root of the last evaluation (its state: from) starts the next one, and its state is
+  // kept for the root
+  const InterfaceState* from = &n.itf;
+  double g_last = -1.0;
+  InterfaceState st, last;
   auto rate_of = [&](const InterfaceState& s) {
     const double d2 = std::max(melting_rate(G_, geo.Cc, grad_n, geo.J, s.grad_bottom, cfg_.moving_origin), 0.0);
     const double d1 = std::max(recession_rate(G_, n.xi, s), 0.0);
     return d2 - d1 + n.v;
   };
   auto rate = [&](double g) {
-    st = solve_interface(G_, n.xi, g, b2_at(g), advected_, phi_last);
+    st = solve_interface(G_, n.xi, g, b2_at(g), advected_, *from);
     g_last = g;
-    if (st.theta_sat > 0.0) phi_last = st.phi;
+    if (st.theta_sat > 0.0) {
+      last = st;
+      from = &last;
+    }
     return rate_of(st);
   };
   const double g_old = n.g;
@@ -101,7 +106,7 @@ void Drill::solve_implicit_thickness(Node& n, const Geometry& geo, double grad_n
     g_new = illinois_root(F, lo, hi, Flo, Fhi, tol, 200, tol).x;
   }
   n.b2 = b2_at(g_new);
-  n.itf = g_new == g_last ? st : solve_interface(G_, n.xi, g_new, n.b2, advected_, phi_last);
+  n.itf = g_new == g_last ? st : solve_interface(G_, n.xi, g_new, n.b2, advected_, *from);
 }
 
 // (3-40) melting and (3-25) recession rates; a negative melting rate is

@@ -75,10 +75,6 @@ double peclet_factor_em(double Pe, double em) { return Pe < 1e-6 ? 1.0 + 0.5 * P
 namespace {
 // The vapour term (vapour_term), its derivative, and the flux recession rate
 // N_i v - Psi p* sqrt(phi) with its derivative, from one exponential.
-struct VapourParts {
-  double v = 0, dv = 0, w = 0, dw = 0;  // w, dw: not clipped at 0
-  double e = 0;                         // exp(H_lv (1 - 1/phi)) = p / p0
-};
 VapourParts vapour_parts(const Groups& G, double phi, bool deriv) {
   VapourParts q;
   const double e = std::exp(G.Hlv * (1.0 - 1.0 / phi));
@@ -93,14 +89,74 @@ VapourParts vapour_parts(const Groups& G, double phi, bool deriv) {
   }
   return q;
 }
+// The evaluations of one interface solve keep what is a function of phi alone (the vapour
+// parts, with their derivatives) or of Pe alone (1 - exp(-Pe), e^Pe - 1) from the last one
+// (and, before the first, from the state the solve starts from): an evaluation at the same phi
+// or Pe takes those numbers instead of computing them again, and every result is the same to
+// the last bit.
+struct Memo {
+  double phi = std::numeric_limits<double>::quiet_NaN();
+  VapourParts q;
+  double Pe = std::numeric_limits<double>::quiet_NaN(), em = 0.0;   // em = 1 - exp(-Pe)
+  double Pe1 = std::numeric_limits<double>::quiet_NaN(), em1 = 0.0; // em1 = e^Pe1 - 1
+  Memo() = default;
+  explicit Memo(const InterfaceState* from) {
+    if (!from || !from->has_vapour) return;
+    phi = from->phi;
+    q = from->vapour;
+    Pe = from->peclet;
+    em = from->em;
+  }
+  const VapourParts& parts(const Groups& G, double p);
+  double em_at(double pe) {
+    if (!(pe == Pe)) {
+      Pe = pe;
+      em = -std::expm1(-pe);
+    }
+    return em;
+  }
+  double em1_at(double pe) {
+    if (!(pe == Pe1)) {
+      Pe1 = pe;
+      em1 = std::expm1(pe);
+    }
+    return em1;
+  }
+};
+const VapourParts& Memo::parts(const Groups& G, double p) {
+  if (!(p == phi)) {
+    phi = p;
+    q = vapour_parts(G, p, true);
+  }
+  return q;
+}
+
+// a solved state keeps its vapour parts and 1 - exp(-Pe) for a solve started from it
+void keep_vapour(InterfaceState& s, const VapourParts& q, double em) {
+  s.vapour = q;
+  s.em = em;
+  s.has_vapour = true;
+}
+
+// The root of an interface solve: where its last Newton correction was at the level of
+// rounding (at most kRoundingUlps units in the last place of phi), the point last evaluated,
+// which is as close to the root as phi can be resolved and whose vapour parts and
+// 1 - exp(-Pe) the solve holds; else the corrected point (evaluated again for the state).
+constexpr double kRoundingUlps = 4.0;
+double at_rounding(const RootResult& rr) {
+  const bool rounding = rr.converged && std::fabs(rr.x - rr.x_eval) <= kRoundingUlps * 0x1p-52 * std::fabs(rr.x);
+  return rounding ? rr.x_eval : rr.x;
+}
+
 // advected_residual from the vapour parts at phi and the beam E = exp(-xi^2); em_out
-// receives 1 - exp(-Pe), which content_factor and interface_at use at the same Pe
+// receives 1 - exp(-Pe), which content_factor and interface_at use at the same Pe;
+// memo: where 1 - exp(-Pe) may be known
 double advected_residual_of(const Groups& G, const VapourParts& q, double phi, double E, double g, double b2,
-                            double* dres, double* em_out = nullptr) {
+                            double* dres, double* em_out = nullptr, Memo* memo = nullptr) {
   const double th = (phi - G.theta_m) / (1.0 - G.theta_m);
   const double w = std::max(q.w, 0.0);
   const double Pe = w * g;
-  const double em = -std::expm1(-Pe);  // 1 - exp(-Pe)
+  const double em = memo ? memo->em_at(Pe) : -std::expm1(-Pe);  // 1 - exp(-Pe)
   if (em_out) *em_out = em;
   const double F = peclet_factor_em(Pe, em);
   if (dres) {
@@ -150,7 +206,9 @@ InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bo
   return interface_at_q(G, vapour_parts(G, phi, false), phi, g, b2, advected);
 }
 
-InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected, double phi_guess) {
+namespace {
+InterfaceState solve_interface_m(const Groups& G, double xi, double g, double b2, bool advected, double phi_guess,
+                                 Memo& memo) {
   InterfaceState s;
   const double E = gaussian_beam(xi);
   s.phi = G.theta_m;
@@ -168,7 +226,7 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       // Advected layer: vapour + k' (theta_sat/g F(w(phi) g) + b2 g) - beam; every
       // term rises with phi and F >= 1, so the linear layer's bracket [theta_m, hi] holds.
       auto residual = [&](double phi, double* df) {
-        return advected ? advected_residual_of(G, vapour_parts(G, phi, df != nullptr), phi, E, g, b2, df)
+        return advected ? advected_residual_of(G, memo.parts(G, phi), phi, E, g, b2, df, nullptr, &memo)
                         : interface_residual_e(G, phi, E, g, b2, df);
       };
       // residual(theta_m) = r0 < 0 < residual(hi): at hi the conduction term is avail, so the
@@ -181,7 +239,7 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       if (std::isnormal(G.vapour_melt) || residual(hi, nullptr) > 0.0) {
         auto fdf = [&](double phi, double& f, double& df) { f = residual(phi, &df); };
         const RootResult rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
-        s.phi = rr.x;
+        s.phi = at_rounding(rr);
         s.iterations = rr.iterations;
         s.converged = rr.converged;
       } else {
@@ -191,13 +249,14 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
       s.theta_sat = (s.phi - G.theta_m) / (1.0 - G.theta_m);
       if (advected) {
         // the state at the root from one exponential of the vapour pressure and one 1 - exp(-Pe)
-        const VapourParts q = vapour_parts(G, s.phi, false);
+        const VapourParts q = memo.parts(G, s.phi);
         double em = 0.0;
-        const double res = advected_residual_of(G, q, s.phi, E, g, b2, nullptr, &em);
+        const double res = advected_residual_of(G, q, s.phi, E, g, b2, nullptr, &em, &memo);
         InterfaceState a = interface_at_q(G, q, s.phi, g, b2, true, &em);
         a.residual = res / E;
         a.iterations = s.iterations;
         a.converged = s.converged;
+        keep_vapour(a, q, em);
         return a;
       }
       s.residual = interface_residual_e(G, s.phi, E, g, b2, nullptr) / E;
@@ -211,17 +270,31 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
   s.p_star = s.p_pa / G.p_scale;
   return s;
 }
+}  // namespace
+
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected, double phi_guess) {
+  Memo memo;
+  return solve_interface_m(G, xi, g, b2, advected, phi_guess, memo);
+}
+
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected,
+                               const InterfaceState& from) {
+  Memo memo(&from);
+  return solve_interface_m(G, xi, g, b2, advected, from.phi, memo);
+}
 
 namespace {
 // content_factor with em = 1 - exp(-Pe) given where the caller has it (the residual of the
 // advected layer computes it at the same Pe)
-double content_factor_em(double Pe, double* dc, const double* em) {
+double content_factor_em(double Pe, double* dc, const double* em, Memo* memo = nullptr) {
   if (Pe < 1e-3) {  // series of 1/Pe - 1/(e^Pe - 1)
     if (dc) *dc = -1.0 / 12.0 + Pe * Pe / 240.0;
     return 0.5 - Pe / 12.0 + Pe * Pe * Pe / 720.0;
   }
-  const double em1 = std::expm1(Pe);  // e^Pe - 1
-  if (dc) *dc = -1.0 / (Pe * Pe) + (std::isfinite(em1) ? 1.0 / (em1 * (em ? *em : -std::expm1(-Pe))) : 0.0);
+  const double em1 = memo ? memo->em1_at(Pe) : std::expm1(Pe);  // e^Pe - 1
+  if (dc)
+    *dc = -1.0 / (Pe * Pe) +
+          (std::isfinite(em1) ? 1.0 / (em1 * (em ? *em : memo ? memo->em_at(Pe) : -std::expm1(-Pe))) : 0.0);
   return 1.0 / Pe - (std::isfinite(em1) ? 1.0 / em1 : 0.0);
 }
 }  // namespace
@@ -232,8 +305,9 @@ double layer_content(const InterfaceState& s, double g, double b2) {
   return s.theta_sat * g * content_factor(s.peclet) - b2 * g * g * g / 6.0;
 }
 
-InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
-                                    bool advected, double kappa, double H_old, double phi_guess) {
+namespace {
+InterfaceState solve_interface_flux_m(const Groups& G, double xi, double g, double beta, double gamma, bool advected,
+                                      double kappa, double H_old, double phi_guess, Memo& memo) {
   if (!(g > 0.0) || !(beta >= 0.0) || !(kappa >= 0.0)) return solve_interface(G, xi, g, 0.0, advected);
   const double E = gaussian_beam(xi);
   // content0(phi) = theta_sat g c(Pe(phi)) >= 0, so the flow's part is >= beta theta_sat - gamma - kappa H_old
@@ -244,12 +318,12 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
     const double th = (p - G.theta_m) / (1.0 - G.theta_m);
     double c = 0.5, dc = 0.0, Pe = 0.0, dw = 0.0;
     if (advected) {
-      const VapourParts qp = q ? *q : vapour_parts(G, p, true);
+      const VapourParts qp = q ? *q : memo.parts(G, p);
       const double w = qp.w;
       dw = qp.dw;
       Pe = std::max(w, 0.0) * g;
       if (!(w > 0.0)) dw = 0.0;
-      c = content_factor_em(Pe, &dc, em);
+      c = content_factor_em(Pe, &dc, em, &memo);
     }
     if (dcont) *dcont = g * (c / (1.0 - G.theta_m) + th * dc * g * dw);
     return th * g * c;
@@ -269,8 +343,8 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
       double r, em = 0.0;
       VapourParts q;
       if (advected) {
-        q = vapour_parts(G, p, true);
-        r = advected_residual_of(G, q, p, E, g, 0.0, df, &em);
+        q = memo.parts(G, p);
+        r = advected_residual_of(G, q, p, E, g, 0.0, df, &em, &memo);
       } else {
         r = interface_residual_e(G, p, E, g, 0.0, df);
       }
@@ -286,7 +360,7 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
     if (std::isnormal(G.vapour_melt) || residual(hi, nullptr) > 0.0) {
       auto fdf = [&](double p, double& f, double& df) { f = residual(p, &df); };
       rr = safe_newton(fdf, G.theta_m, hi, 1e-15 * hi, 200, phi_guess, true);
-      phi = rr.x;
+      phi = at_rounding(rr);
     } else {
       phi = hi;
     }
@@ -294,11 +368,11 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
   // the state at the root from one exponential of the vapour pressure and one 1 - exp(-Pe):
   // the values of flow_part, interface_at and advected_residual at phi, each of which would
   // compute them again (test LaserLaws.FluxInterfaceSharesItsExponentials)
-  const VapourParts q = vapour_parts(G, phi, true);
+  const VapourParts q = memo.parts(G, phi);
   const double b2 = flow_part(phi, nullptr, advected ? &q : nullptr, nullptr) / g;
   double res, em = 0.0;
   if (advected) {
-    res = advected_residual_of(G, q, phi, E, g, b2, nullptr, &em);
+    res = advected_residual_of(G, q, phi, E, g, b2, nullptr, &em, &memo);
   } else {
     res = interface_residual_e(G, phi, E, g, b2, nullptr);
   }
@@ -306,7 +380,21 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
   s.iterations = rr.iterations;
   s.converged = rr.converged;
   s.residual = res / E;
+  if (advected) keep_vapour(s, q, em);
   return s;
+}
+}  // namespace
+
+InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
+                                    bool advected, double kappa, double H_old, double phi_guess) {
+  Memo memo;
+  return solve_interface_flux_m(G, xi, g, beta, gamma, advected, kappa, H_old, phi_guess, memo);
+}
+
+InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
+                                    bool advected, double kappa, double H_old, const InterfaceState& from) {
+  Memo memo(&from);
+  return solve_interface_flux_m(G, xi, g, beta, gamma, advected, kappa, H_old, from.phi, memo);
 }
 
 double recession_rate(const Groups& G, double xi, const InterfaceState& s) {

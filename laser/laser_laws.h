@@ -21,6 +21,7 @@ struct RootResult {
   double x = 0.0;
   int iterations = 0;
   bool converged = false;
+  double x_eval = std::numeric_limits<double>::quiet_NaN();  // safe_newton: the last point f was evaluated at
 };
 
 // Safeguarded Newton ("rtsafe"): f(lo) and f(hi) must have opposite signs; a
@@ -62,6 +63,7 @@ RootResult safe_newton(const FDF& fdf, double lo, double hi, double xtol, int ma
   double x = inside ? x0 : 0.5 * (lo + hi), dxold = std::fabs(hi - lo), dx = dxold;
   double f, df;
   fdf(x, f, df);
+  r.x_eval = x;
   for (int it = 1; it <= maxit; ++it) {
     r.iterations = it;
     const bool newton_leaves = ((x - hi) * df - f) * ((x - lo) * df - f) > 0.0;
@@ -76,6 +78,7 @@ RootResult safe_newton(const FDF& fdf, double lo, double hi, double xtol, int ma
     }
     if (std::fabs(dx) <= xtol) { r.converged = true; break; }
     fdf(x, f, df);
+    r.x_eval = x;
     if (f == 0.0) { r.converged = true; break; }
     if (f < 0.0) lo = x; else hi = x;
     if (std::fabs(hi - lo) <= xtol) { r.converged = true; break; }
@@ -143,8 +146,17 @@ inline double recoil_pressure_from_flux(double q, double T, double hlv, double M
 }
 
 // ------------------------------------------------------------------ beam
-// (3-21), nondimensional: I / I0.
-inline double gaussian_beam(double xi) { return std::exp(-xi * xi); }
+// (3-21), nondimensional: I / I0. A run asks for the beam at one node many times in a row
+// (each evaluation of the interface balance and of the recession rate): the last value is
+// kept (per thread) and returned for the same xi, the same number.
+inline double gaussian_beam(double xi) {
+  thread_local double last_xi = std::numeric_limits<double>::quiet_NaN(), last = 0.0;
+  if (!(xi == last_xi)) {
+    last = std::exp(-xi * xi);
+    last_xi = xi;
+  }
+  return last;
+}
 
 // ----------------------------------------------------- nondimensional groups
 struct Material {
@@ -182,6 +194,14 @@ struct Groups {
 Groups make_groups(const Material& m, double I0, double R);
 
 // ---------------------------------------------------- melt-vapour interface
+// The vapour side of (4-29) at one surface temperature phi, from one exponential: the vapour
+// term v (divided by I' sqrt(phi)) and the flux recession rate w = N_i v - Psi p* sqrt(phi), with
+// their derivatives in phi (w, dw not clipped at 0).
+struct VapourParts {
+  double v = 0, dv = 0, w = 0, dw = 0;
+  double e = 0;  // exp(H_lv (1 - 1/phi)) = p / p0
+};
+
 struct InterfaceState {
   double phi = 0;        // T_sat / T_sat0
   double theta_sat = 0;  // (T_sat - T_m) / (T_sat0 - T_m)
@@ -194,6 +214,12 @@ struct InterfaceState {
   double residual = 0;   // of (4-29), relative to exp(-xi^2)
   int iterations = 0;
   bool converged = true;
+  // advected layer, a solved state: the vapour parts at phi and em = 1 - exp(-peclet), which a
+  // solve started from this state (solve_interface(..., from)) takes instead of computing
+  // them again (functions of phi and of peclet alone: the same numbers)
+  VapourParts vapour;
+  double em = 0;
+  bool has_vapour = false;
 };
 
 // Residual of (4-29) divided by I' sqrt(phi): vapour term + conduction term -
@@ -225,6 +251,12 @@ InterfaceState interface_at(const Groups& G, double phi, double g, double b2, bo
 // fewer iterations when the caller knows a nearby one.
 InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected = false,
                                double phi_guess = std::numeric_limits<double>::quiet_NaN());
+// The same started from the state 'from' of the same groups G (phi_guess = from.phi): where the
+// iteration evaluates the residual at from.phi (or at from's Pe) it takes from's vapour parts
+// (and 1 - exp(-Pe)) instead of computing them again; the result is that of the call above with
+// phi_guess = from.phi, to the last bit.
+InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, bool advected,
+                               const InterfaceState& from);
 // The same with the flow's part of the gradients tied to the surface temperature,
 // b2 g = beta theta_sat - gamma (beta >= 0): the layer gives the heat its outflow
 // carries at its own temperature and takes gamma from upstream (--melt-heat flux,
@@ -239,6 +271,10 @@ InterfaceState solve_interface(const Groups& G, double xi, double g, double b2, 
 InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
                                     bool advected = false, double kappa = 0.0, double H_old = 0.0,
                                     double phi_guess = std::numeric_limits<double>::quiet_NaN());
+// The same started from the state 'from' (phi_guess = from.phi), taking its vapour parts as
+// solve_interface(..., from) does: the result of the call above to the last bit.
+InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
+                                    bool advected, double kappa, double H_old, const InterfaceState& from);
 // Content factor of the layer's profile without b2: int_0^g theta dzeta = theta_sat g c(Pe),
 // c(Pe) = 1/Pe - 1/(e^Pe - 1) for the advected (exponential) profile, 1/2 for the
 // linear one (Pe = 0); dc receives c'(Pe).

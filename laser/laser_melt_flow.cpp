@@ -324,6 +324,7 @@ void Drill::flux_heat_march() {
     const int i = outward ? k : N - 1 - k;
     Node& n = nodes_[i];
     n.dH = 0.0;
+    n.itf_solved = false;
     if (!active(i) || face_c_.empty()) {
       n.b2 = 0.0;
       n.H = 0.0;
@@ -354,11 +355,12 @@ void Drill::flux_heat_march() {
     const double s = transient ? 1.0 / (1.0 + g * g / (12.0 * dtn)) : 1.0;
     const double kappa = transient ? s / (2.0 * dtn) : 0.0, H_old = transient ? n.H : 0.0;
     const double beta = qout / (3.0 * a), gamma = hin / (2.0 * a);
-    n.itf = solve_interface_flux(G_, n.xi, g, s * beta, s * gamma, advected_, kappa, H_old, n.itf.phi);
+    n.itf = solve_interface_flux(G_, n.xi, g, s * beta, s * gamma, advected_, kappa, H_old, n.itf);
     const double th = std::max(n.itf.theta_sat, 0.0);
     n.b2 = (s * (beta * th - gamma) + (transient ? kappa * (layer_content(n.itf, g, 0.0) - H_old) : 0.0)) / g;
     // a hit whose flow part alone is within the limit is the layer's content asking for more
     limit_b2(n, g, th, transient && std::fabs(beta * th - gamma) * g <= th);
+    n.itf_solved = true;
     // the column's heat balance: what it sends on is what came in, plus what its
     // gradients give the flow (2 a b2 g), minus what it keeps in its content; with
     // the solved b2 this is qout 2 theta_sat/3; where the limit of (4-25) held b2

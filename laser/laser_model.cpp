@@ -51,10 +51,14 @@ void Drill::melt_onset(double tb) {
     if (!n.molten && n.tau_m < tb) n.molten = true;
 }
 
+// (4-29) at each molten node's g and b2; a state the face heat march solved at them (the
+// flow's part b2 g tied to the surface temperature, b2 that root's) is kept: solving it again
+// at b2 moves phi by rounding only
 void Drill::solve_interfaces() {
   for (auto& n : nodes_) {
     if (!n.molten) continue;
-    n.itf = solve_interface(G_, n.xi, n.g, n.b2, advected_, n.itf.phi);
+    if (!n.itf_solved) n.itf = solve_interface(G_, n.xi, n.g, n.b2, advected_, n.itf);
+    n.itf_solved = false;
     res_.max_interface_residual = std::max(res_.max_interface_residual, std::fabs(n.itf.residual));
   }
 }

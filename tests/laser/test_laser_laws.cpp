@@ -483,3 +483,38 @@ TEST(LaserLaws, WarmStartedRootsAreTheColdRoots) {
   EXPECT_LE(b.iterations, a.iterations);
   EXPECT_LE(std::fabs(f(b.x)), xtol);
 }
+
+// A solve started from a solved state (solve_interface(..., from), solve_interface_flux(...,
+// from)) takes that state's vapour parts and 1 - exp(-Pe) where it evaluates at its phi and Pe:
+// the result is that of the solve started from phi_guess = from.phi to the last bit, at the
+// state's own g (the march's and the step's start) and at a neighbouring one (the thickness
+// iteration's next evaluation).
+TEST(LaserLaws, SolveFromAStateIsTheSolveFromItsPhi) {
+  const Groups G = make_groups(kMat, kI0, kR);
+  int checked = 0;
+  for (double xi : {0.0, 0.7, 1.5})
+    for (double g : {1e-3, 2e-2, 0.1})
+      for (double b2 : {0.0, 0.4}) {
+        const InterfaceState from = solve_interface(G, xi, g, b2, true);
+        if (!(from.theta_sat > 0.0)) continue;
+        ASSERT_TRUE(from.has_vapour);
+        for (double g1 : {g, g * (1.0 + 1e-7), g * 1.01}) {
+          const InterfaceState a = solve_interface(G, xi, g1, b2 * 1.001, true, from);
+          const InterfaceState b = solve_interface(G, xi, g1, b2 * 1.001, true, from.phi);
+          EXPECT_EQ(a.phi, b.phi) << xi << " " << g << " " << g1;
+          EXPECT_EQ(a.grad_top, b.grad_top);
+          EXPECT_EQ(a.grad_bottom, b.grad_bottom);
+          EXPECT_EQ(a.p_pa, b.p_pa);
+          EXPECT_EQ(a.residual, b.residual);
+          EXPECT_EQ(a.iterations, b.iterations);
+          const InterfaceState fa = solve_interface_flux(G, xi, g1, 0.3, 0.1, true, 2.0, 1e-3, from);
+          const InterfaceState fb = solve_interface_flux(G, xi, g1, 0.3, 0.1, true, 2.0, 1e-3, from.phi);
+          EXPECT_EQ(fa.phi, fb.phi);
+          EXPECT_EQ(fa.grad_top, fb.grad_top);
+          EXPECT_EQ(fa.grad_bottom, fb.grad_bottom);
+          EXPECT_EQ(fa.residual, fb.residual);
+          ++checked;
+        }
+      }
+  EXPECT_GT(checked, 30);
+}
