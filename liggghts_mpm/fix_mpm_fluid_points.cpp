@@ -218,8 +218,10 @@ void FixMpmFluid::fill_points() {
     hi[d] = std::min(gs.ncell[d] - 1, static_cast<int>(std::floor((domain->subhi[d] - gs.origin[d]) / dx)) + 1);
   }
   check_fill_memory(region, lo, hi);
-  // fill ... inside/outside meshes: the lattice points at least half a point spacing from their
-  // triangles, inside the container and outside the others (mesh_fill_host.h)
+  // fill ... inside/outside meshes: the lattice points inside the container and outside the
+  // others (mesh_fill_host.h), as a region's fill takes those inside the region: the points'
+  // volume is then the inside's to the lattice's sampling. A point within a thousandth of a
+  // spacing of a triangle is neither inside nor outside and is left out.
   const bool meshes = !o.fill_inside.empty() || !o.fill_outside.empty();
   mpm::FillLattice lat;
   std::vector<char> keep;
@@ -230,7 +232,7 @@ void FixMpmFluid::fill_points() {
       lat.lo[d] = lo[d] * o.fill_ppc[d];
       lat.hi[d] = (hi[d] + 1) * o.fill_ppc[d] - 1;
     }
-    const double gap = 0.5 * std::min(spacing[0], std::min(spacing[1], spacing[2]));
+    const double gap = 1e-3 * std::min(spacing[0], std::min(spacing[1], spacing[2]));
     guarded([&] { keep = mpm::fill_mesh_mask(lmp, o, lat, gap); });
   }
   double x[3];

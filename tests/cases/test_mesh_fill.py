@@ -3,7 +3,9 @@
 fix mpm/fluid (docs/fix_mpm_fluid.md, keyword `fill`): the drum of inputs/drum (drum.stl
 of tools/make_drum_stl.py with its defaults: inner diameter 0.16 m, length 0.04 m, 72 mantle
 segments circumscribing the circle, 6 lifter bars 8 x 8 mm), filled below h = 0.065 m with cells of
-5 mm and 2 x 2 x 2 points per cell (spacing s = 2.5 mm, gap g = s/2), at rest (run 0).
+5 mm and 2 x 2 x 2 points per cell (spacing s = 2.5 mm), at rest (run 0). The fill takes the
+lattice points inside the mesh, as a region's fill takes those inside the region; a point within
+g = s / 1000 of a triangle is neither inside nor outside and is left out.
 Standard library only.
 
     test_mesh_fill.py CASE --exe build/liggghts_mpm --work DIR [--mpirun "mpirun ..."]
@@ -13,21 +15,19 @@ CASE is one of: inside, outside, regions, inside_np2, bad_input.
 References, from the drum's outline alone (make_drum_stl.outline, the polygon its mesh extrudes):
   * the inside volume below h: the outline clipped to z < h (shoelace) times the length. Each point
     stands for a cube s^3. The caps (y = 0 and L) and h lie on faces of the points' lattice, so
-    they cost no volume; along the mantle and the bars the points keep the gap g = s/2, so the fill
-    ends where the lattice's first row at least g from the wall begins: it lacks a layer of mean
-    thickness g (between 0 and s) along the wetted wall. Expected: V_exact - P_w g L, P_w the
-    wetted perimeter (outline below h); tolerance 1 % of V_exact (the layer's corner terms, g^2 per
-    corner, and the lattice's rows along the curved wall: -0.11 % measured); and at all events
-    0 < V_exact - V_fill < P_w s L.
+    they cost no volume; along the mantle and the bars the lattice's cubes cross the wall, and
+    the points inside sample the inside without a bias: V_fill = V_exact to the lattice's
+    sampling error, which is below 1 % here (tolerance; P_w s L, P_w the wetted perimeter, is
+    the volume of one row of points along the wall: 9.0 % of V_exact; -0.08 % measured).
   * the points themselves: a lattice point (x, z) below h is filled exactly when it lies inside the
-    outline (2-D parity, computed here) and at least g from each of its edges (the caps are s/2 =
-    g away from every point of the lattice): the count must equal this prediction times the
-    points along y; no point outside the mantle polygon or inside a bar.
+    outline (2-D parity, computed here) and at least g from each of its edges (the caps are s/2
+    away from every point of the lattice): the count must equal this prediction times the points
+    along y; no point outside the mantle polygon or inside a bar.
   * outside: the points below h outside the drum (the grid's corners) are the lattice points
     outside the outline and at least g from it, the same prediction.
-  * regions: inputs/drum/in.drum's plane regions (a cylinder R - g and three planes per lifter)
-    give the count they give; the mesh fill is compared with it (reported; the polygon mantle lies
-    outside the cylinder, so the mesh fill holds slightly more).
+  * regions: the same inside built from plane regions (a cylinder of radius R and three planes
+    per lifter) gives the count it gives; the mesh fill is compared with it (reported; the polygon
+    mantle lies outside the cylinder, so the mesh fill holds slightly more).
 """
 import math
 import os
@@ -47,7 +47,7 @@ from make_drum_stl import outline  # noqa: E402
 D, L, H, DX, PPC = 0.16, 0.04, 0.065, 0.005, 2
 XC = ZC = 0.5 * D
 S = DX / PPC
-G = 0.5 * S
+G = 1e-3 * S
 
 
 def poly_abs():
@@ -141,10 +141,11 @@ def check_points(pts, poly, inside, label):
     near = min(dist2d(poly, x, z) for x, y, z in pts)
     ys = [y for _, y, _ in pts]
     print(f"  {label}: {len(pts)} points, {bad_side} on the wrong side of the outline, nearest to the outline "
-          f"{near * 1e3:.4f} mm (gap {G * 1e3:.4f} mm), y in [{min(ys):.6g}, {max(ys):.6g}]")
+          f"{near * 1e3:.4f} mm (g {G * 1e3:.4f} mm), y in [{min(ys):.6g}, {max(ys):.6g}]")
     check(bad_side == 0, f"{label}: no point on the wrong side of the mantle polygon and the bars")
-    check(near >= G * (1 - 1e-6), f"{label}: every point at least the gap s/2 from the mantle and the bars")
-    check(min(ys) >= G * (1 - 1e-6) and max(ys) <= L - G * (1 - 1e-6), f"{label}: every point at least s/2 from the caps")
+    check(near >= G * (1 - 1e-6), f"{label}: every point at least s / 1000 from the mantle and the bars")
+    check(min(ys) >= 0.5 * S * (1 - 1e-6) and max(ys) <= L - 0.5 * S * (1 - 1e-6),
+          f"{label}: every point at least s/2 from the caps")
     check(max(z for _, _, z in pts) < H, f"{label}: every point below h")
 
 
@@ -157,12 +158,10 @@ def case_inside(r):
     vfill = n * S ** 3
     vexact = area(clip_below(poly, H)) * L
     pw = wetted_perimeter(poly, H)
-    vexp = vexact - pw * G * L
     print(f"  V_fill = {vfill:.6e} m3 ({n} points of {S} m), V_exact = {vexact:.6e} m3 (outline below h times L), "
-          f"V_fill / V_exact - 1 = {vfill / vexact - 1:+.4%}; wetted perimeter {pw:.5f} m, "
-          f"V_exact - P_w g L = {vexp:.6e} m3, V_fill against it {vfill / vexp - 1:+.4%}")
-    check(abs(vfill / vexp - 1) < 0.01, "fill volume within 1 % of the exact inside volume less the gap's layer")
-    check(0 < vexact - vfill < pw * S * L, "the missing volume between 0 and one point spacing along the wetted wall")
+          f"V_fill / V_exact - 1 = {vfill / vexact - 1:+.4%}; one row of points along the wetted wall "
+          f"(P_w s L, P_w = {pw:.5f} m) {pw * S * L / vexact:.4%} of V_exact")
+    check(abs(vfill / vexact - 1) < 0.01, "fill volume within 1 % of the exact inside volume")
     pred = predicted(poly, True) * round(L / S)
     print(f"  predicted from the outline: {pred} points")
     check(n == pred, f"point count equals the independent prediction ({n} vs {pred})")
