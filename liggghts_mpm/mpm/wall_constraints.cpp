@@ -260,8 +260,8 @@ int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_f
       // gets no condition, whatever the rounding of its distance. Decided by the rounding, one of
       // two parallel walls 4 cells apart held its nodes one cell off and the other not; the
       // one-sided condition there pumped the water away from it (water released in a closed mesh
-      // box 4 cells wide: its centre moved 2.7 mm across in 0.6 s, 0.4 mm now; in the drum of
-      // inputs/drum the beads went with the water, docs/validation/drum.md)
+      // box 4 cells wide: its centre moved 2.7 mm across in 0.6 s, 0.4 mm with the strict reach;
+      // in the drum of inputs/drum the beads went with the water, docs/validation/drum.md)
       if (hits[h].dist2 > (behind ? rb2 : rf2) * (1.0 - 1e-9)) continue;
       if (nout >= kMaxConstraints) continue;
       WallConstraint &o = out[nout++];
