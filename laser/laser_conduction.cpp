@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -160,19 +161,13 @@ double CorrectedConduction::cumulative(double s) const {
   return H_[k - 1] + 0.5 * (h_[k - 1] + h) * ds;
 }
 
-double CorrectedConduction::correction_mean(double sa, double sb) const {
-  if (sb - sa <= 1e-14 * std::max(1.0, sb)) return correction(0.5 * (sa + sb));
-  return (cumulative(sb) - cumulative(sa)) / (sb - sa);
-}
-
 double CorrectedConduction::gradient(double s) const {
   return 1.0 / std::sqrt(kPi * (s + c0_)) + correction(s);
 }
 
 double CorrectedConduction::gradient_mean(double sa, double sb) const {
-  const double xa = sa + c0_, xb = sb + c0_;
-  const double stefan = 2.0 / (std::sqrt(kPi) * (std::sqrt(xa) + std::sqrt(xb)));
-  return stefan + correction_mean(sa, sb);
+  Cumulative none{std::numeric_limits<double>::quiet_NaN(), 0.0};  // the integral at sa is computed
+  return gradient_mean(sa, sb, none);
 }
 
 double CorrectedConduction::gradient_mean(double sa, double sb, Cumulative& known) const {

@@ -49,9 +49,9 @@ class CorrectedConduction {
   double c0() const { return c0_; }
   // correction h(s) = g2 + g3 and its pieces
   double correction(double s) const;
-  double correction_mean(double sa, double sb) const;  // mean of h over [sa, sb]
   // total scaled gradient d(theta_s/theta_i)/dx at x = 0, (3-29)
   double gradient(double s) const;
+  // its mean over [sa, sb] (the mean of h from its integral, h at the middle for sb - sa at rounding)
   double gradient_mean(double sa, double sb) const;
   // The integral of h from 0 to s, kept by a caller that asks for the means over successive
   // intervals [s0, s1], [s1, s2], ...: the end of one is the start of the next.
