@@ -193,9 +193,32 @@ template <int NS>
   const double *radius = pts.radius, *rmass = pts.rmass;
   const int nsub = state.nsub;
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
+  // The grains' immersion (docs/theory/drag.md, "Grains at the free surface"): the signed distance
+  // to the free surface at the grain, interpolated from its nodes' levels (the projection's level
+  // set of the last solve, in cells); a node counts with its own level where it or a face
+  // neighbour is EMPTY (the surface's band), with the level of the bulk (kLevelMin) elsewhere, and
+  // not at all where SOLID (box padding, behind mesh walls): a wall is not a free surface. The
+  // grain's fluid forces (drag and pressure) take the share of its sphere below that surface.
+  const Projection *pj = pressure_->solve();
+  const std::uint8_t *kind = nullptr;
+  const double *lev = nullptr;
+  if (pj && pj->labels().kind.size() == grid_.size() && pj->surface_level()) {
+    kind = pj->labels().kind.data();
+    lev = pj->surface_level();
+  }
+  const double dx = opt.grid.dx;
+  const auto node_level = [&](std::size_t n, double w, double &wl, double &ws) {
+    if (kind[n] == kSolid) return;
+    const bool band = kind[n] == kEmpty || kind[n - 1] == kEmpty || kind[n + 1] == kEmpty ||
+                      kind[n - sy] == kEmpty || kind[n + sy] == kEmpty || kind[n - sz] == kEmpty ||
+                      kind[n + sz] == kEmpty;
+    wl += w * (band ? lev[n] : kLevelMin);
+    ws += w;
+  };
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || coup_->grain_shapes[k].base[0] == INT_MIN) continue;
     const Stencil &ps = coup_->grain_shapes[k];
+    double wl = 0.0, ws = 0.0;  // the stencil's level sum and weight (kind: the immersion)
     // one pass over the stencil: velocity of the wet nodes (and their total weight, the record's
     // 4th entry), fitted gradients of the determined nodes (and their weight), fluid fraction,
     // gradient of the nodal pressures
@@ -210,6 +233,7 @@ template <int NS>
         uw += w * row4(st + StRec::U);
         th += w * st[StRec::TH];
         for (int d = 0; d < 3; ++d) gradp[d] += w * gw[3 * n + d];
+        if (kind) node_level(n, w, wl, ws);
       });
     } else {
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double gx, double gy, double gz) {
@@ -220,6 +244,7 @@ template <int NS>
         gradp[0] += st[StRec::P] * gx;
         gradp[1] += st[StRec::P] * gy;
         gradp[2] += st[StRec::P] * gz;
+        if (kind) node_level(n, w, wl, ws);
       });
     }
     const double wet = uw[3], wfit = fw[3];
@@ -238,9 +263,12 @@ template <int NS>
                                     (u[2] - v[k][2]) * (u[2] - v[k][2]));
       K = drag_coefficient(opt.drag_law, opt.drag_form, rho_f, mu, d_k, Vk, th, urel, opt.theta_min);
     }
+    // the share of the grain below the free surface (1 without a level set: eos)
+    const double immersed = kind && ws > 0.0 ? immersed_fraction(wl / ws * dx, radius[k]) : 1.0;
+    K *= immersed;
     Kgrain[k] = K;
     double Fp[3];
-    pressure_gradient_force(Vk, gradp, Fp);
+    pressure_gradient_force(immersed * Vk, gradp, Fp);
     if (wet <= 0.0) Fp[0] = Fp[1] = Fp[2] = 0.0;
     for (int d = 0; d < 3; ++d) coup_->grain_force[3 * static_cast<std::size_t>(k) + d] += Fp[d] / nsub;
     // the grain's other accelerations (contacts, gravity: its force so far, and the pressure

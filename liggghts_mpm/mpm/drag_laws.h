@@ -9,6 +9,7 @@
 // [kg/s]; the drag force on the particle is F = K (u_f - v_s) and the fluid
 // receives -F (mapped to the nodes with the interpolation weights).
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -118,6 +119,17 @@ inline double drag_coefficient(DragLaw law, DragForm form, double rho_f, double 
 // -rho_f Vp g; no separate buoyancy term may be added on top.
 inline void pressure_gradient_force(double Vp, const double gradp[3], double F[3]) {
   for (int a = 0; a < 3; ++a) F[a] = -Vp * gradp[a];
+}
+
+// Share of a sphere of radius r that lies below a plane free surface, its centre at depth d
+// beneath it (d < 0: above it): the cap of height h = r + d, clipped to [0, 2 r], holds
+// V_cap / V = h^2 (3 r - h) / (4 r^3). With the fluid at rest the force of the fluid on the
+// sphere is then this share of its full buoyancy (Archimedes for a floating body).
+inline double immersed_fraction(double d, double r) {
+  if (d >= r) return 1.0;  // (exactly: a grain in the bulk keeps its forces to the bit)
+  if (d <= -r) return 0.0;
+  const double h = std::min(std::max(r + d, 0.0), 2.0 * r);
+  return h * h * (3.0 * r - h) / (4.0 * r * r * r);
 }
 
 // ---------------------------------------------------------------- time integration

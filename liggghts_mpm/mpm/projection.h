@@ -84,6 +84,15 @@ class Projection {
   const std::vector<double> &gradient() const {
     return opt_.grain_pressure_acceleration ? grad_acc_ext_ : grad_ext_;
   }
+  // The grains' immersion (FluidSolver::grain_drag_sums): the node labels of the last solve
+  // (owned nodes and halos; kind empty before the first) and per node the signed distance to the
+  // free surface in cells, positive in the fluid (the level set, or with mesh walls the same read
+  // from the fill for the grains; null: none)
+  const NodeLabels &labels() const { return lab_; }
+  const double *surface_level() const {
+    const std::vector<double> &l = lab_.level.empty() ? lab_.grain_level : lab_.level;
+    return l.size() == lab_.kind.size() && !l.empty() ? l.data() : nullptr;
+  }
   // largest nodal pressure of the last solve on this rank's owned nodes, averaged in time
   // (keyword pressure_average tau: exponential average with time constant tau; 0: as solved)
   double largest_average_pressure() const { return p_avg_max_; }

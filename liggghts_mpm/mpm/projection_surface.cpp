@@ -112,6 +112,10 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     front_.assign(grid_.size(), 0);
     lab_.dry.assign(grid_.size(), 1);
   }
+  // grains without a level set (mesh walls): the level read from the same fill, for their
+  // immersion only (NodeLabels::grain_level)
+  const bool glevel = theta && !opt_.surface_ghost;
+  if (glevel) lab_.grain_level.assign(grid_.size(), 0.0);
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kSolid) return;
     const double m = p2g[P2gRec::N * n + P2gRec::M];
@@ -126,6 +130,7 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
       lab_.kind[n] = kEmpty;
     }
+    if (glevel) lab_.grain_level[n] = surface_distance(fill, opt_.shape, np);
     if (film) {
       lab_.dry[n] = m <= mmin || m <= 0.0;
       front_[n] = fill < kFrontFill;

@@ -498,3 +498,34 @@ TEST(DragLaws, ImplicitImpulseSteadySlipUnderLeapfrog) {
 }
 
 }  // namespace
+
+// The share of a sphere below a plane (grains at the free surface): against the cap volume
+// pi h^2 (3 r - h) / 3 integrated independently (slices of the sphere), exactly 1 / 0 beyond the
+// sphere, monotone, and f(d) + f(-d) = 1 (the cap above and the cap below make the sphere).
+TEST(DragLaws, ImmersedFractionIsTheCapBelowThePlane) {
+  const double r = 0.003;
+  const double V = 4.0 / 3.0 * M_PI * r * r * r;
+  for (double d : {-0.0029, -0.002, -0.001, 0.0, 0.0005, 0.0015, 0.0027}) {
+    // the sphere's cross-sections pi (r^2 - z^2) for z from -r up to d (midpoint rule)
+    const int n = 200000;
+    const double top = std::min(d, r), dz = (top + r) / n;
+    double v = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double z = -r + (i + 0.5) * dz;
+      v += M_PI * (r * r - z * z) * dz;
+    }
+    EXPECT_NEAR(mpm::immersed_fraction(d, r), v / V, 1e-9) << "d = " << d;
+    EXPECT_NEAR(mpm::immersed_fraction(d, r) + mpm::immersed_fraction(-d, r), 1.0, 1e-14) << "d = " << d;
+  }
+  EXPECT_EQ(mpm::immersed_fraction(r, r), 1.0);
+  EXPECT_EQ(mpm::immersed_fraction(0.01, r), 1.0);
+  EXPECT_EQ(mpm::immersed_fraction(-r, r), 0.0);
+  EXPECT_EQ(mpm::immersed_fraction(-0.01, r), 0.0);
+  EXPECT_DOUBLE_EQ(mpm::immersed_fraction(0.0, r), 0.5);
+  double last = 0.0;
+  for (int i = 0; i <= 100; ++i) {
+    const double f = mpm::immersed_fraction(-r + 2.0 * r * i / 100.0, r);
+    EXPECT_GE(f, last);
+    last = f;
+  }
+}
