@@ -193,32 +193,17 @@ template <int NS>
   const double *radius = pts.radius, *rmass = pts.rmass;
   const int nsub = state.nsub;
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
-  // The grains' immersion (docs/theory/drag.md, "Grains at the free surface"): the signed distance
-  // to the free surface at the grain, interpolated from its nodes' levels (the projection's level
-  // set of the last solve, in cells); a node counts with its own level where it or a face
-  // neighbour is EMPTY (the surface's band), with the level of the bulk (kLevelMin) elsewhere, and
-  // not at all where SOLID (box padding, behind mesh walls): a wall is not a free surface. The
-  // grain's fluid forces (drag and pressure) take the share of its sphere below that surface.
+  // The grains' immersion (docs/theory/drag.md, "Grains at the free surface"): the signed
+  // distance to the free surface at the grain, its nodes' levels (Projection::grain_level, in
+  // cells; NaN at SOLID nodes: left out) interpolated with its weights; the grain's fluid forces
+  // (drag and pressure) take the share of its sphere below that surface.
   const Projection *pj = pressure_->solve();
-  const std::uint8_t *kind = nullptr;
-  const double *lev = nullptr;
-  if (pj && pj->labels().kind.size() == grid_.size() && pj->surface_level()) {
-    kind = pj->labels().kind.data();
-    lev = pj->surface_level();
-  }
+  const double *lev = pj ? pj->grain_level() : nullptr;
   const double dx = opt.grid.dx;
-  const auto node_level = [&](std::size_t n, double w, double &wl, double &ws) {
-    if (kind[n] == kSolid) return;
-    const bool band = kind[n] == kEmpty || kind[n - 1] == kEmpty || kind[n + 1] == kEmpty ||
-                      kind[n - sy] == kEmpty || kind[n + sy] == kEmpty || kind[n - sz] == kEmpty ||
-                      kind[n + sz] == kEmpty;
-    wl += w * (band ? lev[n] : kLevelMin);
-    ws += w;
-  };
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || coup_->grain_shapes[k].base[0] == INT_MIN) continue;
     const Stencil &ps = coup_->grain_shapes[k];
-    double wl = 0.0, ws = 0.0;  // the stencil's level sum and weight (kind: the immersion)
+    double wl = 0.0, ws = 0.0;  // the stencil's level sum and weight (lev: the immersion)
     // one pass over the stencil: velocity of the wet nodes (and their total weight, the record's
     // 4th entry), fitted gradients of the determined nodes (and their weight), fluid fraction,
     // gradient of the nodal pressures
@@ -233,7 +218,10 @@ template <int NS>
         uw += w * row4(st + StRec::U);
         th += w * st[StRec::TH];
         for (int d = 0; d < 3; ++d) gradp[d] += w * gw[3 * n + d];
-        if (kind) node_level(n, w, wl, ws);
+        if (lev && !std::isnan(lev[n])) {
+          wl += w * lev[n];
+          ws += w;
+        }
       });
     } else {
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double gx, double gy, double gz) {
@@ -244,7 +232,10 @@ template <int NS>
         gradp[0] += st[StRec::P] * gx;
         gradp[1] += st[StRec::P] * gy;
         gradp[2] += st[StRec::P] * gz;
-        if (kind) node_level(n, w, wl, ws);
+        if (lev && !std::isnan(lev[n])) {
+          wl += w * lev[n];
+          ws += w;
+        }
       });
     }
     const double wet = uw[3], wfit = fw[3];
@@ -264,7 +255,7 @@ template <int NS>
       K = drag_coefficient(opt.drag_law, opt.drag_form, rho_f, mu, d_k, Vk, th, urel, opt.theta_min);
     }
     // the share of the grain below the free surface (1 without a level set: eos)
-    const double immersed = kind && ws > 0.0 ? immersed_fraction(wl / ws * dx, radius[k]) : 1.0;
+    const double immersed = lev && ws > 0.0 ? immersed_fraction(wl / ws * dx, radius[k]) : 1.0;
     K *= immersed;
     Kgrain[k] = K;
     double Fp[3];

@@ -84,15 +84,11 @@ class Projection {
   const std::vector<double> &gradient() const {
     return opt_.grain_pressure_acceleration ? grad_acc_ext_ : grad_ext_;
   }
-  // The grains' immersion (FluidSolver::grain_drag_sums): the node labels of the last solve
-  // (owned nodes and halos; kind empty before the first) and per node the signed distance to the
-  // free surface in cells, positive in the fluid (the level set, or with mesh walls the same read
-  // from the fill for the grains; null: none)
-  const NodeLabels &labels() const { return lab_; }
-  const double *surface_level() const {
-    const std::vector<double> &l = lab_.level.empty() ? lab_.grain_level : lab_.level;
-    return l.size() == lab_.kind.size() && !l.empty() ? l.data() : nullptr;
-  }
+  // The grains' immersion (FluidSolver::grain_drag_sums): per node (owned nodes and halos) the
+  // signed distance to the free surface in cells that a grain reads, positive in the fluid, of
+  // the last solve (grain_levels; NaN: a SOLID node, not read); null before the first solve with
+  // grains
+  const double *grain_level() const { return gl_.size() == grid_.size() && !gl_.empty() ? gl_.data() : nullptr; }
   // largest nodal pressure of the last solve on this rank's owned nodes, averaged in time
   // (keyword pressure_average tau: exponential average with time constant tau; 0: as solved)
   double largest_average_pressure() const { return p_avg_max_; }
@@ -143,6 +139,9 @@ class Projection {
   // within 2 cells behind a one-sided wall SOLID, and fills frac_ (fluid-side share of a node's
   // dual cell, for the surface threshold)
   void mesh_wall_labels(const WallGeometry &walls);
+  // with grains: gl_ at the owned nodes from the labels (make_labels, after their exchange), forwarded
+  void grain_levels();
+  std::vector<double> gl_;
   bool behind_mesh(int i, int j, int k, std::size_t n) const;
   // a[stride n ...] at the nodes behind mesh walls := mean over their face neighbours that are
   // not SOLID and hold fluid (node mass above mmin; a massless node beyond the 2 cells behind a

@@ -101,7 +101,6 @@ void NodeLabels::reset(const LocalGrid &grid, const IndexBox *work) {
   dry.clear();
   wall_u.clear();
   if (!work) level.clear();  // with a work box the caller fills the level in the box (kept sized)
-  grain_level.clear();
   // the padding: the slabs of the patch below node 0 and above node ncell of each non-periodic d
   for (int d = 0; d < 3; ++d) {
     if (g.periodic[d]) continue;
@@ -130,11 +129,7 @@ void NodeLabels::exchange(LocalGrid &grid, MPI_Comm comm, LocalGrid::Field with,
     grid.for_box(b, [&](int, int, int, std::size_t n) {
       buf_[n] = kind[n] + 4.0 * closed[n] + (wet.empty() ? 0.0 : 256.0 * wet[n]) + (dry.empty() ? 0.0 : 512.0 * dry[n]);
     });
-  grid.forward({{buf_.data(), 1},
-                {any ? wall_u.data() : nullptr, 3},
-                {level.empty() ? nullptr : level.data(), 1},
-                {grain_level.empty() ? nullptr : grain_level.data(), 1},
-                with,
+  grid.forward({{buf_.data(), 1}, {any ? wall_u.data() : nullptr, 3}, {level.empty() ? nullptr : level.data(), 1}, with,
                 with2});
   for (const IndexBox &b : boxes)
     grid.for_box(b, [&](int, int, int, std::size_t n) {

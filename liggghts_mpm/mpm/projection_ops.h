@@ -52,10 +52,6 @@ struct NodeLabels {
   // fraction s_f = level_n / (level_n - level_m) of the face's length from n (at least
   // kMinSurfaceFraction): its coefficient and gradient are divided by s_f (Gibou et al. 2002).
   std::vector<double> level;
-  // Without a level (mesh walls), with grains: the same signed distance read from the fill, for
-  // the grains' immersion only (FluidSolver::grain_drag_sums; the operator does not read it).
-  // Empty: not kept.
-  std::vector<double> grain_level;
 
   // Every node FLUID with open faces, except the padding nodes behind the box
   // walls (indices < 0 or > ncell in non-periodic dimensions), which are SOLID.

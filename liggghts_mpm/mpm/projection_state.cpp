@@ -28,6 +28,9 @@ void Projection::save(ProjectionState &s) const {
   const bool acc = acceleration_on();
   s.have_acc = acc;
   s.p_acc.resize(acc ? nb : 0);
+  const bool gl = grain_level() != nullptr;
+  s.have_grain_level = gl;
+  s.grain_level.resize(gl ? nb : 0);
   // the gradient the grains feel at the next step (grain_pressure: of the multiplier or of the
   // acceleration pressure)
   const std::vector<double> &grad = opt_.grain_pressure_acceleration ? grad_acc_ : grad_;
@@ -38,6 +41,7 @@ void Projection::save(ProjectionState &s) const {
     if (have_theta_last_) s.theta_last[q] = theta_last_[n];
     if (have_avg_) s.p_avg[q] = p_avg_[n];
     if (acc) s.p_acc[q] = p_acc_[n];
+    if (gl) s.grain_level[q] = gl_[n];
     ++q;
   });
 }
@@ -81,6 +85,13 @@ bool Projection::load(const ProjectionState &s) {
     grid_.for_owned([&](int i, int j, int k, std::size_t n) { p_acc_[n] = s.p_acc[at(i, j, k)]; });
     grid_.forward(p_acc_.data(), 1);
   }
+  if (s.have_grain_level) {
+    gl_.assign(grid_.size(), 0.0);
+    grid_.for_owned([&](int i, int j, int k, std::size_t n) { gl_[n] = s.grain_level[at(i, j, k)]; });
+    grid_.forward(gl_.data(), 1);
+  } else {
+    gl_.clear();
+  }
   largest_pressure();
   last_.iterations = s.iterations;
   last_.relative_residual = s.residual;
@@ -100,7 +111,8 @@ bool Projection::load(const ProjectionState &s) {
 }
 
 namespace {
-constexpr double kStateVersion = 2.0;  // layout of ProjectionState::pack (1: without p_avg)
+// layout of ProjectionState::pack (1: without p_avg; 2: without grain_level)
+constexpr double kStateVersion = 3.0;
 }
 
 void ProjectionState::pack(std::vector<double> &out) const {
@@ -118,12 +130,14 @@ void ProjectionState::pack(std::vector<double> &out) const {
   out.insert(out.end(), p_avg.begin(), p_avg.end());
   out.push_back(have_acc ? 1.0 : 0.0);
   out.insert(out.end(), p_acc.begin(), p_acc.end());
+  out.push_back(have_grain_level ? 1.0 : 0.0);
+  out.insert(out.end(), grain_level.begin(), grain_level.end());
 }
 
 std::size_t ProjectionState::unpack(const double *in) {
   *this = ProjectionState();
   if (in[0] == 0.0) return 1;
-  if (in[0] != kStateVersion && in[0] != 1.0) {
+  if (in[0] != kStateVersion && in[0] != 1.0 && in[0] != 2.0) {
     std::ostringstream os;
     os << "Fix mpm/fluid: the restart file holds a pressure-projection state of layout " << in[0]
        << "; this build reads layout " << kStateVersion;
@@ -156,6 +170,13 @@ std::size_t ProjectionState::unpack(const double *in) {
       m += nb;
     }
   }
+  if (in[0] >= 3.0) {
+    have_grain_level = in[m++] != 0.0;
+    if (have_grain_level) {
+      grain_level.assign(in + m, in + m + nb);
+      m += nb;
+    }
+  }
   valid = true;
   return m;
 }
@@ -173,16 +194,19 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
     g.box.hi[d] = spec.node_hi(d);
   }
   // the optional fields every rank holds
-  const int mine_has[3] = {local.have_theta_last, local.have_avg, local.have_acc};
-  int all_have[3];
-  MPI_Allreduce(mine_has, all_have, 3, MPI_INT, MPI_MIN, comm);
+  const int mine_has[4] = {local.have_theta_last, local.have_avg, local.have_acc, local.have_grain_level};
+  int all_have[4];
+  MPI_Allreduce(mine_has, all_have, 4, MPI_INT, MPI_MIN, comm);
   g.have_theta_last = all_have[0] != 0;
   g.have_avg = all_have[1] != 0;
   g.have_acc = all_have[2] != 0;
+  g.have_grain_level = all_have[3] != 0;
   g.iterations = local.iterations;
   g.residual = local.residual;
-  // every rank's box and values (p, grad, theta, p_avg, p_acc per node), copied into place on every rank
-  const int per = 4 + (g.have_theta_last ? 1 : 0) + (g.have_avg ? 1 : 0) + (g.have_acc ? 1 : 0);
+  // every rank's box and values (p, grad, theta, p_avg, p_acc, grain_level per node), copied into
+  // place on every rank
+  const int per = 4 + (g.have_theta_last ? 1 : 0) + (g.have_avg ? 1 : 0) + (g.have_acc ? 1 : 0) +
+                  (g.have_grain_level ? 1 : 0);
   std::vector<double> mine;
   const std::size_t nb = static_cast<std::size_t>(local.box.count());
   mine.reserve(per * nb);
@@ -192,6 +216,7 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
     if (g.have_theta_last) mine.push_back(local.theta_last[q]);
     if (g.have_avg) mine.push_back(local.p_avg[q]);
     if (g.have_acc) mine.push_back(local.p_acc[q]);
+    if (g.have_grain_level) mine.push_back(local.grain_level[q]);
   }
   std::vector<int> boxes(6 * nprocs), counts(nprocs), displs(nprocs);
   const int mybox[6] = {local.box.lo[0], local.box.lo[1], local.box.lo[2], local.box.hi[0], local.box.hi[1], local.box.hi[2]};
@@ -211,6 +236,7 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
   g.theta_last.assign(g.have_theta_last ? ng : 0, 1.0);
   g.p_avg.assign(g.have_avg ? ng : 0, 0.0);
   g.p_acc.assign(g.have_acc ? ng : 0, 0.0);
+  g.grain_level.assign(g.have_grain_level ? ng : 0, kLevelMin);
   const long gx = g.box.hi[0] - g.box.lo[0] + 1, gy = g.box.hi[1] - g.box.lo[1] + 1;
   for (int r = 0; r < nprocs; ++r) {
     const int *b = &boxes[6 * r];
@@ -224,6 +250,7 @@ ProjectionState gather_global(const ProjectionState &local, const GridSpec &spec
           if (g.have_theta_last) g.theta_last[n] = all[q++];
           if (g.have_avg) g.p_avg[n] = all[q++];
           if (g.have_acc) g.p_acc[n] = all[q++];
+          if (g.have_grain_level) g.grain_level[n] = all[q++];
         }
   }
   return g;

@@ -12,8 +12,8 @@ namespace mpm {
 
 // pressure projection: what the next fluid step reads of the last solve (restart files, a new
 // grid patch at the next run): the nodal pressure (the solve's warm start), its nodal gradient
-// (the grains' pressure force of the next step) and theta of the last solve (the d(theta)/dt
-// source), on a box of global node indices, i fastest. Written by Projection::save, read by
+// (the grains' pressure force of the next step), theta of the last solve (the d(theta)/dt
+// source) and the grains' levels (their immersion at the next step), on a box of global node indices, i fastest. Written by Projection::save, read by
 // Projection::load (mpm/projection_state.cpp, like the functions below).
 struct ProjectionState {
   bool valid = false;
@@ -23,7 +23,10 @@ struct ProjectionState {
   double residual = 0.0;
   bool have_avg = false;         // p_avg holds values (pressure_average, after the first solve)
   bool have_acc = false;         // p_acc holds values (pressure_output acceleration: its warm start)
-  std::vector<double> p, grad, theta_last, p_avg, p_acc;  // 1, 3, 1, 1, 1 per node of box
+  bool have_grain_level = false; // grain_level holds values (couple, after the first solve)
+  // 1, 3, 1, 1, 1, 1 per node of box (grain_level: Projection::grain_level, the grains' immersion
+  // at the next step)
+  std::vector<double> p, grad, theta_last, p_avg, p_acc, grain_level;
   // appends the restart block (doubles); unpack reads one at in and returns the doubles read
   void pack(std::vector<double> &out) const;
   std::size_t unpack(const double *in);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "mpm/error.h"
@@ -112,10 +113,11 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     front_.assign(grid_.size(), 0);
     lab_.dry.assign(grid_.size(), 1);
   }
-  // grains without a level set (mesh walls): the level read from the same fill, for their
-  // immersion only (NodeLabels::grain_level)
+  // with grains: their levels (grain_levels); without a level set (mesh walls) the level read
+  // from the same fill, for the grains only
+  if (theta) gl_.assign(grid_.size(), 0.0);
+  else gl_.clear();
   const bool glevel = theta && !opt_.surface_ghost;
-  if (glevel) lab_.grain_level.assign(grid_.size(), 0.0);
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kSolid) return;
     const double m = p2g[P2gRec::N * n + P2gRec::M];
@@ -130,7 +132,7 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
       lab_.kind[n] = kEmpty;
     }
-    if (glevel) lab_.grain_level[n] = surface_distance(fill, opt_.shape, np);
+    if (glevel) gl_[n] = surface_distance(fill, opt_.shape, np);
     if (film) {
       lab_.dry[n] = m <= mmin || m <= 0.0;
       front_[n] = fill < kFrontFill;
@@ -166,6 +168,39 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     grid_.for_box(plane, [&](int i, int j, int k, std::size_t) { lab_.close_face(grid_, i, j, k, g.dim); });
   }
   lab_.exchange(grid_, comm_, with, with2);
+  if (theta) grain_levels();
+}
+
+/* The grains' immersion (FluidSolver::grain_drag_sums; docs/theory/drag.md, "Grains at the free
+   surface"): per node the signed distance to the free surface in cells that a grain reads, at the
+   owned nodes then forwarded. A node counts with its own level (the level set, or with mesh walls
+   the level of its fill, in gl_ from make_labels) only in the surface's band, where it or one of
+   its six face neighbours is EMPTY; elsewhere with the bulk's kLevelMin (beside a wall the fill is
+   cut by the wall, not by the water: a wall below the water is no surface); at SOLID nodes
+   (padding, behind mesh walls) NaN: not read. Labels of the owned nodes' neighbours: after the
+   labels' exchange. */
+void Projection::grain_levels() {
+  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
+  const bool own = lab_.level.empty();  // mesh walls: gl_ holds the fill's level
+  const std::uint8_t *kind = lab_.kind.data();
+  grid_.for_owned([&](int i, int j, int k, std::size_t n) {
+    if (kind[n] == kSolid) {
+      gl_[n] = std::numeric_limits<double>::quiet_NaN();
+      return;
+    }
+    bool band = kind[n] == kEmpty;
+    const int idx[3] = {i, j, k};
+    const std::size_t step[3] = {1, sy, sz};
+    for (int d = 0; d < 3 && !band; ++d) {
+      int lo[3] = {i, j, k}, hi[3] = {i, j, k};
+      lo[d] = idx[d] - 1;
+      hi[d] = idx[d] + 1;
+      if (grid_.in_patch(lo[0], lo[1], lo[2]) && kind[n - step[d]] == kEmpty) band = true;
+      if (grid_.in_patch(hi[0], hi[1], hi[2]) && kind[n + step[d]] == kEmpty) band = true;
+    }
+    gl_[n] = band ? (own ? gl_[n] : lab_.level[n]) : kLevelMin;
+  });
+  grid_.forward(gl_.data(), 1);
 }
 
 bool Projection::mark_front() {

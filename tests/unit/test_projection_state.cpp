@@ -43,6 +43,7 @@ mpm::ProjectionState local_state(const mpm::LocalGrid &grid) {
   s.have_theta_last = true;
   s.have_avg = true;
   s.have_acc = true;
+  s.have_grain_level = true;
   s.iterations = 7;
   s.residual = 3e-9;
   grid.for_owned([&](int i, int j, int k, std::size_t) {
@@ -51,6 +52,7 @@ mpm::ProjectionState local_state(const mpm::LocalGrid &grid) {
     s.theta_last.push_back(field(i, j, k, 4));
     s.p_avg.push_back(field(i, j, k, 5));
     s.p_acc.push_back(field(i, j, k, 6));
+    s.grain_level.push_back(field(i, j, k, 7));
   });
   return s;
 }
@@ -77,7 +79,9 @@ TEST(ProjectionState, GatherGlobalHasEveryNode) {
       for (int j = s.box.lo[1]; j <= s.box.hi[1]; ++j)
         for (int i = s.box.lo[0]; i <= s.box.hi[0]; ++i, ++q) {
           if (s.p[q] != field(i, j, k, 0) || s.theta_last[q] != field(i, j, k, 4) ||
-              s.p_avg[q] != field(i, j, k, 5) || s.p_acc[q] != field(i, j, k, 6)) ++bad;
+              s.p_avg[q] != field(i, j, k, 5) || s.p_acc[q] != field(i, j, k, 6) ||
+              s.grain_level[q] != field(i, j, k, 7))
+            ++bad;
           for (int d = 0; d < 3; ++d)
             if (s.grad[3 * q + d] != field(i, j, k, 1 + d)) ++bad;
         }
@@ -104,10 +108,20 @@ TEST(ProjectionState, PackUnpackRoundTrip) {
   EXPECT_EQ(r.p_avg, s.p_avg);
   EXPECT_TRUE(r.have_acc);
   EXPECT_EQ(r.p_acc, s.p_acc);
+  EXPECT_TRUE(r.have_grain_level);
+  EXPECT_EQ(r.grain_level, s.grain_level);
   EXPECT_EQ(r.residual, s.residual);
+  // layout 2 (restart files before the grains' levels): the same block without them reads back
+  // without them
+  std::vector<double> two(buf.begin(), buf.end() - 1 - static_cast<long>(s.grain_level.size()));
+  two[1] = 2.0;
+  mpm::ProjectionState r2;
+  EXPECT_EQ(r2.unpack(two.data() + 1), two.size() - 1);
+  EXPECT_TRUE(r2.valid && r2.have_acc && !r2.have_grain_level && r2.grain_level.empty());
+  EXPECT_EQ(r2.p_acc, s.p_acc);
   // layout 1 (restart files before pressure_average): the same block without the averaged
   // pressure reads back without it
-  std::vector<double> old(buf.begin(), buf.end() - 2 - static_cast<long>(s.p_avg.size() + s.p_acc.size()));
+  std::vector<double> old(two.begin(), two.end() - 2 - static_cast<long>(s.p_avg.size() + s.p_acc.size()));
   old[1] = 1.0;
   mpm::ProjectionState r1;
   EXPECT_EQ(r1.unpack(old.data() + 1), old.size() - 1);
@@ -147,6 +161,10 @@ TEST(ProjectionState, LoadSaveAcrossDecompositions) {
     EXPECT_EQ(saved.theta_last, want.theta_last) << split;
     EXPECT_EQ(saved.p_avg, want.p_avg) << split;
     EXPECT_EQ(saved.p_acc, want.p_acc) << split;
+    EXPECT_EQ(saved.grain_level, want.grain_level) << split;
+    // the grains' levels, halos included: forwarded from the owners
+    const double *gl = proj.grain_level();
+    ASSERT_NE(gl, nullptr);
     EXPECT_EQ(proj.iterations(), 7);
     // the grains' gradient, halos included: forwarded from the owners (padding: the wall node's)
     const std::vector<double> &ge = proj.gradient();
@@ -157,6 +175,7 @@ TEST(ProjectionState, LoadSaveAcrossDecompositions) {
         for (int i = pb.lo[0]; i <= pb.hi[0]; ++i) {
           const bool pad = i < 0 || j < 0 || k < 0 || i > g.ncell[0] || j > g.ncell[1] || k > g.ncell[2];
           if (!pad && ge[3 * grid.index(i, j, k)] != field(i, j, k, 1)) ++bad;
+          if (!pad && gl[grid.index(i, j, k)] != field(i, j, k, 7)) ++bad;
         }
     EXPECT_EQ(bad, 0) << split;
     // a state for another patch is refused when it does not hold every owned node
