@@ -179,6 +179,23 @@ void FluidSolver::grain_node_state(const IndexBox &sbox, const IndexBox &rbox, b
   // keeps the right terminal slip (see mpm::drag_implicit_impulse). Grain k receives the share
   // S_jk K_k / K_j of J_j. The pressure-gradient force (7-15) is explicit (not stiff); its
   // reaction goes to the nodes too.
+// The share of a grain (stencil ps, radius r) below the free surface (docs/theory/drag.md, "Grains
+// at the free surface"): the depth of its centre, its nodes' levels (Projection::grain_level, in
+// cells; NaN at SOLID nodes: left out) interpolated with its weights, and the cap of its sphere
+// below it; 1 without levels (pressure eos). The grain's drag and pressure force take this share.
+template <int NS>
+static double immersion(const Stencil &ps, std::size_t sy, std::size_t sz, const double *lev, double dx, double r) {
+  if (!lev) return 1.0;
+  double wl = 0.0, ws = 0.0;
+  for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double, double, double) {
+    if (!std::isnan(lev[n])) {
+      wl += w * lev[n];
+      ws += w;
+    }
+  });
+  return ws > 0.0 ? immersed_fraction(wl / ws * dx, r) : 1.0;
+}
+
 // couple_kernel, per grain: Kgrain[k], the pressure force (coup_->grain_force) and the grain's shares
 // of K, K v, mass, pressure reaction and K a at the nodes of its stencil (dr).
 // (inlined into couple_kernel: as a call of its own, GCC emitted for it a register-to-register
@@ -193,17 +210,10 @@ template <int NS>
   const double *radius = pts.radius, *rmass = pts.rmass;
   const int nsub = state.nsub;
   const double mu = opt.viscosity, rho_f = opt.eos.rho0;
-  // The grains' immersion (docs/theory/drag.md, "Grains at the free surface"): the signed
-  // distance to the free surface at the grain, its nodes' levels (Projection::grain_level, in
-  // cells; NaN at SOLID nodes: left out) interpolated with its weights; the grain's fluid forces
-  // (drag and pressure) take the share of its sphere below that surface.
-  const Projection *pj = pressure_->solve();
-  const double *lev = pj ? pj->grain_level() : nullptr;
-  const double dx = opt.grid.dx;
+  const double *lev = pressure_->solve() ? pressure_->solve()->grain_level() : nullptr;  // (immersion)
   for (int k = 0; k < nlocal; ++k) {
     if (!is_grain(k) || coup_->grain_shapes[k].base[0] == INT_MIN) continue;
     const Stencil &ps = coup_->grain_shapes[k];
-    double wl = 0.0, ws = 0.0;  // the stencil's level sum and weight (lev: the immersion)
     // one pass over the stencil: velocity of the wet nodes (and their total weight, the record's
     // 4th entry), fitted gradients of the determined nodes (and their weight), fluid fraction,
     // gradient of the nodal pressures
@@ -218,10 +228,6 @@ template <int NS>
         uw += w * row4(st + StRec::U);
         th += w * st[StRec::TH];
         for (int d = 0; d < 3; ++d) gradp[d] += w * gw[3 * n + d];
-        if (lev && !std::isnan(lev[n])) {
-          wl += w * lev[n];
-          ws += w;
-        }
       });
     } else {
       for_stencil<NS>(ps, sy, sz, [&](std::size_t n, int, int, int, double w, double gx, double gy, double gz) {
@@ -232,10 +238,6 @@ template <int NS>
         gradp[0] += st[StRec::P] * gx;
         gradp[1] += st[StRec::P] * gy;
         gradp[2] += st[StRec::P] * gz;
-        if (lev && !std::isnan(lev[n])) {
-          wl += w * lev[n];
-          ws += w;
-        }
       });
     }
     const double wet = uw[3], wfit = fw[3];
@@ -247,16 +249,14 @@ template <int NS>
       for (int d = 0; d < 3; ++d) gradp[d] = fw[d] / wfit;
     const double d_k = 2.0 * radius[k];
     const double Vk = M_PI / 6.0 * d_k * d_k * d_k;
+    const double immersed = immersion<NS>(ps, sy, sz, lev, opt.grid.dx, radius[k]);
     double K = 0.0;
     if (wet > 0.0) {
       for (int d = 0; d < 3; ++d) u[d] /= wet;
       const double urel = std::sqrt((u[0] - v[k][0]) * (u[0] - v[k][0]) + (u[1] - v[k][1]) * (u[1] - v[k][1]) +
                                     (u[2] - v[k][2]) * (u[2] - v[k][2]));
-      K = drag_coefficient(opt.drag_law, opt.drag_form, rho_f, mu, d_k, Vk, th, urel, opt.theta_min);
+      K = immersed * drag_coefficient(opt.drag_law, opt.drag_form, rho_f, mu, d_k, Vk, th, urel, opt.theta_min);
     }
-    // the share of the grain below the free surface (1 without a level set: eos)
-    const double immersed = lev && ws > 0.0 ? immersed_fraction(wl / ws * dx, radius[k]) : 1.0;
-    K *= immersed;
     Kgrain[k] = K;
     double Fp[3];
     pressure_gradient_force(immersed * Vk, gradp, Fp);

@@ -113,11 +113,7 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     front_.assign(grid_.size(), 0);
     lab_.dry.assign(grid_.size(), 1);
   }
-  // with grains: their levels (grain_levels); without a level set (mesh walls) the level read
-  // from the same fill, for the grains only
-  if (theta) gl_.assign(grid_.size(), 0.0);
-  else gl_.clear();
-  const bool glevel = theta && !opt_.surface_ghost;
+  gl_.assign(theta ? grid_.size() : 0, 0.0);  // with grains: their levels (grain_levels)
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
     if (lab_.kind[n] == kSolid) return;
     const double m = p2g[P2gRec::N * n + P2gRec::M];
@@ -132,7 +128,8 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
     } else if (m <= mmin || m <= 0.0 || fill < kSurfaceFill) {
       lab_.kind[n] = kEmpty;
     }
-    if (glevel) gl_[n] = surface_distance(fill, opt_.shape, np);
+    // (without a level set, mesh walls: the level of the same fill, for the grains only)
+    if (!gl_.empty() && !opt_.surface_ghost) gl_[n] = surface_distance(fill, opt_.shape, np);
     if (film) {
       lab_.dry[n] = m <= mmin || m <= 0.0;
       front_[n] = fill < kFrontFill;
