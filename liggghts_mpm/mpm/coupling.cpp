@@ -170,15 +170,6 @@ void FluidSolver::grain_node_state(const IndexBox &sbox, const IndexBox &rbox, b
   });
 }
 
-  // Drag, exchanged node by node. Each grain k has the coefficient K_k (frozen over the sub-step)
-  // and touches node j with weight S_jk. At every node the fluid (mass M_j, velocity u_j) and the
-  // grains' share of it (coefficient K_j = sum_k S_jk K_k, mass sum_k S_jk m_k, K-weighted mean
-  // velocity) exchange the backward-Euler two-body impulse J_j over h: the slip decays without
-  // overshoot however many grains share the node (a dense bed) and however stiff the drag, the
-  // fluid loses exactly what the grains gain, and a grain advanced by LIGGGHTS' velocity Verlet
-  // keeps the right terminal slip (see mpm::drag_implicit_impulse). Grain k receives the share
-  // S_jk K_k / K_j of J_j. The pressure-gradient force (7-15) is explicit (not stiff); its
-  // reaction goes to the nodes too.
 // The share of a grain (stencil ps, radius r) below the free surface (docs/theory/drag.md, "Grains
 // at the free surface"): the depth of its centre, its nodes' levels (Projection::grain_level, in
 // cells; NaN at SOLID nodes: left out) interpolated with its weights, and the cap of its sphere
@@ -196,6 +187,15 @@ static double immersion(const Stencil &ps, std::size_t sy, std::size_t sz, const
   return ws > 0.0 ? immersed_fraction(wl / ws * dx, r) : 1.0;
 }
 
+  // Drag, exchanged node by node. Each grain k has the coefficient K_k (frozen over the sub-step)
+  // and touches node j with weight S_jk. At every node the fluid (mass M_j, velocity u_j) and the
+  // grains' share of it (coefficient K_j = sum_k S_jk K_k, mass sum_k S_jk m_k, K-weighted mean
+  // velocity) exchange the backward-Euler two-body impulse J_j over h: the slip decays without
+  // overshoot however many grains share the node (a dense bed) and however stiff the drag, the
+  // fluid loses exactly what the grains gain, and a grain advanced by LIGGGHTS' velocity Verlet
+  // keeps the right terminal slip (see mpm::drag_implicit_impulse). Grain k receives the share
+  // S_jk K_k / K_j of J_j. The pressure-gradient force (7-15) is explicit (not stiff); its
+  // reaction goes to the nodes too.
 // couple_kernel, per grain: Kgrain[k], the pressure force (coup_->grain_force) and the grain's shares
 // of K, K v, mass, pressure reaction and K a at the nodes of its stencil (dr).
 // (inlined into couple_kernel: as a call of its own, GCC emitted for it a register-to-register

@@ -88,7 +88,9 @@ class Projection {
   // signed distance to the free surface in cells that a grain reads, positive in the fluid, of
   // the last solve (grain_levels; NaN: a SOLID node, not read); null before the first solve with
   // grains
-  const double *grain_level() const { return gl_.size() == grid_.size() && !gl_.empty() ? gl_.data() : nullptr; }
+  const double *grain_level() const {
+    return gl_.size() == grid_.size() && !gl_.empty() ? gl_.data() : nullptr;
+  }
   // largest nodal pressure of the last solve on this rank's owned nodes, averaged in time
   // (keyword pressure_average tau: exponential average with time constant tau; 0: as solved)
   double largest_average_pressure() const { return p_avg_max_; }

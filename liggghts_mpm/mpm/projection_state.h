@@ -13,8 +13,9 @@ namespace mpm {
 // pressure projection: what the next fluid step reads of the last solve (restart files, a new
 // grid patch at the next run): the nodal pressure (the solve's warm start), its nodal gradient
 // (the grains' pressure force of the next step), theta of the last solve (the d(theta)/dt
-// source) and the grains' levels (their immersion at the next step), on a box of global node indices, i fastest. Written by Projection::save, read by
-// Projection::load (mpm/projection_state.cpp, like the functions below).
+// source) and the grains' levels (their immersion at the next step), on a box of global node
+// indices, i fastest. Written by Projection::save, read by Projection::load
+// (mpm/projection_state.cpp, like the functions below).
 struct ProjectionState {
   bool valid = false;
   IndexBox box;                  // the nodes held: one rank's owned box, or the whole grid
