@@ -9,7 +9,6 @@
 // [kg/s]; the drag force on the particle is F = K (u_f - v_s) and the fluid
 // receives -F (mapped to the nodes with the interpolation weights).
 #pragma once
-#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -128,7 +127,7 @@ inline void pressure_gradient_force(double Vp, const double gradp[3], double F[3
 inline double immersed_fraction(double d, double r) {
   if (d >= r) return 1.0;  // (exactly: a grain in the bulk keeps its forces to the bit)
   if (d <= -r) return 0.0;
-  const double h = std::min(std::max(r + d, 0.0), 2.0 * r);
+  const double h = r + d;  // within (0, 2 r) here
   return h * h * (3.0 * r - h) / (4.0 * r * r * r);
 }
 

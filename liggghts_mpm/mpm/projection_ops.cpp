@@ -56,14 +56,7 @@ void for_faces(const LocalGrid &grid, const NodeLabels &lab, const ProjectionGeo
 
 // An EMPTY node none of whose six neighbours in the patch is FLUID (its pressure gradient is 0).
 bool empty_away_from_fluid(const LocalGrid &grid, const NodeLabels &lab, int i, int j, int k, std::size_t n) {
-  if (lab.kind[n] != kEmpty) return false;
-  for (int d = 0; d < 3; ++d)
-    for (int side = -1; side <= 1; side += 2) {
-      int q[3] = {i, j, k};
-      q[d] += side;
-      if (grid.in_patch(q[0], q[1], q[2]) && lab.kind[grid.index(q[0], q[1], q[2])] == kFluid) return false;
-    }
-  return true;
+  return lab.kind[n] == kEmpty && !neighbour_of_kind(grid, lab, i, j, k, kFluid);
 }
 
 // Flux theta u along +d through face f of node n (see flux_divergence).
@@ -90,6 +83,16 @@ double face_flux(const NodeLabels &lab, std::size_t n, const Face &f, int d, con
 }
 
 }  // namespace
+
+bool neighbour_of_kind(const LocalGrid &grid, const NodeLabels &lab, int i, int j, int k, NodeKind kind) {
+  for (int d = 0; d < 3; ++d)
+    for (int side = -1; side <= 1; side += 2) {
+      int q[3] = {i, j, k};
+      q[d] += side;
+      if (grid.in_patch(q[0], q[1], q[2]) && lab.kind[grid.index(q[0], q[1], q[2])] == kind) return true;
+    }
+  return false;
+}
 
 void NodeLabels::reset(const LocalGrid &grid, const IndexBox *work) {
   const GridSpec &g = grid.spec();

@@ -160,6 +160,10 @@ inline double surface_weight(const NodeLabels &labels, std::size_t n, std::size_
   return 0.5 / surface_scale(labels, n, m);
 }
 
+// Whether one of the six face neighbours of node (i, j, k) that lie in the patch is of this kind
+// (faces open or not).
+bool neighbour_of_kind(const LocalGrid &grid, const NodeLabels &lab, int i, int j, int k, NodeKind kind);
+
 // True if the face of node (i, j, k) towards (i, j, k) + side e_d (side = -1 or
 // +1) is open: both nodes in the patch, neither SOLID, not flagged closed.
 // *m: the neighbour's flat index when it lies in the patch.

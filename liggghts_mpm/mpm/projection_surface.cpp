@@ -177,24 +177,13 @@ void Projection::make_labels(const double *p2g, double mmin, const double *theta
    (padding, behind mesh walls) NaN: not read. Labels of the owned nodes' neighbours: after the
    labels' exchange. */
 void Projection::grain_levels() {
-  const std::size_t sy = grid_.stride_y(), sz = grid_.stride_z();
   const bool own = lab_.level.empty();  // mesh walls: gl_ holds the fill's level
-  const std::uint8_t *kind = lab_.kind.data();
   grid_.for_owned([&](int i, int j, int k, std::size_t n) {
-    if (kind[n] == kSolid) {
+    if (lab_.kind[n] == kSolid) {
       gl_[n] = std::numeric_limits<double>::quiet_NaN();
       return;
     }
-    bool band = kind[n] == kEmpty;
-    const int idx[3] = {i, j, k};
-    const std::size_t step[3] = {1, sy, sz};
-    for (int d = 0; d < 3 && !band; ++d) {
-      int lo[3] = {i, j, k}, hi[3] = {i, j, k};
-      lo[d] = idx[d] - 1;
-      hi[d] = idx[d] + 1;
-      if (grid_.in_patch(lo[0], lo[1], lo[2]) && kind[n - step[d]] == kEmpty) band = true;
-      if (grid_.in_patch(hi[0], hi[1], hi[2]) && kind[n + step[d]] == kEmpty) band = true;
-    }
+    const bool band = lab_.kind[n] == kEmpty || neighbour_of_kind(grid_, lab_, i, j, k, kEmpty);
     gl_[n] = band ? (own ? gl_[n] : lab_.level[n]) : kLevelMin;
   });
   grid_.forward(gl_.data(), 1);
