@@ -84,7 +84,6 @@ class Drill {
   void move_fronts(Node& n, const Rates& r, double dtn);
   void melt_temperature();
   void flux_heat_march();
-  double implicit_column(Node& n, double a, double qout, double hin, double dtn);
   void limit_b2(Node& n, double g, double th, bool content_only);
   void record(double tau, bool frame);
   void emit(Frame&& f);

@@ -397,25 +397,6 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
   return solve_interface_flux_m(G, xi, g, beta, gamma, advected, kappa, H_old, from.phi, memo);
 }
 
-ImplicitHeatColumn solve_implicit_heat_column(const Groups& G, double xi, double g, double a, double qout,
-                                              double hin, double dtn, double H_old, bool advected,
-                                              const InterfaceState& from) {
-  ImplicitHeatColumn c;
-  const double c0 = advected ? content_factor(std::max(from.peclet, 0.0)) : 0.5;
-  c.lambda = 2.0 / (3.0 * c0);
-  c.E = 1.0 + c.lambda * dtn * qout / (a * g);
-  const double kappa = 1.0 / (2.0 * dtn + c.E * g * g / 6.0);
-  const double gamma = kappa * (dtn * hin / a - (c.E - 1.0) * H_old);
-  c.itf = solve_interface_flux(G, xi, g, 0.0, gamma, advected, c.E * kappa, H_old, from);
-  c.b2 = (c.E * kappa * (layer_content(c.itf, g, 0.0) - H_old) - gamma) / g;
-  return c;
-}
-
-double implicit_heat_content(const ImplicitHeatColumn& c, double g, double a, double hin, double dtn,
-                             double H_old, double b2) {
-  return (H_old + dtn * (2.0 * b2 * g + hin / a)) / c.E;
-}
-
 double recession_rate(const Groups& G, double xi, const InterfaceState& s) {
   return G.Ni * gaussian_beam(xi) - G.Psi * s.p_star * std::sqrt(s.phi) -
          G.hls_hlv * G.Ste * s.grad_top;

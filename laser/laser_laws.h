@@ -275,26 +275,6 @@ InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double
 // solve_interface(..., from) does: the result of the call above to the last bit.
 InterfaceState solve_interface_flux(const Groups& G, double xi, double g, double beta, double gamma,
                                     bool advected, double kappa, double H_old, const InterfaceState& from);
-// --heat-march implicit (docs/theory/laser_model.md 2.12): one column of the face heat march whose
-// outflow (volume rate qout per unit circumference, area a, both in the march's units) leaves at
-// theta_out = lambda H / g, H the column's new content (backward Euler), lambda = 2/(3 c) with c the
-// content factor of 'from' (the state at the step's start), so that a layer without b2 sends
-// 2 theta_sat/3 as the explicit march does. The balance H E = H_old + dtn (2 b2 g + hin / a),
-// E = 1 + lambda dtn qout / (a g), and the profile's content H = content0 - b2 g^3/6 give
-// b2 g = E kappa (content0 - H_old) - gamma, kappa = 1/(2 dtn + E g^2/6),
-// gamma = kappa (dtn hin / a - (E - 1) H_old), solved with the surface temperature by
-// solve_interface_flux (beta = 0, kappa E). b2 is the root's, before any limit of (4-25).
-struct ImplicitHeatColumn {
-  InterfaceState itf;
-  double b2 = 0.0, lambda = 0.0, E = 1.0;
-};
-ImplicitHeatColumn solve_implicit_heat_column(const Groups& G, double xi, double g, double a, double qout,
-                                              double hin, double dtn, double H_old, bool advected,
-                                              const InterfaceState& from);
-// The column's new content for its b2 (the root's, or the limited one): H = (H_old + dtn (2 b2 g +
-// hin / a)) / E. It sends (E - 1) H = (E - 1)/E of what it holds and receives, never more.
-double implicit_heat_content(const ImplicitHeatColumn& c, double g, double a, double hin, double dtn,
-                             double H_old, double b2);
 // Content factor of the layer's profile without b2: int_0^g theta dzeta = theta_sat g c(Pe),
 // c(Pe) = 1/Pe - 1/(e^Pe - 1) for the advected (exponential) profile, 1/2 for the
 // linear one (Pe = 0); dc receives c'(Pe).

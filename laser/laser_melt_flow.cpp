@@ -317,7 +317,6 @@ void Drill::flux_heat_march() {
   const int N = static_cast<int>(nodes_.size());
   const double R2 = cfg_.R * cfg_.R;
   const bool outward = A_ >= 0.0, transient = cfg_.transient_content();
-  const bool implicit = transient && cfg_.heat_march == HeatMarch::Implicit;
   std::vector<double> theta_out(N, 0.0);  // flux-weighted temperature of the heat a node sends
   std::vector<char> done(N, 0);
   auto active = [&](int i) { return i >= first_c_ && i < N && nodes_[i].molten && nodes_[i].g > 0.0; };
@@ -347,11 +346,6 @@ void Drill::flux_heat_march() {
     if ((qout == 0.0 && hin == 0.0 && !transient) || !(dtn > 0.0)) {
       n.b2 = 0.0;
       n.H = transient ? layer_content(n.itf, g, 0.0) : 0.0;
-      done[i] = 1;
-      continue;
-    }
-    if (implicit) {  // the outflow at the column's new content (docs 2.12)
-      theta_out[i] = implicit_column(n, a, qout, hin, dtn);
       done[i] = 1;
       continue;
     }
@@ -388,26 +382,6 @@ void Drill::flux_heat_march() {
                               : 2.0 / 3.0 * std::max(n.itf.theta_sat, 0.0);
     done[i] = 1;
   }
-}
-
-// --heat-march implicit (docs/theory/laser_model.md 2.12): the column's outflow leaves at
-// theta_out = lambda H / g, H its new content (backward Euler; solve_implicit_heat_column), so
-// that it never sends more heat than it holds, at any heat Courant number. Where the limit of
-// (4-25) holds b2 back, H is the balance's at the limited b2 (nothing is moved elsewhere).
-// Returns theta_out.
-double Drill::implicit_column(Node& n, double a, double qout, double hin, double dtn) {
-  const double g = n.g, H_old = n.H;
-  const ImplicitHeatColumn c = solve_implicit_heat_column(G_, n.xi, g, a, qout, hin, dtn, H_old, advected_, n.itf);
-  n.itf = c.itf;
-  n.b2 = c.b2;
-  const double th = std::max(n.itf.theta_sat, 0.0);
-  // a hit whose quasi-steady flow part alone is within the limit is the content asking for more
-  limit_b2(n, g, th, std::fabs(qout / (3.0 * a) * th - hin / (2.0 * a)) * g <= th);
-  n.itf_solved = true;
-  const double H = implicit_heat_content(c, g, a, hin, dtn, H_old, n.b2);
-  n.dH = H - H_old;
-  n.H = H;
-  return c.lambda * H / g;
 }
 
 }  // namespace detail

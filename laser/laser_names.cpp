@@ -51,10 +51,6 @@ void validate(Config& c) {
   if (c.melt_content == MeltContent::Transient && c.model == FlowModel::Conduction)
     throw UsageError("--melt-content: transient needs a melt flow model (the layer's content changes through b2 of "
                      "(4-25), which --model conduction does not have), got --model conduction");
-  if (c.heat_march == HeatMarch::Implicit && !c.transient_content())
-    throw UsageError("--heat-march: implicit needs the layer's heat content (--melt-content transient, or auto "
-                     "with --melt-update implicit or trapezoidal; the march is backward Euler in that content), "
-                     "got the quasi-steady layer");
   // the heat Courant sub-steps split the face heat fluxes of the conservative flow: without
   // them (the ODE b2 of (4-25), or no melt flow) the option would change nothing
   if (c.heat_courant > 0.0 && (!c.flux_heat() || c.model == FlowModel::Conduction)) {

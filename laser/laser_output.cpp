@@ -407,8 +407,6 @@ ordered_json case_json(const Config& cfg) {
                {"absorptivity", num(cfg.absorptivity)},
                {"melt_update", cfg.melt_update_name()},
                {"dxi", num(cfg.dxi)},               {"material", cfg.material}};
-  // only where it is not the default, so that the summaries of the explicit march stay as they were
-  if (cfg.heat_march == HeatMarch::Implicit) j["case"]["heat_march"] = "implicit";
   return j["case"];
 }
 

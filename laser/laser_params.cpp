@@ -364,13 +364,6 @@ void add_numerics_params(std::vector<Param>& t) {
                    "heat Courant number C = dtau sum|c_k| g / a of the face heat fluxes (--melt-heat flux) kept in "
                    "each step by splitting it into the fewest equal sub-steps with C <= this (at most 1000); 0: "
                    "no splitting (beyond C = 1 the b2 limit of (4-25) acts)", &Config::heat_courant));
-  t.push_back(choice(
-      "heat-march", "numerics", {"explicit", "implicit"},
-      "march of the face heat fluxes with the layer's content (--melt-content transient): explicit = outflow at "
-      "2 theta_sat/3 whatever the column holds (heat Courant number C up to about 0.5), implicit = at a "
-      "temperature proportional to its new content (backward Euler: never more than it holds, at any C)",
-      [](Config& c, const std::string& v) { c.heat_march = v == "implicit" ? HeatMarch::Implicit : HeatMarch::Explicit; },
-      [](const Config& c) { return std::string(c.heat_march == HeatMarch::Implicit ? "implicit" : "explicit"); }));
   // [output]
   {
     Param p{"frames", "output", Kind::Int, "-", 2, 1e5, false, {}, "number of profile frames in profiles.h5 "

@@ -34,11 +34,6 @@ enum class MeltHeat { Auto, Ode, Flux };
 // layer (what flows in is conducted out at once); Auto = transient with the face
 // heat fluxes and the implicit melt update (docs/theory/laser_model.md 2.7).
 enum class MeltContent { Auto, Transient, Steady };
-// March of the face heat fluxes with the layer's content (docs/theory/laser_model.md 2.12):
-// Explicit = a column sends its outflow at 2 theta_sat/3 of its solved profile without b2,
-// whatever its content; Implicit = at a temperature proportional to its new content
-// (backward Euler), so that a column never sends more heat than it holds, at any C.
-enum class HeatMarch { Explicit, Implicit };
 // Curvature factor of the melting front in (3-39)/(3-40): Conduction = the two
 // branches of (3-37) set by conduction into the curved solid (C_c >= 1 under a
 // front that bulges into the solid, a > 0; damps node-scale modes of the front),
@@ -98,7 +93,6 @@ struct Config {
   // heat Courant number kept per step by --melt-heat flux by splitting the step
   // (docs/theory/laser_model.md 2.10); 0: no splitting
   double heat_courant = 0.0;
-  HeatMarch heat_march = HeatMarch::Explicit;
   // Set by the time-step policy for the first run of an automatic ladder (no option): where the
   // heat Courant limit split the first heat_probe_share of the run's steps into more than
   // heat_probe_mbar sub-steps on average, the run stops there with status "split_probe" (the
