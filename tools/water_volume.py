@@ -87,9 +87,10 @@ def rest_area(zmean, zc, R):
     return segment_area(0.5 * (lo + hi), zc, R)[0]
 
 
-def level_ratio(xyz, dx, origin, ppc, axis, c1, c2, R, length):
+def level_ratio(fill, npoints, dx, origin, ppc, axis, c1, c2, R, length):
     """The segment below the level at rest times the jar's length, over the points' own volume
-    (one point spacing everywhere: n (dx / ppc)^3). The level is where the fill, averaged over the
+    (one point spacing everywhere: npoints (dx / ppc)^3); fill: node_fill of the points. The level
+    is where the fill, averaged over the
     node columns across the middle 0.6 R of the jar (2 dx off the end caps), falls through 1/2:
     the expected fill of points of any arrangement is the B-spline's convolution of the water's
     indicator, which is 1/2 on a plane surface, so the mean over many columns finds the surface
@@ -97,12 +98,11 @@ def level_ratio(xyz, dx, origin, ppc, axis, c1, c2, R, length):
     lies low for disordered points: points placed at random in the jar's segment below a plane
     read 0.908 by it against 0.994, the profile 0.974; in the water-only jar after 25 turns it read
     0.98-1.01 where the profile reads 1.066 and the points missing within one cell of the mantle
-    are 7 % of the water.) The jar's axis is horizontal,
-    z up: C1 and C2 are the centre's coordinates across it in the order x, y, z."""
+    are 7 % of the water.) The jar's axis is horizontal, z up: C1 and C2 are the centre's
+    coordinates across it in the order x, y, z."""
     ax = "xyz".index(axis)
     centre = dict(zip([d for d in range(3) if d != ax], (c1, c2)))
     horiz = next(d for d in centre if d != 2)  # the horizontal coordinate across the axis
-    fill = node_fill(xyz, dx, origin, ppc)
     cols, layer = set(), {}
     for idx, f in fill.items():
         x_h, x_a = origin[horiz] + idx[horiz] * dx, origin[ax] + idx[ax] * dx
@@ -120,19 +120,19 @@ def level_ratio(xyz, dx, origin, ppc, axis, c1, c2, R, length):
             break
     if level is None:
         return float("nan")
-    return segment_area(level, centre[2], R)[0] * length / (len(xyz) * (dx / ppc) ** 3)
+    return segment_area(level, centre[2], R)[0] * length / (npoints * (dx / ppc) ** 3)
 
 
 def wall_shell_share(xyz, dx, ppc, axis, c1, c2, R):
-    """Points within one cell of the mantle of a cylinder (axis AXIS through C1 C2, radius R)
-    below its centre height, over the number an even fill of the half shell holds,
+    """Points within one cell of the mantle of a horizontal cylinder (axis AXIS through C1 C2, as
+    --rest: C2 the centre's height, radius R) below its centre height, over the number an even fill of the half shell holds,
     pi (R^2 - (R - dx)^2) / 2 * length / (dx / ppc)^3 per unit length (the length: the points'
     extent along the axis): 1 for water filled up to the mantle, lower where the points left a
     layer along it."""
     ax = "xyz".index(axis)
     other = [d for d in range(3) if d != ax]
     r = np.hypot(xyz[:, other[0]] - c1, xyz[:, other[1]] - c2)
-    below = xyz[:, 2] < (c2 if other[1] == 2 else c1)
+    below = xyz[:, 2] < c2
     n = int(np.sum((r > R - dx) & below))
     length = float(np.ptp(xyz[:, ax])) + dx / ppc
     even = 0.5 * np.pi * (R * R - (R - dx) ** 2) * length / (dx / ppc) ** 3
@@ -191,8 +191,8 @@ def main():
             row["rest_volume_ratio"] = area / first_area
             extra = f"  at rest: volume / first {area / first_area:.5f}"
             if a.length:
-                lev = level_ratio(xyz, dx, origin, a.ppc, a.rest[0], float(a.rest[1]), float(a.rest[2]),
-                                  float(a.rest[3]), a.length)
+                lev = level_ratio(fill, len(xyz), dx, origin, a.ppc, a.rest[0], float(a.rest[1]),
+                                  float(a.rest[2]), float(a.rest[3]), a.length)
                 row["level_over_points"] = lev
                 shell = wall_shell_share(xyz, dx, a.ppc, a.rest[0], float(a.rest[1]), float(a.rest[2]),
                                          float(a.rest[3]))
