@@ -3,10 +3,10 @@
 # Run from the repository top:  tools/demo.sh [--out starter-demo.png] [--quick] [--exe EXE --work DIR]
 # Builds (incrementally), runs the starter scene inputs/starter/in.pour_and_collapse (800 glass
 # beads poured by LIGGGHTS, a 0.03 x 0.02 x 0.06 m water column released onto them, coupled both
-# ways, every setting of fix mpm/fluid at its default) in inputs/starter/out-demo/ with HDF5 output
+# ways, the fix's defaults and `every auto`) in inputs/starter/out-demo/ with HDF5 output
 # every 0.01 s, writes the picture (a cut through the middle of the box at four times: the column at
 # rest behind the gate, two moments of the collapse, the end; water points coloured by |v|, beads
-# to scale) and checks the run against bounds from its inputs. ~1 min after the build on one core
+# to scale) and checks the run against bounds from its inputs. ~10 s after the build on one core
 # (--quick: the input's reduced scene, a few seconds). Installs the Debian packages that are
 # missing (tools/install_deps.sh); python packages come from tools/python (its own venv).
 # --exe: run that liggghts_mpm, without installing or building; --work: the run folder.
@@ -108,5 +108,5 @@ slab=(--slab "$6" "$7")
 [ "$quick" = 1 ] && slab=()
 "$top/tools/python" "$top/tools/render_run.py" "$work" --field v --times "$1" "$2" "$3" "$4" \
   --labels "at rest behind the gate" "collapsing" "into the bed" "last frame" "${slab[@]}" --out "$out" \
-  --title "Water column released onto poured glass beads (inputs/starter), fix mpm/fluid defaults: pressure projection, two-way coupling; gate opens at t = $5 s"
+  --title "Water column released onto poured glass beads (inputs/starter), fix mpm/fluid defaults (pressure projection, two-way coupling) and every auto; gate opens at t = $5 s"
 echo "== picture: $out"

@@ -328,7 +328,7 @@ def row_c4(r, models, turns=float(os.environ.get("C4_TURNS", "1"))):
 def row_starter(r, models):
     """Starter scene, quick (300 beads, cell 10 mm) and default size (800 beads, cell 5 mm): the
     largest point pressure against rho g h + rho U^2, U = sqrt(2 g h) of the 0.06 m column. The starter
-    input runs the fix's defaults only (no eos branch): other models are skipped."""
+    input runs the fix's defaults and `every auto` only (no eos branch): other models are skipped."""
     sys.path.insert(0, os.path.join(TOP, "tests", "cases"))
     from test_starter import thermo_blocks
     bound = 1000.0 * 9.81 * 0.06 * 3.0
