@@ -67,6 +67,13 @@ def deep_fill(fill, dx, origin, deep, keep):
     return (float(np.mean(vals)) if vals else float("nan")), len(vals)
 
 
+def cylinder(spec):
+    """AXIS C1 C2 R (--cylinder, --rest) as (axis index, the two other indices in the order x, y,
+    z, C1, C2, R)."""
+    ax = "xyz".index(spec[0])
+    return ax, [d for d in range(3) if d != ax], float(spec[1]), float(spec[2]), float(spec[3])
+
+
 def segment_area(zs, zc, R, n=4000):
     """Area and centroid height of the part of a disc (centre height zc, radius R) below z = zs."""
     z = np.linspace(zc - R, min(zs, zc + R), n)
@@ -87,7 +94,7 @@ def rest_area(zmean, zc, R):
     return segment_area(0.5 * (lo + hi), zc, R)[0]
 
 
-def level_ratio(fill, npoints, dx, origin, ppc, axis, c1, c2, R, length):
+def level_ratio(fill, npoints, dx, origin, ppc, cyl, length):
     """The segment below the level at rest times the jar's length, over the points' own volume
     (one point spacing everywhere: npoints (dx / ppc)^3); fill: node_fill of the points. The level
     is where the fill, averaged over the
@@ -98,10 +105,10 @@ def level_ratio(fill, npoints, dx, origin, ppc, axis, c1, c2, R, length):
     lies low for disordered points: points placed at random in the jar's segment below a plane
     read 0.908 by it against 0.994, the profile 0.974; in the water-only jar after 25 turns it read
     0.98-1.01 where the profile reads 1.066 and the points missing within one cell of the mantle
-    are 7 % of the water.) The jar's axis is horizontal, z up: C1 and C2 are the centre's
-    coordinates across it in the order x, y, z."""
-    ax = "xyz".index(axis)
-    centre = dict(zip([d for d in range(3) if d != ax], (c1, c2)))
+    are 7 % of the water.) cyl: cylinder() of --rest; the jar's axis is horizontal, z up: C1 and
+    C2 are the centre's coordinates across it in the order x, y, z."""
+    ax, other, c1, c2, R = cyl
+    centre = dict(zip(other, (c1, c2)))
     horiz = next(d for d in centre if d != 2)  # the horizontal coordinate across the axis
     cols, layer = set(), {}
     for idx, f in fill.items():
@@ -123,14 +130,13 @@ def level_ratio(fill, npoints, dx, origin, ppc, axis, c1, c2, R, length):
     return segment_area(level, centre[2], R)[0] * length / (npoints * (dx / ppc) ** 3)
 
 
-def wall_shell_share(xyz, dx, ppc, axis, c1, c2, R):
+def wall_shell_share(xyz, dx, ppc, cyl):
     """Points within one cell of the mantle of a horizontal cylinder (axis AXIS through C1 C2, as
     --rest: C2 the centre's height, radius R) below its centre height, over the number an even fill of the half shell holds,
     pi (R^2 - (R - dx)^2) / 2 * length / (dx / ppc)^3 per unit length (the length: the points'
     extent along the axis): 1 for water filled up to the mantle, lower where the points left a
-    layer along it."""
-    ax = "xyz".index(axis)
-    other = [d for d in range(3) if d != ax]
+    layer along it. cyl: cylinder() of --rest."""
+    ax, other, c1, c2, R = cyl
     r = np.hypot(xyz[:, other[0]] - c1, xyz[:, other[1]] - c2)
     below = xyz[:, 2] < c2
     n = int(np.sum((r > R - dx) & below))
@@ -156,14 +162,13 @@ def main():
     a = ap.parse_args()
     origin = np.array(a.origin)
     dx = a.dx
+    keep_cyl = cylinder(a.cylinder) if a.cylinder else None
+    rest = cylinder(a.rest) if a.rest else None
 
     def keep(x):
-        if a.cylinder:
-            ax = "xyz".index(a.cylinder[0])
-            other = [d for d in range(3) if d != ax]
-            c = [float(a.cylinder[1]), float(a.cylinder[2])]
-            r = np.hypot(x[other[0]] - c[0], x[other[1]] - c[1])
-            if r > float(a.cylinder[3]) - 2.0 * dx:
+        if keep_cyl:
+            _, other, c1, c2, R = keep_cyl
+            if np.hypot(x[other[0]] - c1, x[other[1]] - c2) > R - 2.0 * dx:
                 return False
         if a.box:
             for d in range(3):
@@ -184,18 +189,16 @@ def main():
         row = {"t": t, "points": len(xyz), "deep_nodes": count, "deep_fill": mean,
                "volume_ratio": first / mean, "occupied_cells": occ, "z_max": float(xyz[:, 2].max())}
         extra = ""
-        if a.rest:
-            area = rest_area(float(xyz[:, 2].mean()), float(a.rest[2]), float(a.rest[3]))
+        if rest:
+            area = rest_area(float(xyz[:, 2].mean()), rest[3], rest[4])
             if first_area is None:
                 first_area = area
             row["rest_volume_ratio"] = area / first_area
             extra = f"  at rest: volume / first {area / first_area:.5f}"
             if a.length:
-                lev = level_ratio(fill, len(xyz), dx, origin, a.ppc, a.rest[0], float(a.rest[1]),
-                                  float(a.rest[2]), float(a.rest[3]), a.length)
+                lev = level_ratio(fill, len(xyz), dx, origin, a.ppc, rest, a.length)
                 row["level_over_points"] = lev
-                shell = wall_shell_share(xyz, dx, a.ppc, a.rest[0], float(a.rest[1]), float(a.rest[2]),
-                                         float(a.rest[3]))
+                shell = wall_shell_share(xyz, dx, a.ppc, rest)
                 row["wall_shell"] = shell
                 extra += f"  level / points' volume {lev:.5f}  wall shell {shell:.3f}"
         rows.append(row)
