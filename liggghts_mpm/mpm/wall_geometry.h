@@ -153,8 +153,9 @@ class WallGeometry {
               bool *near = nullptr) const;
   // h: the time over which a shear wall's stress acts (the grid update's step); h = 0 applies only
   // its normal condition (a second pass over the same velocities, e.g. the MUSL remap, must not
-  // apply the stress again).
-  static void impose(const WallConstraint *c, int n, double vel[3], double h = 0.0);
+  // apply the stress again). bilateral: the normal velocity relative to the wall is removed both
+  // ways (a node under the free surface of incompressible water), not only into the wall.
+  static void impose(const WallConstraint *c, int n, double vel[3], double h = 0.0, bool bilateral = false);
   // Kinematic viscosity of the fluid, for the shear walls.
   void set_kinematic_viscosity(double nu) { nu_ = nu; }
   // Rotation rate |omega| (rad/time) of wall k fitted to the velocities of its triangles' nodes
