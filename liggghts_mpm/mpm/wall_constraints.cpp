@@ -26,7 +26,7 @@ using wall_tri::smooth_normal_speed;
 using wall_tri::wall_velocity;
 
 // Relative velocity r = v - w: normal part along unit n -> max(0, r.n) (fluid side, one-sided) or 0
-// (behind, or 'bilateral': water under its surface does not leave a wetted wall).
+// (behind, or 'bilateral' at a face: water under its surface does not leave a wetted wall).
 // Tangential part: v_t -> target w_t + keep (v_t - target w_t), with
 //   noslip / freeslip / partial f: target 1, keep 1 - f (0, 1, 1 - f);
 //   sticky f (imposed): target f, keep 0: the tangential velocity becomes f times the wall's (the
@@ -38,7 +38,7 @@ inline void constrain(double v[3], const WallConstraint &c, double h, bool bilat
   double r[3];
   sub3(v, c.w, r);
   const double rn = dot3(r, c.n);
-  const double rn_new = (c.behind || bilateral) ? 0.0 : std::max(0.0, rn);
+  const double rn_new = (c.behind || (bilateral && c.face)) ? 0.0 : std::max(0.0, rn);
   const double wn = dot3(c.w, c.n), vn = dot3(v, c.n);
   double keep = 1.0 - c.sticky, target = 1.0;
   if (c.imposed) {
@@ -274,6 +274,7 @@ int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_f
       o.rate = walls_[k].kind == WALL_SHEAR ? wall_layer_rate(nu_, layer_thickness(static_cast<int>(k)), reach_fluid) : 0.0;
       o.behind = behind;
       o.imposed = walls_[k].kind == WALL_STICKY;
+      o.face = any_face || smooth_edge;
       o.wall = static_cast<int>(k);
     }
   }
