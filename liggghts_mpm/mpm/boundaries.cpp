@@ -20,7 +20,7 @@ void Boundaries::walls_moved() {
   }
 }
 
-void Boundaries::apply(double *vel, int i, int j, int k, double h, double m, bool bilateral) {
+void Boundaries::apply(double *vel, int i, int j, int k, double h, double m) {
   const GridSpec &gs = opt_->grid;
   const int idx[3] = {i, j, k};
   for (int d = 0; d < 3; ++d) {
@@ -58,13 +58,13 @@ void Boundaries::apply(double *vel, int i, int j, int k, double h, double m, boo
       for (int c = 0; c < count_[n]; ++c) {
         const WallConstraint &wc = cache_[first_[n] + c];
         const double v0[3] = {vel[0], vel[1], vel[2]};
-        WallGeometry::impose(&wc, 1, vel, h, bilateral);
+        WallGeometry::impose(&wc, 1, vel, h);
         const double ms = m * rec_s_;
         const double J[3] = {ms * (vel[0] - v0[0]), ms * (vel[1] - v0[1]), ms * (vel[2] - v0[2])};
         add_impulse(wc.wall, xn, J);
       }
     } else {
-      WallGeometry::impose(cache_.data() + first_[n], count_[n], vel, h, bilateral);
+      WallGeometry::impose(cache_.data() + first_[n], count_[n], vel, h);
     }
   }
   const Gate &g = opt_->gate;

@@ -34,9 +34,7 @@ class Boundaries {
   // of shear walls acts over it).
   // m > 0 with record_loads on: the momentum each mesh-wall condition gives the node's mass m,
   // m (v after - v before), is added to its wall's load (owned nodes only, so each counts once).
-  // bilateral: mesh walls remove the normal velocity relative to them both ways
-  // (WallGeometry::impose).
-  void apply(double *vel, int i, int j, int k, double h, double m = 0.0, bool bilateral = false);
+  void apply(double *vel, int i, int j, int k, double h, double m = 0.0);
   // (8-23) of one point (P2G, after its own scatter so that each node sums in point order):
   // grid faces and mesh walls, into the force rows of the P2G records.
   void add_traction(const Stencil &ps, const double *xp, double V, double p, double *p2g) {

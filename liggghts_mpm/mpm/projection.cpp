@@ -261,7 +261,7 @@ void Projection::set_velocities(double *vel, const double *p2g, double mmin, con
       return;
     }
     for (int d = 0; d < 3; ++d) v[d] = u_[3 * n + d];
-    bc.apply(v, i, j, k, h, m, mesh_ && lab_.kind[n] == kFluid && frac_[n] > 0.5 + kWallPlane);
+    bc.apply(v, i, j, k, h, m);
   });
 }
 

@@ -242,11 +242,6 @@ class Projection {
   // walls off the box's faces, WallGeometry::kWallDirs per node (mesh_wall_labels,
   // WallGeometry::node_side), kWallFar beyond the shape's reach
   static constexpr double kWallFar = 2.0;
-  // FLUID nodes more than kWallPlane cells off every mesh wall (frac_ > 1/2 + kWallPlane) take the
-  // wall condition both ways (set_velocities): water under its surface does not leave a wetted
-  // wall; nodes in a wall's plane keep the one-sided condition (docs/theory/projection.md,
-  // "Beside mesh walls")
-  static constexpr double kWallPlane = 0.01;
   std::vector<double> wall_dist_;
   // node (i, j, k) = n beside mesh walls: the fill it reads from an even fill of points (np per
   // cell) at rest, against which crowding (*crowd) and gaps (*gap) are read (left as they are,

@@ -25,8 +25,7 @@ using wall_tri::set_normal_part;
 using wall_tri::smooth_normal_speed;
 using wall_tri::wall_velocity;
 
-// Relative velocity r = v - w: normal part along unit n -> max(0, r.n) (fluid side, one-sided) or 0
-// (behind, or 'bilateral' at a face: water under its surface does not leave a wetted wall).
+// Relative velocity r = v - w: normal part along unit n -> max(0, r.n) (fluid side) or 0 (behind).
 // Tangential part: v_t -> target w_t + keep (v_t - target w_t), with
 //   noslip / freeslip / partial f: target 1, keep 1 - f (0, 1, 1 - f);
 //   sticky f (imposed): target f, keep 0: the tangential velocity becomes f times the wall's (the
@@ -34,11 +33,11 @@ using wall_tri::wall_velocity;
 //   shear delta f: target f, keep exp(-rate h): the exact solution over h of
 //     dv_t/dt = -rate (v_t - f w_t), the wall shear stress mu (f w_t - v_t) / delta acting on the
 //     fluid within 'reach' of the wall, rate = nu / (delta reach) (docs/theory/mesh_walls.md).
-inline void constrain(double v[3], const WallConstraint &c, double h, bool bilateral) {
+inline void constrain(double v[3], const WallConstraint &c, double h) {
   double r[3];
   sub3(v, c.w, r);
   const double rn = dot3(r, c.n);
-  const double rn_new = (c.behind || (bilateral && c.face)) ? 0.0 : std::max(0.0, rn);
+  const double rn_new = c.behind ? 0.0 : std::max(0.0, rn);
   const double wn = dot3(c.w, c.n), vn = dot3(v, c.n);
   double keep = 1.0 - c.sticky, target = 1.0;
   if (c.imposed) {
@@ -67,8 +66,8 @@ bool WallGeometry::apply(const double x[3], double vel[3], double reach_fluid, d
   return nc > 0;
 }
 
-void WallGeometry::impose(const WallConstraint *c, int nc, double vel[3], double h, bool bilateral) {
-  for (int k = 0; k < nc; ++k) constrain(vel, c[k], h, bilateral);
+void WallGeometry::impose(const WallConstraint *c, int nc, double vel[3], double h) {
+  for (int k = 0; k < nc; ++k) constrain(vel, c[k], h);
 }
 
 int WallGeometry::collect(const double x[3], double reach_fluid, double reach_behind, WallConstraint *out,
@@ -274,7 +273,6 @@ int WallGeometry::constraints(const KeptHits &kept, double reach, double reach_f
       o.rate = walls_[k].kind == WALL_SHEAR ? wall_layer_rate(nu_, layer_thickness(static_cast<int>(k)), reach_fluid) : 0.0;
       o.behind = behind;
       o.imposed = walls_[k].kind == WALL_STICKY;
-      o.face = any_face || smooth_edge;
       o.wall = static_cast<int>(k);
     }
   }

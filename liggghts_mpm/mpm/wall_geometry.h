@@ -67,9 +67,6 @@ struct WallConstraint {
   double rate;
   bool behind;
   bool imposed;
-  // from the face of a triangle or an edge of a smooth surface (not a sharp edge or a vertex): the
-  // conditions that may hold water both ways (impose's 'bilateral')
-  bool face;
   int wall;  // the mesh (wall index) the condition belongs to
 };
 
@@ -156,10 +153,8 @@ class WallGeometry {
               bool *near = nullptr) const;
   // h: the time over which a shear wall's stress acts (the grid update's step); h = 0 applies only
   // its normal condition (a second pass over the same velocities, e.g. the MUSL remap, must not
-  // apply the stress again). bilateral: at the conditions from faces (WallConstraint::face) the
-  // normal velocity relative to the wall is removed both ways (a node under the free surface of
-  // incompressible water), not only into the wall; water still leaves sharp edges and vertices.
-  static void impose(const WallConstraint *c, int n, double vel[3], double h = 0.0, bool bilateral = false);
+  // apply the stress again).
+  static void impose(const WallConstraint *c, int n, double vel[3], double h = 0.0);
   // Kinematic viscosity of the fluid, for the shear walls.
   void set_kinematic_viscosity(double nu) { nu_ = nu; }
   // Rotation rate |omega| (rad/time) of wall k fitted to the velocities of its triangles' nodes

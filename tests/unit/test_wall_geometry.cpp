@@ -236,30 +236,6 @@ TEST(WallGeometry, PlateKinds) {
     WallGeometry::impose(c, nc, z, 0.0);
     expect_v(z, 1, 2, 0);
   }
-  {
-    // bilateral (a node under the free surface with the projection): the normal velocity relative
-    // to the wall is removed leaving the wall as well; the tangential part as one-sided
-    const WallGeometry g = plate_geometry(wall(mpm::WALL_FREESLIP), moving);
-    WallConstraint c[WallGeometry::kMaxConstraints];
-    const int nc = g.collect(x, reach, reach, c);
-    ASSERT_EQ(nc, 1);
-    EXPECT_TRUE(c[0].face);
-    double in[3] = {1, 2, -3}, out[3] = {1, 2, 3}, one[3] = {1, 2, 3};
-    WallGeometry::impose(c, nc, in, 0.0, true);
-    WallGeometry::impose(c, nc, out, 0.0, true);
-    WallGeometry::impose(c, nc, one, 0.0, false);
-    expect_v(in, 1, 2, 0);
-    expect_v(out, 1, 2, 0);
-    expect_v(one, 1, 2, 3);
-    // beyond the plate's edge the node sees a sharp edge: water leaves it also with 'bilateral'
-    const double xe[3] = {1.05, 0.6, 0.55};
-    const int ne = g.collect(xe, reach, reach, c);
-    ASSERT_EQ(ne, 1);
-    EXPECT_FALSE(c[0].face);
-    double e[3] = {0, 0, 3};
-    WallGeometry::impose(c, ne, e, 0.0, true);
-    expect_v(e, 0, 0, 3);
-  }
 }
 
 TEST(WallGeometry, PushBackUndoesCrossing) {
