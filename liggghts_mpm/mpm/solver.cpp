@@ -162,8 +162,11 @@ void FluidSolver::compute_shapes() {
   if (static_cast<int>(pw_.shapes.size()) < nlocal) {
     pw_.shapes.resize(nlocal);
     pw_.vpic.resize(3 * static_cast<std::size_t>(nlocal));
-    pw_.velgrad.resize(9 * static_cast<std::size_t>(nlocal));
   }
+  // the velocity gradient apart from the state rows: APIC only (their affine record holds C there);
+  // FLIP and PIC keep it in the affine record (grad_in_state)
+  if (opt.transfer == Transfer::Apic && pw_.velgrad.size() < 9 * static_cast<std::size_t>(nlocal))
+    pw_.velgrad.resize(9 * static_cast<std::size_t>(nlocal));
   pw_.plist.clear();
   double **x = pts.x;
   const GridSpec &gs = opt.grid;

@@ -30,9 +30,10 @@ struct PointWork {
   std::vector<Stencil> shapes;
   std::vector<int> plist;       // local indices of the material points (this sub-step)
   std::vector<double> vpic;     // grid (PIC) velocity at the points, for the position update
-  std::vector<double> velgrad;  // velocity gradient at the points, for the stress update
-  // the velocity gradient of the last transfer sits in the points' affine record (FLIP/PIC with
-  // MUSL store it there anyway), not in velgrad: one stream of 9 doubles per point less
+  std::vector<double> velgrad;  // velocity gradient at the points, for the stress update (APIC only)
+  // the velocity gradient of the last transfer sits in the points' affine record (FLIP and PIC,
+  // whose affine record holds nothing else), not in velgrad: 9 doubles per point less, allocated
+  // with APIC only
   bool grad_in_state = false;
   // anti-locking (eos): the node index of each point's cell, and whether the MUSL gradient pass
   // has already summed the cells of this sub-step's stress update (sum_cell)

@@ -80,7 +80,8 @@ void FluidSolver::g2p_kernel() {
   const double dinv = apic_dinv_bspline2() / (opt.grid.dx * opt.grid.dx);
   const bool flip = opt.transfer == Transfer::Flip;
   const double alpha = opt.flip_alpha;
-  if (P::need_L) pw_.grad_in_state = false;  // pw_.velgrad holds this transfer's gradient
+  // the gradient of this transfer: in the affine record for FLIP and PIC, in pw_.velgrad for APIC
+  if (P::need_L) pw_.grad_in_state = !P::apic;
   for (const int i : pw_.plist) {
     const Stencil &ps = pw_.shapes[i];
     double *s = pts.state[i];
@@ -131,7 +132,7 @@ void FluidSolver::g2p_kernel() {
       throw LocalError(os.str());
     }
     // velocity gradient for the stress update (USL; MUSL recomputes it)
-    if (P::need_L) std::copy(L, L + 9, &pw_.velgrad[9 * static_cast<std::size_t>(i)]);
+    if (P::need_L && P::apic) std::copy(L, L + 9, &pw_.velgrad[9 * static_cast<std::size_t>(i)]);
   }
 }
 
