@@ -120,6 +120,12 @@ int main(int argc, char **argv) {
   }
   args.push_back(nullptr);
   auto *lmp = new LAMMPS_NS::LAMMPS(int(args.size()) - 1, args.data(), MPI_COMM_WORLD);
+  // '-screen none' leaves the first rank without a screen, and LIGGGHTS 3.8 writes to it
+  // unconditionally in places (the STL import of fix mesh/surface, insertion): a segmentation
+  // fault. A sink takes its place, behind the tee below, so that an error LIGGGHTS writes to the
+  // screen only still reaches the log.
+  if (!lmp->screen && lmp->universe->existflag == 0 && lmp->universe->me == 0)
+    lmp->screen = std::fopen("/dev/null", "w");
   if (lmp->screen && lmp->logfile) {
     cookie_io_functions_t io = {nullptr, tee_write, nullptr, tee_close};
     auto *tee = new ScreenTee{lmp->screen, &lmp->logfile, std::string()};

@@ -55,7 +55,7 @@ size="default size: $(val nbeads) beads, cell $(val cell) m, $(val ppc)^3 points
 [ "$quick" = 1 ] && size="quick scene: $(val nbeads) beads, cell $(val cell) m, $(val ppc)^3 points per cell"
 echo "== starter scene ($size) in ${work#$top/}"
 t0=$(date +%s.%N)
-# stdout to a file, not '-screen none': LIGGGHTS' insertion writes to the screen and crashes without one
+# the screen to a file: its last lines are shown if the run fails
 (cd "$work" && "$exe" -in in.pour_and_collapse -echo none -var quick "$quick" -var tout "$tout" \
    > screen.txt 2>&1) || {
   echo "demo.sh: the run failed; see ${work#$top/}/log.liggghts:" >&2

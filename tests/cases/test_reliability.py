@@ -557,6 +557,30 @@ def case_lost_messages(r):
         check(not extra, f"bogus_command, run {k + 1} of 5: nothing after the error (got {extra[:2]})")
 
 
+def case_screen_none(r):
+    """'-screen none' crashed LIGGGHTS 3.8's STL import of fix mesh/surface (a segmentation fault:
+    it writes to the screen unconditionally): a mesh scene runs to its end with it, and an error
+    reaches the log."""
+    data = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "data")
+    d = r.fresh("screen_none/mesh")
+    for f in ("in.mesh_walls_box", "box.stl"):
+        shutil.copy(os.path.join(data, f), d)
+    cmd = [r.exe, "-in", "in.mesh_walls_box", "-echo", "none", "-screen", "none", "-log", "log.txt",
+           "-var", "fside", "opposite", "-var", "steps", "20"]
+    p = subprocess.run(cmd, cwd=d, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=120)
+    log = open(os.path.join(d, "log.txt"), errors="replace").read() if os.path.exists(os.path.join(d, "log.txt")) else ""
+    check(p.returncode == 0 and "Loop time of" in log,
+          f"mesh scene with -screen none: exit 0 and the run in the log (exit {p.returncode})")
+    d = r.fresh("screen_none/error")
+    with open(os.path.join(d, "in.script"), "w") as f:
+        f.write(COLUMN.format(pre="", fixargs="cfl 2", steps=1))
+    p = subprocess.run([r.exe, "-in", "in.script", "-echo", "none", "-screen", "none", "-log", "log.txt"], cwd=d,
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=60)
+    log = open(os.path.join(d, "log.txt"), errors="replace").read() if os.path.exists(os.path.join(d, "log.txt")) else ""
+    l_err = [ln for ln in log.splitlines() if "ERROR" in ln and "keyword 'cfl'" in ln]
+    check(p.returncode != 0 and len(l_err) == 1, f"error with -screen none: once in the log ({len(l_err)}), exit {p.returncode}")
+
+
 def joke_lines(text):
     """Lines that LIGGGHTS' error->all or error->one print after the ERROR line when its version
     string says PUBLIC: a 'comment from the off' or a 'tip of the day', read from a destroyed
