@@ -581,6 +581,20 @@ def case_screen_none(r):
     check(p.returncode != 0 and len(l_err) == 1, f"error with -screen none: once in the log ({len(l_err)}), exit {p.returncode}")
 
 
+def case_units(r):
+    """An input without 'units si' (LIGGGHTS' default is lj) ran with the fix's SI defaults read in
+    other units: refused at the fix command, naming the unit style given; si runs."""
+    base = COLUMN.format(pre="", fixargs="", steps=2)
+    for style, text in (("lj", base.replace("units si\n", "")), ("cgs", base.replace("units si", "units cgs"))):
+        p, msg = r.run_script(f"units/{style}", text)
+        check(p.returncode != 0 and "requires 'units si'" in msg and f"'units {style}'" in msg,
+              f"units {style}: refused naming 'units si' and the style given (got: {msg.strip()[:200]})")
+        check(not re.search(r"^\s+Step\s", p.stdout, re.M), f"units {style}: before any step")
+    d = r.fresh("units/si")
+    p = execute_text(r, d, base)
+    check(p.returncode == 0 and result(p) is not None, "units si: runs")
+
+
 def joke_lines(text):
     """Lines that LIGGGHTS' error->all or error->one print after the ERROR line when its version
     string says PUBLIC: a 'comment from the off' or a 'tip of the day', read from a destroyed
