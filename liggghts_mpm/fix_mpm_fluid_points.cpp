@@ -328,3 +328,34 @@ void FixMpmFluid::check_group_atoms() {
        << " of the fix: grains must not share the type of the material points (give them another atom type)";
   if (!os.str().empty()) error->all(FLERR, os.str().c_str());
 }
+
+/* A mesh that walls the grains (fix wall/gran) but not the fluid lets the water through it, which
+   a scene seldom means (a drum or tank whose mesh_wall was left out): a warning at the first
+   setup, naming the mesh, when its bounds come within a cell of the points'. */
+void FixMpmFluid::warn_grain_walls() {
+  if (grain_walls_checked) return;
+  grain_walls_checked = true;
+  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  for (int i = 0; i < atom->nlocal; ++i)
+    if (is_point(i))
+      for (int d = 0; d < 3; ++d) {
+        lo[d] = std::min(lo[d], atom->x[i][d]);
+        hi[d] = std::max(hi[d], atom->x[i][d]);
+      }
+  std::vector<std::string> fluid;
+  for (const mpm::MeshWallSpec &w : mesh_specs) fluid.push_back(w.fix_id);
+  const mpm::GridSpec &g = sync().opt.grid;
+  double glo[3], ghi[3];
+  for (int d = 0; d < 3; ++d) {
+    glo[d] = g.periodic[d] ? -HUGE_VAL : g.origin[d];
+    ghi[d] = g.periodic[d] ? HUGE_VAL : g.upper(d);
+  }
+  const std::vector<std::string> ids = mpm::grain_walls_beside_fluid(lmp, fluid, lo, hi, glo, ghi, g.dx);
+  if (comm->me != 0) return;
+  for (const std::string &id : ids) {
+    const std::string msg = "Fix mpm/fluid: the mesh of fix " + id + " is a wall of the grains (fix wall/gran) but not " +
+                            "of the fluid, and the water reaches it: the water passes through it. Give 'mesh_wall " +
+                            id + " ...' to fix mpm/fluid if it should hold the water";
+    error->warning(FLERR, msg.c_str());
+  }
+}

@@ -3,6 +3,8 @@
 
 #include <mpi.h>
 
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 // LIGGGHTS
@@ -64,6 +66,50 @@ std::vector<char> fill_mesh_mask(LAMMPS_NS::LAMMPS *lmp, const Options &o, const
   std::vector<std::vector<Tri9>> outside;
   for (const std::string &id : o.fill_outside) outside.push_back(gather_closed_mesh(lmp, id, "fill outside"));
   return mesh_fill_mask(lat, o.fill_inside.empty() ? nullptr : &inside, outside, gap);
+}
+
+std::vector<std::string> grain_walls_beside_fluid(LAMMPS_NS::LAMMPS *lmp, const std::vector<std::string> &fluid_walls,
+                                                  const double lo[3], const double hi[3], const double glo[3],
+                                                  const double ghi[3], double reach) {
+  const double eps = 0.01 * reach;
+  int me = 0;
+  MPI_Comm_rank(lmp->world, &me);
+  double box[6];  // the points' bounds over all ranks: min lo, max hi (as -max -lo)
+  for (int d = 0; d < 3; ++d) {
+    box[d] = -lo[d];
+    box[3 + d] = hi[d];
+  }
+  MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_DOUBLE, MPI_MAX, lmp->world);
+  std::vector<std::string> out;
+  for (int f = 0; f < lmp->modify->nfix; ++f) {
+    auto *fm = dynamic_cast<LAMMPS_NS::FixMeshSurface *>(lmp->modify->fix[f]);
+    if (!fm || !fm->hasNeighList() || !fm->triMesh() || fm->triMesh()->numNodes() != 3) continue;
+    const std::string id = fm->id;
+    if (std::find(fluid_walls.begin(), fluid_walls.end(), id) != fluid_walls.end()) continue;
+    LAMMPS_NS::TriMesh *m = fm->triMesh();
+    double mb[6] = {HUGE_VAL, HUGE_VAL, HUGE_VAL, HUGE_VAL, HUGE_VAL, HUGE_VAL};  // -max -lo, -max hi as minima
+    if (m->isParallel() || me == 0)
+      for (int i = 0; i < m->sizeLocal(); ++i) {
+        double p[3][3];
+        for (int j = 0; j < 3; ++j) m->node(i, j, p[j]);
+        bool on_face = false;
+        for (int d = 0; d < 3 && !on_face; ++d)
+          on_face = (p[0][d] <= glo[d] + eps && p[1][d] <= glo[d] + eps && p[2][d] <= glo[d] + eps) ||
+                    (p[0][d] >= ghi[d] - eps && p[1][d] >= ghi[d] - eps && p[2][d] >= ghi[d] - eps);
+        if (on_face) continue;
+        for (int j = 0; j < 3; ++j)
+          for (int d = 0; d < 3; ++d) {
+            mb[d] = std::min(mb[d], p[j][d]);
+            mb[3 + d] = std::min(mb[3 + d], -p[j][d]);
+          }
+      }
+    MPI_Allreduce(MPI_IN_PLACE, mb, 6, MPI_DOUBLE, MPI_MIN, lmp->world);
+    bool near = true;
+    for (int d = 0; d < 3; ++d)
+      near = near && mb[d] <= box[3 + d] + reach && -mb[3 + d] >= -box[d] - reach;
+    if (near) out.push_back(id);
+  }
+  return out;
 }
 
 }  // namespace mpm

@@ -595,6 +595,44 @@ def case_units(r):
     check(p.returncode == 0 and result(p) is not None, "units si: runs")
 
 
+def case_grain_walls(r):
+    """A drum whose mesh walls the beads (fix wall/gran) but was not given to the fluid as a
+    mesh_wall ran without a word while the water passed through it: a warning at setup names the
+    mesh. None with the mesh_wall given, nor for a mesh on the grid's faces (the grid faces hold the
+    water there: tests/data/in.every_bed)."""
+    top = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+    data = os.path.join(top, "tests", "data")
+    drum = open(os.path.join(r.inputs, "drum", "in.drum")).read()
+    line = "                mesh_wall drum ${wallkw} ${walla} ${wallb} side opposite &\n"
+    check(line in drum, "inputs/drum/in.drum gives the drum to the fluid as a mesh_wall")
+    short = {"nbeads": 50, "cells": 16, "ppc": 1, "tdry": 0.002, "tsettle": 0.002, "turns": 0.002, "tsnap": 0}
+    needle = "the mesh of fix drum is a wall of the grains (fix wall/gran) but not of the fluid"
+    for name, text in (("without", drum.replace(line, "                &\n")), ("with", drum)):
+        d = r.fresh(f"grain_walls/drum_{name}")
+        with open(os.path.join(d, "in.drum"), "w") as f:
+            f.write(text)
+        subprocess.run([sys.executable, os.path.join(top, "tools", "make_drum_stl.py"), "drum.stl"], cwd=d,
+                       check=True, stdout=subprocess.DEVNULL)
+        p = r.execute(d, "in.drum", short, expect_ok=False, timeout=300)
+        log = open(os.path.join(d, "log.liggghts"), errors="replace").read()
+        n_screen = sum(needle in ln for ln in p.stdout.splitlines() if "WARNING" in ln)
+        n_log = sum(needle in ln for ln in log.splitlines() if "WARNING" in ln)
+        want = 1 if name == "without" else 0
+        check(p.returncode == 0 and n_screen == want and n_log == want,
+              f"drum {name} its mesh_wall: runs, the warning naming the mesh {want} time(s) in screen and log "
+              f"(screen {n_screen}, log {n_log}, exit {p.returncode})")
+    d = r.fresh("grain_walls/every_bed")
+    text = open(os.path.join(data, "in.every_bed")).read()
+    text = text.replace("variable nsettle equal 20000", "variable nsettle equal 40").replace(
+        "variable nmeas  equal 10000", "variable nmeas  equal 40")
+    with open(os.path.join(d, "in.every_bed"), "w") as f:
+        f.write(text)
+    shutil.copy(os.path.join(data, "box.stl"), d)
+    p = r.execute(d, "in.every_bed", {}, expect_ok=False, timeout=300)
+    check(p.returncode == 0 and "wall of the grains" not in p.stdout,
+          f"a mesh box on the grid's faces, walls of the grains only: runs without the warning (exit {p.returncode})")
+
+
 def joke_lines(text):
     """Lines that LIGGGHTS' error->all or error->one print after the ERROR line when its version
     string says PUBLIC: a 'comment from the off' or a 'tip of the day', read from a destroyed
