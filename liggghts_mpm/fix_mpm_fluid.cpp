@@ -226,7 +226,7 @@ void FixMpmFluid::setup(int) {
   mpm::FluidSolver &s = sync();
   s.setup_grid(domain->sublo, domain->subhi, neighbor->skin, !mesh_specs.empty());
   check_gate_side();
-  warn_grain_walls();
+  warn_unheld();
   if (!mesh_specs.empty()) {
     const bool first = !mesh_walls;  // the sides given in the fix command are checked at the first setup
     try {

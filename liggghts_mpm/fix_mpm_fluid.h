@@ -66,7 +66,8 @@ class FixMpmFluid : public Fix {
  private:
   std::unique_ptr<mpm::FluidSolver> solver;
   std::vector<mpm::MeshWallSpec> mesh_specs;
-  bool grain_walls_checked = false;  // warn_grain_walls ran (first setup)
+  bool grain_walls_checked = false;  // warn_unheld: the meshes checked (first setup)
+  bool uncoupled_warned = false;     // warn_unheld: uncoupled atoms among the points named
   std::unique_ptr<mpm::MeshWalls> mesh_walls;
   int couple_groupbit = 0;
   class FixPropertyAtom *fix_dragforce = nullptr;  // per-atom vector 'dragforce' (LIGGGHTS convention)
@@ -100,7 +101,7 @@ class FixMpmFluid : public Fix {
   void fluid_step_ahead(mpm::FluidSolver &s);  // every N > 1: the fluid step with the grains (N-1)/2 steps ahead
   std::vector<double> shifted;  // the grains' positions while fluid_step_ahead moved them  // F of the last fluid step onto the coupled grains' f (every DEM step)
   void check_gate_side();
-  void warn_grain_walls();
+  void warn_unheld();
   mpm::FluidSolver &sync();  // the solver with views of the current atom arrays and clock
   template <class Fn> void guarded(Fn &&fn);  // runs fn, translating the solver's errors
   void print(const std::string &text) const;  // rank 0: to screen and log file

@@ -329,12 +329,15 @@ void FixMpmFluid::check_group_atoms() {
   if (!os.str().empty()) error->all(FLERR, os.str().c_str());
 }
 
-/* A mesh that walls the grains (fix wall/gran) but not the fluid lets the water through it, which
-   a scene seldom means (a drum or tank whose mesh_wall was left out): a warning at the first
-   setup, naming the mesh, when its bounds come within a cell of the points'. */
-void FixMpmFluid::warn_grain_walls() {
-  if (grain_walls_checked) return;
-  grain_walls_checked = true;
+/* Checks at a run's setup of what a scene seldom means, each a warning once per fix:
+   - a mesh that walls the grains (fix wall/gran) but not the fluid lets the water through it (a
+     drum or tank whose mesh_wall was left out), named when its bounds come within a cell of the
+     points' (first setup);
+   - atoms that are neither points nor in the couple group (all of them without couple) within the
+     points' bounds feel no fluid force, and the fluid does not feel them (couple left out, or
+     given a smaller group); checked at every setup until it warns, so that grains inserted in an
+     earlier run are seen. */
+void FixMpmFluid::warn_unheld() {
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   for (int i = 0; i < atom->nlocal; ++i)
     if (is_point(i))
@@ -342,20 +345,47 @@ void FixMpmFluid::warn_grain_walls() {
         lo[d] = std::min(lo[d], atom->x[i][d]);
         hi[d] = std::max(hi[d], atom->x[i][d]);
       }
-  std::vector<std::string> fluid;
-  for (const mpm::MeshWallSpec &w : mesh_specs) fluid.push_back(w.fix_id);
   const mpm::GridSpec &g = sync().opt.grid;
-  double glo[3], ghi[3];
+  if (!grain_walls_checked) {
+    grain_walls_checked = true;
+    std::vector<std::string> fluid;
+    for (const mpm::MeshWallSpec &w : mesh_specs) fluid.push_back(w.fix_id);
+    double glo[3], ghi[3];
+    for (int d = 0; d < 3; ++d) {
+      glo[d] = g.periodic[d] ? -HUGE_VAL : g.origin[d];
+      ghi[d] = g.periodic[d] ? HUGE_VAL : g.upper(d);
+    }
+    const std::vector<std::string> ids = mpm::grain_walls_beside_fluid(lmp, fluid, lo, hi, glo, ghi, g.dx);
+    if (comm->me == 0)
+      for (const std::string &id : ids) {
+        const std::string msg = "Fix mpm/fluid: the mesh of fix " + id + " is a wall of the grains (fix wall/gran) but " +
+                                "not of the fluid, and the water reaches it: the water passes through it. Give " +
+                                "'mesh_wall " + id + " ...' to fix mpm/fluid if it should hold the water";
+        error->warning(FLERR, msg.c_str());
+      }
+  }
+  if (uncoupled_warned) return;
+  double box[6];
   for (int d = 0; d < 3; ++d) {
-    glo[d] = g.periodic[d] ? -HUGE_VAL : g.origin[d];
-    ghi[d] = g.periodic[d] ? HUGE_VAL : g.upper(d);
+    box[d] = -lo[d];
+    box[3 + d] = hi[d];
   }
-  const std::vector<std::string> ids = mpm::grain_walls_beside_fluid(lmp, fluid, lo, hi, glo, ghi, g.dx);
+  MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_DOUBLE, MPI_MAX, world);
+  long mine = 0, all = 0;
+  for (int i = 0; i < atom->nlocal; ++i) {
+    if (is_point(i) || (atom->mask[i] & couple_groupbit)) continue;
+    bool in = true;
+    for (int d = 0; d < 3 && in; ++d) in = atom->x[i][d] >= -box[d] && atom->x[i][d] <= box[3 + d];
+    mine += in;
+  }
+  MPI_Allreduce(&mine, &all, 1, MPI_LONG, MPI_SUM, world);
+  if (all == 0) return;
+  uncoupled_warned = true;
   if (comm->me != 0) return;
-  for (const std::string &id : ids) {
-    const std::string msg = "Fix mpm/fluid: the mesh of fix " + id + " is a wall of the grains (fix wall/gran) but not " +
-                            "of the fluid, and the water reaches it: the water passes through it. Give 'mesh_wall " +
-                            id + " ...' to fix mpm/fluid if it should hold the water";
-    error->warning(FLERR, msg.c_str());
-  }
+  std::ostringstream os;
+  os << "Fix mpm/fluid: " << all << " atoms that are no material points lie within the points' bounds and are "
+     << (couple_groupbit ? "not in the couple group '" + solver->opt.couple_group + "'" : std::string("not coupled (no keyword 'couple')"))
+     << ": they feel no fluid force and the fluid does not feel them. Give 'couple GROUP' with their group for "
+     << "two-way coupling";
+  error->warning(FLERR, os.str().c_str());
 }

@@ -134,11 +134,15 @@ void FluidSolver::coupled_limits(const double *glob) {
 // weakly compressible fluid is out of its range (a soft bulk modulus, a fast impact, pressure noise
 // in a dense bed), and its pressures and densities are not those of water.
 std::string FluidSolver::range_warning() {
-  constexpr double kDensityDeviation = 0.03, kPressureFactor = 5.0;
+  // kRoundOff: a pressure below kRoundOff K is the round-off of the equation of state (a density
+  // a few ulps off rho0), not a pressure; a fluid at rest without gravity has a scale of 0 and
+  // such pressures (measured 2e-11 Pa with K = 1e5 at a scale of 4e-31 Pa)
+  constexpr double kDensityDeviation = 0.03, kPressureFactor = 5.0, kRoundOff = 1e-12;
   if (pressure_->incompressible() || lim_.range_warned) return "";
   const double r0 = opt.eos.rho0, lo = lim_.rho_range[0] / r0, hi = lim_.rho_range[1] / r0;
   const bool density = lo < 1.0 - kDensityDeviation || hi > 1.0 + kDensityDeviation;
-  const bool pressure = lim_.p_max > kPressureFactor * lim_.p_scale && lim_.p_scale > 0.0;
+  const bool pressure = lim_.p_max > kPressureFactor * lim_.p_scale && lim_.p_scale > 0.0 &&
+                        lim_.p_max > kRoundOff * opt.eos.K;
   if (!density && !pressure) return "";
   lim_.range_warned = true;
   std::ostringstream os;

@@ -633,6 +633,27 @@ def case_grain_walls(r):
           f"a mesh box on the grid's faces, walls of the grains only: runs without the warning (exit {p.returncode})")
 
 
+def case_uncoupled(r):
+    """Grains in the water without 'couple' (or outside its group) fell through it as through air
+    without a word: a warning at setup gives their count; none with them coupled. The coupled grains
+    at rest in water without gravity: no warning at all (the weakly compressible range warning read
+    the equation of state's round-off, 2e-11 Pa, against a scene scale of 4e-31 Pa)."""
+    base = GRAINS.format(d="0.002", fixargs="", steps=5)
+    cases_ = (("coupled", base, None),
+              ("no_couple", base.replace(" couple grains", ""), "2 atoms that are no material points"),
+              ("subgroup", base.replace("group fluid type 1", "group fluid type 1\ngroup one id 1").replace("couple grains", "couple one"),
+               "1 atoms that are no material points"))
+    for name, text, needle in cases_:
+        d = r.fresh(f"uncoupled/{name}")
+        p = execute_text(r, d, text)
+        warns = [ln for ln in p.stdout.splitlines() if "WARNING" in ln]
+        if needle is None:
+            check(p.returncode == 0 and not warns, f"{name}: runs without a warning (got {[w[:120] for w in warns]})")
+        else:
+            hit = [w for w in warns if needle in w and "feel no fluid force" in w]
+            check(p.returncode == 0 and len(hit) == 1, f"{name}: one warning with the count ({[w[:160] for w in warns]})")
+
+
 def joke_lines(text):
     """Lines that LIGGGHTS' error->all or error->one print after the ERROR line when its version
     string says PUBLIC: a 'comment from the off' or a 'tip of the day', read from a destroyed
