@@ -48,7 +48,7 @@ FixMpmFluid::FixMpmFluid(LAMMPS *lmp, int narg, char **arg) : Fix(lmp, narg, arg
   if (!atom->rmass_flag || !atom->radius_flag)
     error->all(FLERR, "Fix mpm/fluid requires atom_style sphere (per-atom mass and radius)");
   // the defaults are SI quantities (density 1000 kg/m3, g = 9.81 m/s^2 of the volume correction's
-  // rate and of hydrostatic, the drag laws' constants): any other unit style would read them wrongly
+  // rate and of hydrostatic): any other unit style would read them wrongly
   if (!update->unit_style || std::strcmp(update->unit_style, "si") != 0) {
     std::string msg = std::string("Fix mpm/fluid requires 'units si' (its defaults are SI quantities: density ") +
                       "1000 kg/m3, g = 9.81 m/s^2); the input has 'units " +

@@ -383,7 +383,8 @@ void FixMpmFluid::warn_unheld() {
   uncoupled_warned = true;
   if (comm->me != 0) return;
   std::ostringstream os;
-  os << "Fix mpm/fluid: " << all << " atoms that are no material points lie within the points' bounds and are "
+  os << "Fix mpm/fluid: " << all << (all == 1 ? " atom that is no material point lies" : " atoms that are no material points lie")
+     << " within the points' bounds and " << (all == 1 ? "is " : "are ")
      << (couple_groupbit ? "not in the couple group '" + solver->opt.couple_group + "'" : std::string("not coupled (no keyword 'couple')"))
      << ": they feel no fluid force and the fluid does not feel them. Give 'couple GROUP' with their group for "
      << "two-way coupling";

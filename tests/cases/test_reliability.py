@@ -642,7 +642,7 @@ def case_uncoupled(r):
     cases_ = (("coupled", base, None),
               ("no_couple", base.replace(" couple grains", ""), "2 atoms that are no material points"),
               ("subgroup", base.replace("group fluid type 1", "group fluid type 1\ngroup one id 1").replace("couple grains", "couple one"),
-               "1 atoms that are no material points"))
+               "1 atom that is no material point"))
     for name, text, needle in cases_:
         d = r.fresh(f"uncoupled/{name}")
         p = execute_text(r, d, text)
