@@ -68,6 +68,7 @@ class FixMpmFluid : public Fix {
   std::vector<mpm::MeshWallSpec> mesh_specs;
   bool grain_walls_checked = false;  // warn_unheld: the meshes checked (first setup)
   bool uncoupled_warned = false;     // warn_unheld: uncoupled atoms among the points named
+  bool overlap_checked = false;      // warn_unheld: other fixes' grids compared (first setup)
   std::unique_ptr<mpm::MeshWalls> mesh_walls;
   int couple_groupbit = 0;
   class FixPropertyAtom *fix_dragforce = nullptr;  // per-atom vector 'dragforce' (LIGGGHTS convention)

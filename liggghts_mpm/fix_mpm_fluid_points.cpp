@@ -333,10 +333,12 @@ void FixMpmFluid::check_group_atoms() {
    - a mesh that walls the grains (fix wall/gran) but not the fluid lets the water through it (a
      drum or tank whose mesh_wall was left out), named when its bounds come within a cell of the
      points' (first setup);
-   - atoms that are neither points nor in the couple group (all of them without couple) within the
-     points' bounds feel no fluid force, and the fluid does not feel them (couple left out, or
-     given a smaller group); checked at every setup until it warns, so that grains inserted in an
-     earlier run are seen. */
+   - another fix mpm/fluid whose grid overlaps this one's is a second fluid that this one passes
+     through (first setup);
+   - atoms of finite radius that are neither points nor in the couple group (all of them without
+     couple) within the points' bounds feel no fluid force, and the fluid does not feel them
+     (couple left out, or given a smaller group); checked at every setup until it warns, so that
+     grains inserted in an earlier run are seen. */
 void FixMpmFluid::warn_unheld() {
   double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   for (int i = 0; i < atom->nlocal; ++i)
@@ -364,6 +366,23 @@ void FixMpmFluid::warn_unheld() {
         error->warning(FLERR, msg.c_str());
       }
   }
+  // another fix mpm/fluid whose grid overlaps this one's: two fluids that pass through each other
+  // (each fix is a fluid of its own; the later fix in the input warns)
+  if (!overlap_checked) {
+    overlap_checked = true;
+    for (int f = 0; f < modify->nfix && modify->fix[f] != this; ++f) {
+      auto *o = dynamic_cast<FixMpmFluid *>(modify->fix[f]);
+      if (!o || !o->solver) continue;
+      const mpm::GridSpec &h = o->solver->opt.grid;
+      bool overlap = true;
+      for (int d = 0; d < 3; ++d) overlap = overlap && g.origin[d] < h.upper(d) && h.origin[d] < g.upper(d);
+      if (!overlap || comm->me != 0) continue;
+      const std::string msg = std::string("Fix mpm/fluid: the grids of fix ") + o->id + " and fix " + id +
+                              " overlap: each fix is a fluid of its own, and the two pass through each other " +
+                              "(a mixture of fluids is not modelled)";
+      error->warning(FLERR, msg.c_str());
+    }
+  }
   if (uncoupled_warned) return;
   double box[6];
   for (int d = 0; d < 3; ++d) {
@@ -373,7 +392,8 @@ void FixMpmFluid::warn_unheld() {
   MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_DOUBLE, MPI_MAX, world);
   long mine = 0, all = 0;
   for (int i = 0; i < atom->nlocal; ++i) {
-    if (is_point(i) || (atom->mask[i] & couple_groupbit)) continue;
+    // (radius 0: a point, also of another fix mpm/fluid)
+    if (is_point(i) || (atom->mask[i] & couple_groupbit) || !(atom->radius[i] > 0.0)) continue;
     bool in = true;
     for (int d = 0; d < 3 && in; ++d) in = atom->x[i][d] >= -box[d] && atom->x[i][d] <= box[3 + d];
     mine += in;

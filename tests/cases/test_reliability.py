@@ -681,6 +681,37 @@ def case_range_rest(r):
     check(p.returncode == 0 and not warns, f"water at rest, three runs: no range warning (got {[w[:160] for w in warns]})")
 
 
+TWO_FLUIDS = cases.PREAMBLE + """region box block 0 0.4 0 0.05 0 0.3 units box
+create_box 2 box
+neighbor 0.005 bin
+neigh_modify delay 0 every 1 check yes
+region a block 0 0.1 0 0.05 0 0.2 units box
+region b block {b} 0 0.05 0 0.2 units box
+group f1 type 1
+group f2 type 2
+fix fa f1 mpm/fluid cell 0.025 density 1000 viscosity 1e-3 boundary all freeslip fill a 2 2 2 type 1 {grid}
+fix fb f2 mpm/fluid cell 0.025 density 800 viscosity 1e-3 boundary all freeslip fill b 2 2 2 type 2 {grid2}
+fix grav all gravity 9.81 vector 0 0 -1
+timestep 2e-4
+run 20
+"""
+
+
+def case_two_fluids(r):
+    """Two fix mpm/fluid in one box are two fluids that pass through each other (a water column and
+    an oil column collapsed through one another without a word): a warning names both fixes when
+    their grids overlap, once; none when their grids are apart. The other fluid's points are not
+    counted as uncoupled grains."""
+    for name, b, grid, grid2, want in (("overlap", "0.05 0.15", "", "", 1),
+                                       ("apart", "0.3 0.4", "grid 0 0.2 0 0.05 0 0.3", "grid 0.2 0.4 0 0.05 0 0.3", 0)):
+        d = r.fresh(f"two_fluids/{name}")
+        p = execute_text(r, d, TWO_FLUIDS.format(b=b, grid=grid, grid2=grid2))
+        warns = [ln for ln in p.stdout.splitlines() if "WARNING" in ln]
+        hit = [w for w in warns if "the grids of fix fa and fix fb overlap" in w]
+        check(p.returncode == 0 and len(hit) == want and len(warns) == want,
+              f"{name}: {want} warning(s) naming both fixes, no other (got {[w[:140] for w in warns]}, exit {p.returncode})")
+
+
 def joke_lines(text):
     """Lines that LIGGGHTS' error->all or error->one print after the ERROR line when its version
     string says PUBLIC: a 'comment from the off' or a 'tip of the day', read from a destroyed
