@@ -103,6 +103,7 @@ class FixMpmFluid : public Fix {
   std::vector<double> shifted;  // the grains' positions while fluid_step_ahead moved them  // F of the last fluid step onto the coupled grains' f (every DEM step)
   void check_gate_side();
   void warn_unheld();
+  void warn_fill_beyond_grid(class Region *region);
   mpm::FluidSolver &sync();  // the solver with views of the current atom arrays and clock
   template <class Fn> void guarded(Fn &&fn);  // runs fn, translating the solver's errors
   void print(const std::string &text) const;  // rank 0: to screen and log file

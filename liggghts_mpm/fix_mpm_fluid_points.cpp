@@ -197,6 +197,29 @@ void FixMpmFluid::check_fill_memory(Region *region, const int lo[3], const int h
   }
 }
 
+/* The fill creates points in the grid's cells only: a region whose finite bounds reach beyond a
+   non-periodic face of the grid is cut there (an unbounded side, INF, is not named), and the
+   water has less volume than the region. A warning names the region, the axis and both extents. */
+void FixMpmFluid::warn_fill_beyond_grid(Region *region) {
+  if (!region->bboxflag || comm->me != 0) return;
+  const mpm::GridSpec &gs = solver->opt.grid;
+  const double big = 1e19;  // LIGGGHTS' INF bound is 1e20
+  const double ext[2][3] = {{region->extent_xlo, region->extent_ylo, region->extent_zlo},
+                            {region->extent_xhi, region->extent_yhi, region->extent_zhi}};
+  const double tol = 1e-9 * gs.dx;
+  for (int d = 0; d < 3; ++d) {
+    if (gs.periodic[d]) continue;
+    const bool below = ext[0][d] > -big && ext[0][d] < gs.origin[d] - tol;
+    const bool above = ext[1][d] < big && ext[1][d] > gs.upper(d) + tol;
+    if (!below && !above) continue;
+    std::ostringstream os;
+    os << "Fix mpm/fluid: the fill region '" << solver->opt.fill_region << "' reaches beyond the grid along "
+       << "xyz"[d] << " (the region " << ext[0][d] << " .. " << ext[1][d] << " m, the grid " << gs.origin[d] << " .. "
+       << gs.upper(d) << " m): points are created inside the grid only";
+    error->warning(FLERR, os.str().c_str());
+  }
+}
+
 void FixMpmFluid::fill_points() {
   const mpm::Options &o = solver->opt;
   const mpm::GridSpec &gs = o.grid;
@@ -218,6 +241,7 @@ void FixMpmFluid::fill_points() {
     hi[d] = std::min(gs.ncell[d] - 1, static_cast<int>(std::floor((domain->subhi[d] - gs.origin[d]) / dx)) + 1);
   }
   check_fill_memory(region, lo, hi);
+  warn_fill_beyond_grid(region);
   // fill ... inside/outside meshes: the lattice points inside the container and outside the
   // others (mesh_fill_host.h), as a region's fill takes those inside the region: the points'
   // volume is then the inside's to the lattice's sampling. A point within a thousandth of a

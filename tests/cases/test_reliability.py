@@ -712,6 +712,22 @@ def case_two_fluids(r):
               f"{name}: {want} warning(s) naming both fixes, no other (got {[w[:140] for w in warns]}, exit {p.returncode})")
 
 
+def case_fill_beyond(r):
+    """A fill region reaching beyond the grid was cut at the grid's face without a word (a column
+    0.3 m long in a grid 0.2 m long held 2 kg of water, not 3): a warning names the region, the axis
+    and both extents. None for a region with an unbounded side (INF) or inside the grid."""
+    text = TWO_FLUIDS.replace("fix fb f2 mpm/fluid cell 0.025 density 800 viscosity 1e-3 boundary all freeslip fill b 2 2 2 type 2 {grid2}\n", "")
+    for name, region, want in (("beyond", "0 0.3 0 0.05 0 0.2", 1), ("inf", "INF INF INF INF INF 0.2", 0), ("inside", "0 0.1 0 0.05 0 0.2", 0)):
+        d = r.fresh(f"fill_beyond/{name}")
+        t = text.format(b="0 0.1", grid="grid 0 0.2 0 0.05 0 0.3", grid2="").replace(
+            "region a block 0 0.1 0 0.05 0 0.2", f"region a block {region}")
+        p = execute_text(r, d, t)
+        warns = [ln for ln in p.stdout.splitlines() if "WARNING" in ln]
+        hit = [w for w in warns if "the fill region 'a' reaches beyond the grid along x" in w and "0 .. 0.3 m" in w]
+        check(p.returncode == 0 and len(hit) == want and len(warns) == want,
+              f"region {region}: {want} warning(s) naming the region, the axis and the extents (got {[w[:150] for w in warns]}, exit {p.returncode})")
+
+
 def joke_lines(text):
     """Lines that LIGGGHTS' error->all or error->one print after the ERROR line when its version
     string says PUBLIC: a 'comment from the off' or a 'tip of the day', read from a destroyed
