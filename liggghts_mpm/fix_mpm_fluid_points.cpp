@@ -364,14 +364,19 @@ void FixMpmFluid::check_group_atoms() {
      (couple left out, or given a smaller group); checked at every setup until it warns, so that
      grains inserted in an earlier run are seen. */
 void FixMpmFluid::warn_unheld() {
-  double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  if (grain_walls_checked && overlap_checked && uncoupled_warned) return;
+  const mpm::GridSpec &g = solver->opt.grid;
+  // the points' bounds over all ranks, box[d] = -lo[d], box[3 + d] = hi[d] (one reduction for the
+  // checks below)
+  double box[6] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
   for (int i = 0; i < atom->nlocal; ++i)
     if (is_point(i))
       for (int d = 0; d < 3; ++d) {
-        lo[d] = std::min(lo[d], atom->x[i][d]);
-        hi[d] = std::max(hi[d], atom->x[i][d]);
+        box[d] = std::max(box[d], -atom->x[i][d]);
+        box[3 + d] = std::max(box[3 + d], atom->x[i][d]);
       }
-  const mpm::GridSpec &g = sync().opt.grid;
+  MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_DOUBLE, MPI_MAX, world);
+  const double lo[3] = {-box[0], -box[1], -box[2]}, hi[3] = {box[3], box[4], box[5]};
   if (!grain_walls_checked) {
     grain_walls_checked = true;
     std::vector<std::string> fluid;
@@ -408,18 +413,12 @@ void FixMpmFluid::warn_unheld() {
     }
   }
   if (uncoupled_warned) return;
-  double box[6];
-  for (int d = 0; d < 3; ++d) {
-    box[d] = -lo[d];
-    box[3 + d] = hi[d];
-  }
-  MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_DOUBLE, MPI_MAX, world);
   long mine = 0, all = 0;
   for (int i = 0; i < atom->nlocal; ++i) {
     // (radius 0: a point, also of another fix mpm/fluid)
     if (is_point(i) || (atom->mask[i] & couple_groupbit) || !(atom->radius[i] > 0.0)) continue;
     bool in = true;
-    for (int d = 0; d < 3 && in; ++d) in = atom->x[i][d] >= -box[d] && atom->x[i][d] <= box[3 + d];
+    for (int d = 0; d < 3 && in; ++d) in = atom->x[i][d] >= lo[d] && atom->x[i][d] <= hi[d];
     mine += in;
   }
   MPI_Allreduce(&mine, &all, 1, MPI_LONG, MPI_SUM, world);

@@ -74,12 +74,6 @@ std::vector<std::string> grain_walls_beside_fluid(LAMMPS_NS::LAMMPS *lmp, const 
   const double eps = 0.01 * reach;
   int me = 0;
   MPI_Comm_rank(lmp->world, &me);
-  double box[6];  // the points' bounds over all ranks: min lo, max hi (as -max -lo)
-  for (int d = 0; d < 3; ++d) {
-    box[d] = -lo[d];
-    box[3 + d] = hi[d];
-  }
-  MPI_Allreduce(MPI_IN_PLACE, box, 6, MPI_DOUBLE, MPI_MAX, lmp->world);
   std::vector<std::string> out;
   for (int f = 0; f < lmp->modify->nfix; ++f) {
     auto *fm = dynamic_cast<LAMMPS_NS::FixMeshSurface *>(lmp->modify->fix[f]);
@@ -106,7 +100,7 @@ std::vector<std::string> grain_walls_beside_fluid(LAMMPS_NS::LAMMPS *lmp, const 
     MPI_Allreduce(MPI_IN_PLACE, mb, 6, MPI_DOUBLE, MPI_MIN, lmp->world);
     bool near = true;
     for (int d = 0; d < 3; ++d)
-      near = near && mb[d] <= box[3 + d] + reach && -mb[3 + d] >= -box[d] - reach;
+      near = near && mb[d] <= hi[d] + reach && -mb[3 + d] >= lo[d] - reach;
     if (near) out.push_back(id);
   }
   return out;

@@ -27,7 +27,7 @@ std::vector<char> fill_mesh_mask(LAMMPS_NS::LAMMPS *lmp, const Options &o, const
 // Collective. The IDs of the meshes that are walls of the grains (a fix wall/gran made their
 // neighbour list) but not of the fluid (not in fluid_walls), and whose triangles inside the grid
 // (glo..ghi; a triangle on or beyond a face of it is the grid face's to hold) have a bounding box
-// within reach of the box lo..hi (the points' bounds; lo > hi on a rank without points).
+// within reach of the box lo..hi (the points' bounds over all ranks; lo > hi without points).
 std::vector<std::string> grain_walls_beside_fluid(LAMMPS_NS::LAMMPS *lmp, const std::vector<std::string> &fluid_walls,
                                                   const double lo[3], const double hi[3], const double glo[3],
                                                   const double ghi[3], double reach);

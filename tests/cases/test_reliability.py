@@ -681,20 +681,22 @@ def case_range_rest(r):
     check(p.returncode == 0 and not warns, f"water at rest, three runs: no range warning (got {[w[:160] for w in warns]})")
 
 
-TWO_FLUIDS = cases.PREAMBLE + """region box block 0 0.4 0 0.05 0 0.3 units box
+# fix fa: water in region a; {fb}: optionally a second fluid (SECOND_FLUID, region b)
+FLUIDS = cases.PREAMBLE + """region box block 0 0.4 0 0.05 0 0.3 units box
 create_box 2 box
 neighbor 0.005 bin
 neigh_modify delay 0 every 1 check yes
-region a block 0 0.1 0 0.05 0 0.2 units box
-region b block {b} 0 0.05 0 0.2 units box
+region a block {a} units box
 group f1 type 1
 group f2 type 2
 fix fa f1 mpm/fluid cell 0.025 density 1000 viscosity 1e-3 boundary all freeslip fill a 2 2 2 type 1 {grid}
-fix fb f2 mpm/fluid cell 0.025 density 800 viscosity 1e-3 boundary all freeslip fill b 2 2 2 type 2 {grid2}
+{fb}
 fix grav all gravity 9.81 vector 0 0 -1
 timestep 2e-4
 run 20
 """
+SECOND_FLUID = """region b block {b} 0 0.05 0 0.2 units box
+fix fb f2 mpm/fluid cell 0.025 density 800 viscosity 1e-3 boundary all freeslip fill b 2 2 2 type 2 {grid2}"""
 
 
 def case_two_fluids(r):
@@ -705,7 +707,7 @@ def case_two_fluids(r):
     for name, b, grid, grid2, want in (("overlap", "0.05 0.15", "", "", 1),
                                        ("apart", "0.3 0.4", "grid 0 0.2 0 0.05 0 0.3", "grid 0.2 0.4 0 0.05 0 0.3", 0)):
         d = r.fresh(f"two_fluids/{name}")
-        p = execute_text(r, d, TWO_FLUIDS.format(b=b, grid=grid, grid2=grid2))
+        p = execute_text(r, d, FLUIDS.format(a="0 0.1 0 0.05 0 0.2", grid=grid, fb=SECOND_FLUID.format(b=b, grid2=grid2)))
         warns = [ln for ln in p.stdout.splitlines() if "WARNING" in ln]
         hit = [w for w in warns if "the grids of fix fa and fix fb overlap" in w]
         check(p.returncode == 0 and len(hit) == want and len(warns) == want,
@@ -716,12 +718,9 @@ def case_fill_beyond(r):
     """A fill region reaching beyond the grid was cut at the grid's face without a word (a column
     0.3 m long in a grid 0.2 m long held 2 kg of water, not 3): a warning names the region, the axis
     and both extents. None for a region with an unbounded side (INF) or inside the grid."""
-    text = TWO_FLUIDS.replace("fix fb f2 mpm/fluid cell 0.025 density 800 viscosity 1e-3 boundary all freeslip fill b 2 2 2 type 2 {grid2}\n", "")
     for name, region, want in (("beyond", "0 0.3 0 0.05 0 0.2", 1), ("inf", "INF INF INF INF INF 0.2", 0), ("inside", "0 0.1 0 0.05 0 0.2", 0)):
         d = r.fresh(f"fill_beyond/{name}")
-        t = text.format(b="0 0.1", grid="grid 0 0.2 0 0.05 0 0.3", grid2="").replace(
-            "region a block 0 0.1 0 0.05 0 0.2", f"region a block {region}")
-        p = execute_text(r, d, t)
+        p = execute_text(r, d, FLUIDS.format(a=region, grid="grid 0 0.2 0 0.05 0 0.3", fb=""))
         warns = [ln for ln in p.stdout.splitlines() if "WARNING" in ln]
         hit = [w for w in warns if "the fill region 'a' reaches beyond the grid along x" in w and "0 .. 0.3 m" in w]
         check(p.returncode == 0 and len(hit) == want and len(warns) == want,
