@@ -8,8 +8,8 @@ against the case's reference (CASES.md), with the wall time of each run.
 
 ROW: f1 f2 f3 f4 c1 c1var (C1 with the fluid damped while the grain is held) c2 c5 c5wall c5tilt
 c6 porewave transfer (the coupled rows again with transfer apic) damping (C5 undamped while settling,
-C6 damped while held) f3var (F3 with the other transfer) f4fine (F4 at 80 cells) fluidapic (F2 MPM32, F4 with transfer apic),
-c3 (C3 tank, quick size, 0.26 s) c4 (C4 jar, full size, C4_TURNS turns, default 1) starter (quick and default size), or all. Each run prints one line: row, model, settings, figures, wall time (s).
+C6 damped while held) f3var (F3 with the other transfer) f3fine (F3 at Grid80) f4fine (F4 at 80 cells) fluidapic (F2 MPM32, F4 with transfer apic),
+c3 (C3 tank, quick size, 0.26 s) c3full (C3 at full size) c4 (C4 jar, full size, C4_TURNS turns, default 1) starter (quick and default size), or all. Each run prints one line: row, model, settings, figures, wall time (s).
 """
 import argparse
 import inspect
@@ -80,8 +80,9 @@ def row_f2(r, models, cells=(16, 32), extra=""):
                                                              "mass_exact": s["mass"][0] == s["mass0"][0]}, w)
 
 
-def row_f3(r, models, cells=(20, 40), extra=""):
-    """F3 released column (free-slip walls): kinetic energy / inviscid at 0.01 and 0.02 s."""
+def row_f3(r, models, cells=(20, 40), extra="", dt=None):
+    """F3 released column (free-slip walls): kinetic energy / inviscid at 0.01 and 0.02 s.
+    dt: {model: time step} where the input's automatic step does not hold (None: the input's)."""
     from test_projection import inviscid_column_ke_rate
     rate = inviscid_column_ke_rate(0.05, 0.1, 0.1)
     for m in models:
@@ -89,6 +90,8 @@ def row_f3(r, models, cells=(20, 40), extra=""):
             v = {"cells": c, "pressure": m, "wallkind": "freeslip"}
             if extra:
                 v["extra"] = extra
+            if dt and m in dt:
+                v["dt"] = dt[m]
             d, p, w = timed(r, f"f3/{m}_g{c}{extra.replace(' ', '_')}", "tank/in.column", v)
             s = read_csv(os.path.join(d, "column.csv"))
             f = {}
@@ -251,6 +254,13 @@ def row_fluidapic(r, models):
     row_f2(r, models, cells=(32,), extra="transfer apic")
 
 
+def row_f3fine(r, models):
+    """F3 at Grid80 (256,000 points) with both transfers; eos at 8e-6 s, under its acoustic limit
+    8.43e-6 s there (the input's 1e-5 s is refused)."""
+    row_f3(r, models, cells=(80,), dt={"eos": 8e-6})
+    row_f3(r, [m for m in models if m == "projection"], cells=(80,), extra="transfer flip 1")
+
+
 def row_f3var(r, models):
     """F3 with the other transfer: flip 1 for the projection (in.column sets apic), apic for eos."""
     other = {"projection": "transfer flip 1", "eos": "transfer apic"}
@@ -265,17 +275,19 @@ def row_transfer(r, models):
     row_c6(r, models, extra="transfer apic", phis=(0.3,))
 
 
-def row_c3(r, models, extra=""):
-    """C3 tank, quick size (Grid20, 1 point per cell, 2000 beads) to 0.26 s after the start of the lift
+def row_c3(r, models, extra="", quick=True):
+    """C3 tank, quick size (Grid20, 1 point per cell, 2000 beads; quick=False: the input's full size,
+    Grid40 x 8 points, 7762 beads) to 0.26 s after the start of the lift
     (past the water's impact on the far wall), fronts.csv every 2 ms: the time the water reaches
     0.19 m, the fronts at 0.05-0.2 s, the largest point pressure against rho g h + rho U_gate^2, the
     highest bead against the highest water point, the fluid mass."""
     bound = 1000.0 * 9.81 * 0.1 + 1000.0 * 0.68 ** 2
+    size = "quick (Grid20 x 1, 2000 beads)" if quick else "full size (Grid40 x 8, 7762 beads)"
     for m in models:
-        v = {"quick": 1, "tend": 0.26, "tfront": 0.002, "pressure": m}
+        v = {"quick": 1 if quick else 0, "tend": 0.26, "tfront": 0.002, "pressure": m}
         if extra:
             v["extra"] = extra  # after the input's own keywords: a repeated one (e.g. every) takes this value
-        d, p, w = timed(r, f"c3/{m}{extra.replace(' ', '_')}", "tank/in.tank", v)
+        d, p, w = timed(r, f"c3{'' if quick else 'full'}/{m}{extra.replace(' ', '_')}", "tank/in.tank", v)
         f = read_csv(os.path.join(d, "fronts.csv"))
         t = f["t"]
 
@@ -292,7 +304,12 @@ def row_c3(r, models, extra=""):
                      "bed_rise_to_0.2s_mm": 1e3 * (max(z for z, tt in zip(f["z_beads"], t) if tt <= 0.2 + 1e-9)
                                                    - f["z_beads"][0]),
                      "mass_exact": max(f["mass"]) == min(f["mass"])})
-        emit("C3", m, "quick (Grid20 x 1, 2000 beads), 0.26 s" + (f", {extra}" if extra else ""), figs, w)
+        emit("C3", m, size + ", 0.26 s" + (f", {extra}" if extra else ""), figs, w)
+
+
+def row_c3full(r, models):
+    """C3 at the input's full size (about 20 minutes of one core with the projection)."""
+    row_c3(r, models, quick=False)
 
 
 def row_c4(r, models, turns=float(os.environ.get("C4_TURNS", "1"))):
@@ -348,8 +365,8 @@ def row_starter(r, models):
 
 
 ROWS = {"f1": row_f1, "f2": row_f2, "f3": row_f3, "f4": row_f4, "c1": row_c1, "c2": row_c2, "c5": row_c5,
-        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "f4fine": row_f4fine, "fluidapic": row_fluidapic, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer,
-        "c3": row_c3, "c4": row_c4, "starter": row_starter}
+        "c5wall": row_c5wall, "c1var": row_c1var, "damping": row_damping, "f3var": row_f3var, "f3fine": row_f3fine, "f4fine": row_f4fine, "fluidapic": row_fluidapic, "c5tilt": row_c5tilt, "c6": row_c6, "porewave": row_porewave, "transfer": row_transfer,
+        "c3": row_c3, "c3full": row_c3full, "c4": row_c4, "starter": row_starter}
 
 
 def main():
