@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -353,6 +354,38 @@ TEST(Options, ReferencePageListsExactlyTheTableKeywords) {
   std::sort(page.begin(), page.end());
   std::sort(table.begin(), table.end());
   EXPECT_EQ(page, table) << "docs/fix_mpm_fluid.md, section Keywords";
+}
+
+// The same table's Default column (the fifth; a '|' escaped as '\|' stays in its cell, code spans
+// are read without their backquotes) holds each keyword's default as mpm::keywords() gives it.
+TEST(Options, ReferencePageDefaultsAreTheTableDefaults) {
+  std::ifstream in(MPM_DOC_PAGE);
+  ASSERT_TRUE(in) << MPM_DOC_PAGE;
+  std::map<std::string, std::string> page;
+  bool inside = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("## ", 0) == 0) inside = line == "## Keywords";
+    if (!inside || line.rfind("| `", 0) != 0) continue;
+    std::vector<std::string> cells(1);
+    for (std::size_t i = 1; i < line.size(); ++i) {
+      if (line[i] == '|' && line[i - 1] != '\\') {
+        cells.emplace_back();
+      } else if (line[i] != '`') {
+        cells.back() += line[i];
+      }
+    }
+    ASSERT_GE(cells.size(), 6u) << line;
+    auto trim = [](std::string s) {
+      s.erase(0, s.find_first_not_of(' '));
+      s.erase(s.find_last_not_of(' ') + 1);
+      return s;
+    };
+    page[trim(cells[0])] = trim(cells[4]);
+  }
+  for (const mpm::Keyword &k : mpm::keywords()) {
+    ASSERT_TRUE(page.count(k.name)) << k.name;
+    EXPECT_EQ(page[k.name], k.deflt) << "docs/fix_mpm_fluid.md, section Keywords, default of '" << k.name << "'";
+  }
 }
 
 }  // namespace
