@@ -153,18 +153,24 @@ static double usable_memory_bytes() {
   return mem;
 }
 
+// the region's bounding box: ext[0] the low bounds, ext[1] the high ones (x, y, z; an unbounded
+// side is LIGGGHTS' INF, 1e20). Meaningful where region->bboxflag.
+static void region_extent(const Region *region, double ext[2][3]) {
+  ext[0][0] = region->extent_xlo, ext[0][1] = region->extent_ylo, ext[0][2] = region->extent_zlo;
+  ext[1][0] = region->extent_xhi, ext[1][1] = region->extent_yhi, ext[1][2] = region->extent_zhi;
+}
+
 /* Before creating the points: an upper estimate of their number (the cells of the grid within the
    region's bounding box, times the points per cell) against half of the machine's physical memory,
    so that 'cell 0.002' in a 1 m box stops with a message instead of dying in the allocator. */
 void FixMpmFluid::check_fill_memory(Region *region, const int lo[3], const int hi[3]) {
   const mpm::Options &o = solver->opt;
   const mpm::GridSpec &gs = o.grid;
-  double ncells = 1.0;
+  double ncells = 1.0, ext[2][3];
+  if (region->bboxflag) region_extent(region, ext);
   for (int d = 0; d < 3; ++d) {
     double a = lo[d], b = hi[d];
     if (region->bboxflag) {
-      const double ext[2][3] = {{region->extent_xlo, region->extent_ylo, region->extent_zlo},
-                                {region->extent_xhi, region->extent_yhi, region->extent_zhi}};
       a = std::max(a, std::floor((ext[0][d] - gs.origin[d]) / gs.dx));
       b = std::min(b, std::floor((ext[1][d] - gs.origin[d]) / gs.dx));
     }
@@ -204,8 +210,8 @@ void FixMpmFluid::warn_fill_beyond_grid(Region *region) {
   if (!region->bboxflag || comm->me != 0) return;
   const mpm::GridSpec &gs = solver->opt.grid;
   const double big = 1e19;  // LIGGGHTS' INF bound is 1e20
-  const double ext[2][3] = {{region->extent_xlo, region->extent_ylo, region->extent_zlo},
-                            {region->extent_xhi, region->extent_yhi, region->extent_zhi}};
+  double ext[2][3];
+  region_extent(region, ext);
   const double tol = 1e-9 * gs.dx;
   for (int d = 0; d < 3; ++d) {
     if (gs.periodic[d]) continue;
