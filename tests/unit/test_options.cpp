@@ -335,33 +335,18 @@ TEST(Options, EveryRowIsComplete) {
   }
 }
 
-// The contract with the reference page: its section '## Keywords' holds one table whose rows start
-// with | `keyword` |, one per row of mpm::keywords().
-TEST(Options, ReferencePageListsExactlyTheTableKeywords) {
+// The rows of the reference page's section '## Keywords': one table whose rows start with
+// | `keyword` |. Each row as its cells, trimmed, code spans read without their backquotes; a '|'
+// escaped as '\|' stays in its cell.
+std::vector<std::vector<std::string>> keyword_rows() {
   std::ifstream in(MPM_DOC_PAGE);
-  ASSERT_TRUE(in) << MPM_DOC_PAGE;
-  std::vector<std::string> page;
-  bool inside = false;
-  for (std::string line; std::getline(in, line);) {
-    if (line.rfind("## ", 0) == 0) inside = line == "## Keywords";
-    if (!inside || line.rfind("| `", 0) != 0) continue;
-    const std::size_t end = line.find('`', 3);
-    ASSERT_NE(end, std::string::npos) << line;
-    page.push_back(line.substr(3, end - 3));
-  }
-  std::vector<std::string> table;
-  for (const mpm::Keyword &k : mpm::keywords()) table.push_back(k.name);
-  std::sort(page.begin(), page.end());
-  std::sort(table.begin(), table.end());
-  EXPECT_EQ(page, table) << "docs/fix_mpm_fluid.md, section Keywords";
-}
-
-// The same table's Default column (the fifth; a '|' escaped as '\|' stays in its cell, code spans
-// are read without their backquotes) holds each keyword's default as mpm::keywords() gives it.
-TEST(Options, ReferencePageDefaultsAreTheTableDefaults) {
-  std::ifstream in(MPM_DOC_PAGE);
-  ASSERT_TRUE(in) << MPM_DOC_PAGE;
-  std::map<std::string, std::string> page;
+  EXPECT_TRUE(in) << MPM_DOC_PAGE;
+  std::vector<std::vector<std::string>> rows;
+  auto trim = [](std::string s) {
+    s.erase(0, s.find_first_not_of(' '));
+    s.erase(s.find_last_not_of(' ') + 1);
+    return s;
+  };
   bool inside = false;
   for (std::string line; std::getline(in, line);) {
     if (line.rfind("## ", 0) == 0) inside = line == "## Keywords";
@@ -369,18 +354,34 @@ TEST(Options, ReferencePageDefaultsAreTheTableDefaults) {
     std::vector<std::string> cells(1);
     for (std::size_t i = 1; i < line.size(); ++i) {
       if (line[i] == '|' && line[i - 1] != '\\') {
+        cells.back() = trim(cells.back());
         cells.emplace_back();
       } else if (line[i] != '`') {
         cells.back() += line[i];
       }
     }
-    ASSERT_GE(cells.size(), 6u) << line;
-    auto trim = [](std::string s) {
-      s.erase(0, s.find_first_not_of(' '));
-      s.erase(s.find_last_not_of(' ') + 1);
-      return s;
-    };
-    page[trim(cells[0])] = trim(cells[4]);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+// The contract with the reference page: its Keywords table has one row per row of mpm::keywords().
+TEST(Options, ReferencePageListsExactlyTheTableKeywords) {
+  std::vector<std::string> page;
+  for (const std::vector<std::string> &row : keyword_rows()) page.push_back(row[0]);
+  std::vector<std::string> table;
+  for (const mpm::Keyword &k : mpm::keywords()) table.push_back(k.name);
+  std::sort(page.begin(), page.end());
+  std::sort(table.begin(), table.end());
+  EXPECT_EQ(page, table) << "docs/fix_mpm_fluid.md, section Keywords";
+}
+
+// The same table's Default column (the fifth) holds each keyword's default as mpm::keywords() gives it.
+TEST(Options, ReferencePageDefaultsAreTheTableDefaults) {
+  std::map<std::string, std::string> page;
+  for (const std::vector<std::string> &row : keyword_rows()) {
+    ASSERT_GE(row.size(), 6u) << row[0];
+    page[row[0]] = row[4];
   }
   for (const mpm::Keyword &k : mpm::keywords()) {
     ASSERT_TRUE(page.count(k.name)) << k.name;
