@@ -53,15 +53,15 @@ def emit(row, model, settings, figs, wall):
     print(f"{row} | {model} | {settings} | {f} | {wall:.1f} s", flush=True)
 
 
-def row_f1(r, models):
-    """F1 hydrostatic column, 16 cells, 0.4 s (eos: its damping 20 1/s; also without)."""
+def row_f1(r, models, cells=16, undamped=True):
+    """F1 hydrostatic column, 16 cells, 0.4 s (eos: its damping 20 1/s; also without, if undamped)."""
     for m in models:
-        runs = [("", {})] + ([("no damping", {"extra": "damping 0"})] if m == "eos" else [])
+        runs = [("", {})] + ([("no damping", {"extra": "damping 0"})] if m == "eos" and undamped else [])
         for label, v in runs:
-            d, p, w = timed(r, f"f1/{m}{label.replace(' ', '_')}", "hydrostatic/in.hydrostatic",
-                            dict({"cells": 16, "pressure": m}, **v))
+            d, p, w = timed(r, f"f1/{m}_c{cells}{label.replace(' ', '_')}", "hydrostatic/in.hydrostatic",
+                            dict({"cells": cells, "pressure": m}, **v))
             e_all, e_in, s = pressure_errors(d)
-            emit("F1", m, "cells 16, 0.4 s" + (", " + label if label else ""),
+            emit("F1", m, f"cells {cells}, 0.4 s" + (", " + label if label else ""),
                  {"L2_all": e_all, "L2_interior": e_in, "mass_exact": s["mass"][0] == s["mass0"][0],
                   "crossings": int(s["crossings"][0]), "ke_end_J": s["ke"][0]}, w)
 
@@ -163,7 +163,8 @@ def row_c5(r, models, extra="", **more):
                 v["extra"] = extra
             tag = extra + "".join(f" {k} {x}" for k, x in more.items())
             q, n, side, w = bed(r, f"c5/{m}_{fl}{tag.replace(' ', '_')}", **v)
-            emit("C5", m, f"{where}, cell 1.5 d, {n} grains" + (", " + tag.strip() if tag else ""), {"archimedes_ratio": q}, w)
+            emit("C5", m, f"{where}, cell {more.get('cellf', 1.5):g} d, {n} grains" + (", " + tag.strip() if tag else ""),
+                 {"archimedes_ratio": q}, w)
 
 
 def row_c5wall(r, models, extra=""):
