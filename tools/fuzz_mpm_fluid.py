@@ -279,8 +279,8 @@ def cases(quick):
                         if kw == "gate":
                             mod = "fix_modify fluid gate " + v
                         out.append(("fix_modify/" + label, script(ctx, "", post=mod), kw, "bad"))
-        # repeated keyword (boundary and mesh_wall may repeat: one face or mesh each)
-        if kw not in ("boundary", "mesh_wall", "fill", "couple", "pressure") and (not quick or kw in ("cfl", "gate", "drag")):
+        # repeated keyword (boundary, mesh_wall and probe may repeat: one face, mesh or probe each)
+        if kw not in ("boundary", "mesh_wall", "probe", "fill", "couple", "pressure") and (not quick or kw in ("cfl", "gate", "drag")):
             one = kw + " " + " ".join(example)
             out.append((f"{kw}/repeated", script(ctx, one + " " + one), kw, "repeat"))
     for kw in ("tolerance", "cell", "pressure", "mesh_wall", "couple", "density", "colour"):
@@ -288,7 +288,8 @@ def cases(quick):
     for label, extra, ctx, kw in (CONFLICTS if not quick else CONFLICTS[::4]):
         out.append((f"conflict/{label}", script(ctx, extra), kw, "bad"))
     # boundary FACE inflow U (the row above varies the face and the partial kind): U, a real > 0
-    for v in (BAD_REAL if not quick else QUICK_REAL[:3]) + [None]:
+    # (BAD_REAL ends with the missing value already; QUICK_REAL has none)
+    for v in (BAD_REAL if not quick else QUICK_REAL[:3] + [None]):
         if in_range(FLOW_U, v):
             continue
         extra = "boundary zlo inflow" + (" " + v if v is not None else "")
@@ -375,6 +376,12 @@ def main():
     exe = os.path.abspath(a.exe)
     os.makedirs(a.work, exist_ok=True)
     todo = cases(a.quick)
+    # each case runs in its own folder, named from its label: two cases with one folder would
+    # run at once in it under -j > 1 and read each other's files
+    dirs = [re.sub(r"[^A-Za-z0-9_.+-]", "_", c[0]) for c in todo]
+    dup = sorted({x for x in dirs if dirs.count(x) > 1})
+    if dup:
+        sys.exit("fuzz_mpm_fluid.py: cases share a folder: " + " ".join(dup))
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.j) as pool:
         results = list(pool.map(lambda c: run_one(exe, a.work, c, a.timeout), todo))
     counts = {}
