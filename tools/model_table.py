@@ -54,7 +54,7 @@ def emit(row, model, settings, figs, wall):
 
 
 def row_f1(r, models, cells=16, undamped=True):
-    """F1 hydrostatic column, 16 cells, 0.4 s (eos: its damping 20 1/s; also without, if undamped)."""
+    """F1 hydrostatic column, `cells` cells (16), 0.4 s (eos: its damping 20 1/s; also without, if undamped)."""
     for m in models:
         runs = [("", {})] + ([("no damping", {"extra": "damping 0"})] if m == "eos" and undamped else [])
         for label, v in runs:
