@@ -130,7 +130,8 @@ def row_c1(r, models, extra="", **more):
         tc, vc = [c[0] for c in curve], [c[1] for c in curve]
         dev = max(abs(x - cases.interp(t, tc, vc)) for t, x in zip(sim["t"], vs)) / vt
         emit("C1", m, f"d 0.1 mm, cell {1e3 * more.get('cell', 3e-3):g} mm, 0.1 s" + (", " + tag.strip() if tag else ""),
-             {"vt_ratio": vs[-1] / vt, "vt_SN": vt, "curve_dev_vt": dev}, w)
+             {"vt_ratio": vs[-1] / vt, "vt_SN": vt, "curve_dev_vt": dev,
+              "end_over_curve": vs[-1] / cases.interp(sim["t"][-1], tc, vc)}, w)
 
 
 def row_c2(r, models):
