@@ -102,8 +102,9 @@ def run_c6(r, models):
 
 def run_c8(r, models):
     # the fluidized bed's input is written for the default model (its fluid step, every 10 DEM
-    # steps, is above the stable step of pressure eos, which refuses it): the projection only. Stages 0.01, 0.02, 0.025
-    # (fixed bed) and 0.04, 0.045 m/s (fluidized), 0.6 s each; the box about 18 x 18 x 86 mm
+    # steps, is above the stable step of pressure eos, which refuses it): the projection only.
+    # Stages 0.01, 0.02, 0.025 (fixed bed) and 0.04, 0.045 m/s (fluidized), 0.6 s each; the box
+    # about 18 x 18 x 86 mm
     import time
     import fluidized_bed as fb
     if "projection" not in models:
