@@ -45,27 +45,28 @@ sys.path.insert(0, HERE)
 import model_table as mt  # noqa: E402
 
 
+def emitted(row, *args, **kwargs):
+    """The records that one call of a model_table row emits."""
+    n0 = len(mt.OUT)
+    row(*args, **kwargs)
+    return mt.OUT[n0:]
+
+
 def run_f1(r, models):
     for c in (8, 16, 32):
-        n0 = len(mt.OUT)
-        mt.row_f1(r, models, cells=c, undamped=False)
-        for rec in mt.OUT[n0:]:
+        for rec in emitted(mt.row_f1, r, models, cells=c, undamped=False):
             yield rec, f"{c} cells", c, {"L2 pressure error": rec["figures"]["L2_all"]}
 
 
 def run_f3(r, models):
     for c in (20, 40, 80):
-        n0 = len(mt.OUT)
-        mt.row_f3(r, models, cells=(c,), dt={"eos": 8e-6} if c == 80 else None)
-        for rec in mt.OUT[n0:]:
+        for rec in emitted(mt.row_f3, r, models, cells=(c,), dt={"eos": 8e-6} if c == 80 else None):
             yield rec, f"Grid{c}", c, {"|KE/KE_inviscid - 1| at 0.02 s": abs(rec["figures"]["ke_ratio_0.02s"] - 1.0)}
 
 
 def run_f4(r, models):
     for c in (20, 40, 80):
-        n0 = len(mt.OUT)
-        mt.row_f4(r, models, cells=(c,))
-        for rec in mt.OUT[n0:]:
+        for rec in emitted(mt.row_f4, r, models, cells=(c,)):
             f = rec["figures"]
             yield rec, f"{c} cells", c, {"|omega/omega_exact - 1|": abs(f["w_ratio"] - 1.0),
                                          "|amplitude after 3 periods - 1|": abs(f["amp_end_ratio"] - 1.0)}
@@ -74,9 +75,7 @@ def run_f4(r, models):
 def run_c1(r, models):
     # the box 24 x 24 x 36 mm at every cell size (the input's 8 x 8 x 12 cells of 3 mm)
     for cell_mm in (6.0, 3.0, 1.5):
-        n0 = len(mt.OUT)
-        mt.row_c1(r, models, cell=cell_mm * 1e-3, nxy=round(24 / cell_mm), nz=round(36 / cell_mm))
-        for rec in mt.OUT[n0:]:
+        for rec in emitted(mt.row_c1, r, models, cell=cell_mm * 1e-3, nxy=round(24 / cell_mm), nz=round(36 / cell_mm)):
             yield rec, f"cell {cell_mm:g} mm", 1.0 / cell_mm, {"|v / v_SN(t) - 1| at the end": abs(rec["figures"]["end_over_curve"] - 1.0)}
 
 
@@ -84,9 +83,7 @@ def run_c5(r, models):
     # 150 grains at cell 1.5 d (model_table's C5); the box is 8 cells wide, so the grains grow with
     # the cell's area to keep the bed's height
     for cellf in (3.0, 2.0, 1.5):
-        n0 = len(mt.OUT)
-        mt.row_c5(r, models, cellf=cellf, nbeads=round(150 * (cellf / 1.5) ** 2))
-        for rec in mt.OUT[n0:]:
+        for rec in emitted(mt.row_c5, r, models, cellf=cellf, nbeads=round(150 * (cellf / 1.5) ** 2)):
             where = "mid-depth" if rec["settings"].startswith("mid-depth") else "floor"
             yield rec, f"cell {cellf:g} d", 1.0 / cellf, {f"|F / Archimedes - 1|, {where}": abs(rec["figures"]["archimedes_ratio"] - 1.0)}
 
@@ -94,9 +91,7 @@ def run_c5(r, models):
 def run_c6(r, models):
     # model_table's reduced C6 is 4 x 4 x 12 cells of 2 d: the same box (8 x 8 x 24 mm) at each cell
     for cellf in (3.0, 2.0, 1.5):
-        n0 = len(mt.OUT)
-        mt.row_c6(r, models, phis=(0.2,), cellf=cellf, nxy=round(8 / cellf), nsus=round(24 / cellf))
-        for rec in mt.OUT[n0:]:
+        for rec in emitted(mt.row_c6, r, models, phis=(0.2,), cellf=cellf, nxy=round(8 / cellf), nsus=round(24 / cellf)):
             yield rec, f"cell {cellf:g} d", 1.0 / cellf, {"|v / v_ref - 1|, solid fraction 0.2": abs(rec["figures"]["v_ratio"] - 1.0)}
 
 
@@ -118,10 +113,9 @@ def run_c8(r, models):
         wall = time.time() - t0
         with open(os.devnull, "w") as devnull:
             res = fb.analyse(work, out=devnull)
-        rec = {"row": "C8", "model": "projection", "wall_s": round(wall, 1)}
-        print(f"C8 | projection | cell {cellf:g} d | plateau {res.get('plateau', float('nan')):.4f} of W/A, "
-              f"U_mf {res.get('umf', float('nan')):.4f} m/s | {wall:.1f} s", flush=True)
-        yield rec, f"cell {cellf:g} d", 1.0 / cellf, {
+        mt.emit("C8", "projection", f"cell {cellf:g} d, stages 0.01-0.045 m/s of 0.6 s",
+                {"plateau_over_W": res.get("plateau", float("nan")), "umf_m_s": res.get("umf", float("nan"))}, wall)
+        yield mt.OUT[-1], f"cell {cellf:g} d", 1.0 / cellf, {
             "|dP / (W/A) - 1|, fluidized": res.get("plateau_dev", float("nan")),
             "|U_mf / U_mf(Wen-Yu) - 1|": abs(res["umf"] / res["umf_wy"] - 1.0) if "umf" in res else float("nan")}
 

@@ -335,11 +335,16 @@ OPTIONAL = {("transfer", 1)}
 MODIFIABLE = ("gate", "damping", "cfl", "boundary", "subcycle", "cell_check")
 
 
+def case_folder(name):
+    """The folder of a case under the work folder: its label with the characters a path may not hold replaced."""
+    return re.sub(r"[^A-Za-z0-9_.+-]", "_", name)
+
+
 def run_one(exe, work, case, timeout):
     name, text, kw, group = case
     if text is None:
         return name, kw, group, "unspecified", "the driver has no argument spec for this keyword"
-    d = os.path.join(work, re.sub(r"[^A-Za-z0-9_.+-]", "_", name))
+    d = os.path.join(work, case_folder(name))
     shutil.rmtree(d, ignore_errors=True)
     os.makedirs(d)
     with open(os.path.join(d, "in.script"), "w") as f:
@@ -378,7 +383,7 @@ def main():
     todo = cases(a.quick)
     # each case runs in its own folder, named from its label: two cases with one folder would
     # run at once in it under -j > 1 and read each other's files
-    dirs = [re.sub(r"[^A-Za-z0-9_.+-]", "_", c[0]) for c in todo]
+    dirs = [case_folder(c[0]) for c in todo]
     dup = sorted({x for x in dirs if dirs.count(x) > 1})
     if dup:
         sys.exit("fuzz_mpm_fluid.py: cases share a folder: " + " ".join(dup))
